@@ -3,6 +3,7 @@
 /// Scalar, vector and rigid-transform types used throughout the collision layer.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 

@@ -1,0 +1,70 @@
+#pragma once
+/// \file model.h
+/// One entry point over every polygon-level method: build a CollisionModel
+/// for a mesh once, then query pairs of models of the same method.
+///
+/// Why: the command line, the benchmarks and the tests compare methods side by
+/// side; they choose a Method at run time and must not care which hierarchy
+/// type sits behind it. A built model is immutable and may be shared and
+/// queried from any number of threads at once.
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string_view>
+
+#include "dovetail/collision/collide.h"
+#include "dovetail/collision/mesh.h"
+#include "dovetail/collision/types.h"
+
+namespace dovetail::collision {
+
+/// Polygon-level methods. kBrute tests every triangle pair (the reference).
+enum class Method { kBoxtree, kDop6, kDop14, kDop18, kDop26, kAabb, kObb, kBrute };
+
+/// Command-line name: boxtree, dop6, dop14, dop18, dop26, aabb, obb, brute.
+std::string_view method_name(Method method);
+/// Inverse of method_name; nullopt for an unknown name.
+std::optional<Method> parse_method(std::string_view name);
+/// Every method, in the order above.
+std::span<const Method> all_methods();
+
+/// Shape and size of a built hierarchy.
+struct ModelInfo {
+  std::size_t nodes = 0;   ///< all nodes, leaves included
+  std::size_t leaves = 0;
+  std::size_t depth = 0;   ///< longest root-to-leaf path, root = 1
+  std::size_t bytes = 0;   ///< memory of the hierarchy itself (not the mesh)
+  double bytes_per_triangle = 0.0;
+};
+
+/// A mesh with its hierarchy for one Method. Immutable after build.
+class CollisionModel {
+ public:
+  virtual ~CollisionModel() = default;
+  CollisionModel(const CollisionModel&) = delete;
+  CollisionModel& operator=(const CollisionModel&) = delete;
+
+  Method method() const { return method_; }
+  const Mesh& mesh() const { return *mesh_; }
+  const std::shared_ptr<const Mesh>& shared_mesh() const { return mesh_; }
+  virtual ModelInfo info() const = 0;
+
+  /// Collision query with this model as A and `b` as B, X_AB the pose of B in
+  /// A's frame. Throws std::invalid_argument when b was built for another Method.
+  virtual CollideResult collide(const CollisionModel& b, const Transform& X_AB,
+                                const CollideRequest& request = {}) const = 0;
+
+ protected:
+  CollisionModel(Method method, std::shared_ptr<const Mesh> mesh)
+      : method_(method), mesh_(std::move(mesh)) {}
+
+ private:
+  Method method_;
+  std::shared_ptr<const Mesh> mesh_;
+};
+
+/// Builds the hierarchy of `method` for `mesh` (top-down, once).
+std::shared_ptr<const CollisionModel> build_model(Method method, std::shared_ptr<const Mesh> mesh);
+
+}  // namespace dovetail::collision

@@ -1,0 +1,80 @@
+#pragma once
+// Restricted boxtree (Zachmann, "Minimal hierarchical collision detection",
+// VRST 2002).
+//
+// Why: a child box equals its parent box except for one face, so a node needs
+// only a split axis and two split values (12 bytes), the smallest node of all
+// hierarchies here; and in a simultaneous traversal a child's test re-uses
+// its parent's transformed extents: descending one tree changes one face, so
+// the child's enclosure in the other tree's frame costs three multiply-adds,
+// and in its own frame only the moved face has to be compared.
+
+#include <cstdint>
+#include <vector>
+
+#include "dovetail/collision/collide.h"
+#include "dovetail/collision/mesh.h"
+
+namespace dovetail::collision {
+
+/// Build settings of a Boxtree.
+struct BoxtreeSettings {
+  int max_leaf_size = 2;        ///< triangles per leaf, 1..4
+  double slab_threshold = 0.3;  ///< split off an empty slab wider than this fraction of the box
+  int bins = 16;                ///< candidate split positions per axis
+};
+
+/// One node. Inner node: children at `child()` (and `child() + 1` when both
+/// exist); the left child's box is the parent's with its upper face on `axis`
+/// moved to `split_left`, the right child's with its lower face moved to
+/// `split_right`. A node with one child splits off an empty slab. Leaf: up to
+/// four consecutive entries of Boxtree::triangle_order.
+struct BoxtreeNode {
+  float split_left = 0;
+  float split_right = 0;
+  std::uint32_t bits = 0;  ///< axis (2 bits, 3 = leaf) | kind or leaf count - 1 (2 bits) | index (28 bits)
+
+  static constexpr std::uint32_t kLeafAxis = 3;
+  static constexpr std::uint32_t kBothChildren = 0;
+  static constexpr std::uint32_t kLeftOnly = 1;
+  static constexpr std::uint32_t kRightOnly = 2;
+  static constexpr std::uint32_t kMaxIndex = (1u << 28) - 1;
+
+  std::uint32_t axis() const { return bits & 3u; }
+  bool is_leaf() const { return axis() == kLeafAxis; }
+  std::uint32_t kind() const { return (bits >> 2) & 3u; }
+  int leaf_count() const { return static_cast<int>(kind()) + 1; }
+  std::uint32_t index() const { return bits >> 4; }
+};
+
+/// Restricted boxtree over one mesh; immutable after construction.
+class Boxtree {
+ public:
+  Boxtree(const Mesh& mesh, const BoxtreeSettings& settings = {});
+
+  /// Query with this tree over `mesh_a` as A and `b` over `mesh_b` as B.
+  CollideResult collide(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,
+                        const Transform& X_AB, const CollideRequest& request) const;
+
+  std::size_t node_count() const { return nodes_.size(); }
+  std::size_t leaf_count() const { return leaves_; }
+  std::size_t depth() const { return depth_; }
+  std::size_t bytes() const;
+
+  const std::vector<BoxtreeNode>& nodes() const { return nodes_; }
+  const std::vector<std::uint32_t>& triangle_order() const { return order_; }
+
+ private:
+  friend class BoxtreeBuilder;
+  friend class BoxtreeTraversal;
+
+  std::vector<BoxtreeNode> nodes_;   ///< root at 0
+  std::vector<std::uint32_t> order_;  ///< leaf slots -> Mesh::triangles index
+  float root_lo_[3] = {0, 0, 0};
+  float root_hi_[3] = {0, 0, 0};
+  Real max_abs_ = 0;  ///< largest absolute vertex coordinate
+  std::size_t leaves_ = 0;
+  std::size_t depth_ = 0;
+};
+
+}  // namespace dovetail::collision

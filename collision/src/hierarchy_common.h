@@ -1,0 +1,120 @@
+#pragma once
+// Pieces shared by every hierarchy: per-triangle build records, outward
+// rounding to float, the conservative margin and the leaf-pair test.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "dovetail/collision/collide.h"
+#include "dovetail/collision/mesh.h"
+#include "dovetail/collision/tri_tri.h"
+
+namespace dovetail::collision::detail {
+
+/// Largest float <= x.
+inline float round_down(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
+}
+
+/// Smallest float >= x.
+inline float round_up(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+
+/// A triangle during top-down construction.
+struct BuildTriangle {
+  Vec3 lo;
+  Vec3 hi;
+  Vec3 centroid;
+  std::uint32_t index = 0;  ///< into Mesh::triangles
+};
+
+inline std::vector<BuildTriangle> build_triangles(const Mesh& mesh) {
+  std::vector<BuildTriangle> out(mesh.triangles.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const TriangleIndices& t = mesh.triangles[i];
+    const Vec3& p = mesh.vertices[t[0]];
+    const Vec3& q = mesh.vertices[t[1]];
+    const Vec3& r = mesh.vertices[t[2]];
+    out[i].lo = p.cwiseMin(q).cwiseMin(r);
+    out[i].hi = p.cwiseMax(q).cwiseMax(r);
+    out[i].centroid = (p + q + r) / 3.0;
+    out[i].index = static_cast<std::uint32_t>(i);
+  }
+  return out;
+}
+
+/// Largest absolute coordinate of a mesh (for the conservative margin).
+inline Real max_abs_coordinate(const Mesh& mesh) {
+  Real r = 0;
+  for (const Vec3& v : mesh.vertices) r = std::max(r, v.cwiseAbs().maxCoeff());
+  return r;
+}
+
+/// Margin added to every volume overlap test of a query. Transformed volumes
+/// and transformed vertices are rounded differently; the margin, far above
+/// that rounding (relative 2^-40) and far below any geometric feature, keeps
+/// the culling conservative, so a hierarchy never misses a pair that the exact
+/// triangle test (on the same transformed vertices) would report.
+inline Real query_margin(Real max_abs_a, Real max_abs_b, const Transform& X_AB) {
+  return 0x1.0p-40 * (max_abs_a + 3 * max_abs_b + X_AB.t.cwiseAbs().sum());
+}
+
+/// State of one query's traversal: meshes, pose, result, early exit.
+class LeafTester {
+ public:
+  LeafTester(const Mesh& a, const Mesh& b, const Transform& X_AB, bool all_pairs,
+             CollideResult& result)
+      : a_(a), b_(b), X_AB_(X_AB), all_pairs_(all_pairs), result_(result) {}
+
+  bool done() const { return done_; }
+
+  /// Tests triangle `ia` of A against triangle `ib` of B (B's vertices brought
+  /// into A's frame with Transform::apply, as every method does).
+  void test(std::uint32_t ia, std::uint32_t ib) {
+    const TriangleIndices& ta = a_.triangles[ia];
+    const TriangleIndices& tb = b_.triangles[ib];
+    const Vec3 p2 = X_AB_.apply(b_.vertices[tb[0]]);
+    const Vec3 q2 = X_AB_.apply(b_.vertices[tb[1]]);
+    const Vec3 r2 = X_AB_.apply(b_.vertices[tb[2]]);
+    ++result_.stats.triangle_tests;
+    if (triangles_intersect(a_.vertices[ta[0]], a_.vertices[ta[1]], a_.vertices[ta[2]], p2, q2,
+                            r2)) {
+      result_.colliding = true;
+      result_.pairs.push_back({ia, ib});
+      done_ = !all_pairs_;
+    }
+  }
+
+  /// Tests every triangle of one leaf against every triangle of another.
+  void test_leaves(const std::uint32_t* tris_a, int count_a, const std::uint32_t* tris_b,
+                   int count_b) {
+    for (int i = 0; i < count_a && !done_; ++i) {
+      for (int j = 0; j < count_b && !done_; ++j) test(tris_a[i], tris_b[j]);
+    }
+  }
+
+  void count_volume_test() { ++result_.stats.volume_tests; }
+
+  /// Sorts all-pairs output by (a, b).
+  void finish() {
+    if (all_pairs_) std::sort(result_.pairs.begin(), result_.pairs.end());
+  }
+
+ private:
+  const Mesh& a_;
+  const Mesh& b_;
+  const Transform& X_AB_;
+  bool all_pairs_;
+  bool done_ = false;
+  CollideResult& result_;
+};
+
+}  // namespace dovetail::collision::detail

@@ -1,0 +1,82 @@
+#include "dovetail/collision/mesh.h"
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "dovetail/collision/predicates.h"
+
+namespace dovetail::collision {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& source, const std::string& what) {
+  throw MeshError(source + ": " + what);
+}
+
+}  // namespace
+
+Mesh make_mesh(std::vector<Vec3> vertices, std::vector<TriangleIndices> triangles,
+               std::string source, const MeshLimits& limits, MeshValidation* validation) {
+  MeshValidation found;
+  found.input_vertices = vertices.size();
+  found.input_triangles = triangles.size();
+
+  if (vertices.empty()) fail(source, "mesh has no vertices");
+  if (triangles.empty()) fail(source, "mesh has no triangles");
+  if (vertices.size() > limits.max_vertices) {
+    fail(source, std::to_string(vertices.size()) + " vertices exceed the limit of " +
+                     std::to_string(limits.max_vertices));
+  }
+  if (triangles.size() > limits.max_triangles) {
+    fail(source, std::to_string(triangles.size()) + " triangles exceed the limit of " +
+                     std::to_string(limits.max_triangles));
+  }
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const Real c = vertices[i][k];
+      if (!std::isfinite(c)) fail(source, "vertex " + std::to_string(i) + " is not finite");
+      if (std::abs(c) > limits.max_abs_coordinate) {
+        fail(source, "vertex " + std::to_string(i) + " has a coordinate beyond " +
+                         std::to_string(limits.max_abs_coordinate));
+      }
+    }
+  }
+
+  std::vector<bool> used(vertices.size(), false);
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    const TriangleIndices& t = triangles[i];
+    for (std::uint32_t v : t) {
+      if (v >= vertices.size()) {
+        fail(source, "triangle " + std::to_string(i) + " references vertex " + std::to_string(v) +
+                         " of " + std::to_string(vertices.size()));
+      }
+    }
+    if (is_degenerate_triangle(vertices[t[0]], vertices[t[1]], vertices[t[2]])) {
+      ++found.degenerate_removed;
+      continue;
+    }
+    for (std::uint32_t v : t) used[v] = true;
+    triangles[kept++] = t;
+  }
+  triangles.resize(kept);
+  if (triangles.empty()) {
+    fail(source, "all " + std::to_string(found.input_triangles) + " triangles are degenerate");
+  }
+  for (bool u : used) found.unused_vertices += u ? 0 : 1;
+
+  if (validation != nullptr) *validation = found;
+  return Mesh{std::move(vertices), std::move(triangles), std::move(source)};
+}
+
+Bounds mesh_bounds(const Mesh& mesh) {
+  Bounds b{mesh.vertices.front(), mesh.vertices.front()};
+  for (const Vec3& v : mesh.vertices) {
+    b.min = b.min.cwiseMin(v);
+    b.max = b.max.cwiseMax(v);
+  }
+  return b;
+}
+
+}  // namespace dovetail::collision

@@ -1,0 +1,95 @@
+#pragma once
+// Simultaneous traversal of two hierarchies with tight volumes (the bounding
+// volume test tree). B's volume is brought into A's frame once per B node
+// (the policy's Enc) and re-used while A descends; the larger node descends.
+
+#include "binary_layout.h"
+#include "hierarchy_common.h"
+
+namespace dovetail::collision::detail {
+
+/// Policy interface:
+///   using Enc;                           B's node volume expressed in A's frame
+///   Enc enclose_b(uint32_t b) const;
+///   bool overlap(uint32_t a, const Enc&) const;
+///   NodeLink link_a(uint32_t), link_b(uint32_t) const;
+///   Real size_a(uint32_t), size_b(uint32_t) const;
+///   const uint32_t* slots_a(), *slots_b() const;  leaf slot -> triangle index
+template <typename Policy>
+class PairTraversal {
+ public:
+  using Enc = typename Policy::Enc;
+
+  PairTraversal(const Policy& policy, LeafTester& tester) : p_(policy), tester_(tester) {}
+
+  void run() {
+    const Enc root_b = p_.enclose_b(0);
+    tester_.count_volume_test();
+    if (p_.overlap(0, root_b)) visit(0, 0, root_b);
+  }
+
+ private:
+  void visit(std::uint32_t a, std::uint32_t b, const Enc& enc_b) {
+    const NodeLink la = p_.link_a(a);
+    const NodeLink lb = p_.link_b(b);
+    if (la.is_leaf() && lb.is_leaf()) {
+      tester_.test_leaves(p_.slots_a() + la.first_slot(), la.count(), p_.slots_b() + lb.first_slot(),
+                          lb.count());
+      return;
+    }
+    if (!la.is_leaf() && (lb.is_leaf() || p_.size_a(a) >= p_.size_b(b))) {
+      for (std::uint32_t c = la.first_child(); c < la.first_child() + 2; ++c) {
+        tester_.count_volume_test();
+        if (p_.overlap(c, enc_b)) visit(c, b, enc_b);
+        if (tester_.done()) return;
+      }
+    } else {
+      for (std::uint32_t c = lb.first_child(); c < lb.first_child() + 2; ++c) {
+        const Enc enc_c = p_.enclose_b(c);
+        tester_.count_volume_test();
+        if (p_.overlap(a, enc_c)) visit(a, c, enc_c);
+        if (tester_.done()) return;
+      }
+    }
+  }
+
+  const Policy& p_;
+  LeafTester& tester_;
+};
+
+/// Separating-axis test of two boxes (Gottschalk et al., OBB-Tree, 15 axes):
+/// box A with half extents ea in its own frame, box B with half extents eb,
+/// axes the columns of R and centre T, both in A's frame. `margin` widens
+/// every projected radius so that rounding never separates touching boxes.
+inline bool boxes_overlap(const Mat3& R, const Vec3& T, const Vec3& ea, const Vec3& eb,
+                          Real margin) {
+  Mat3 absR;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) absR(i, j) = std::abs(R(i, j));
+  }
+  // A's face axes.
+  for (int i = 0; i < 3; ++i) {
+    const Real rb = absR(i, 0) * eb[0] + absR(i, 1) * eb[1] + absR(i, 2) * eb[2];
+    if (std::abs(T[i]) > ea[i] + rb + margin) return false;
+  }
+  // B's face axes.
+  for (int j = 0; j < 3; ++j) {
+    const Real ra = absR(0, j) * ea[0] + absR(1, j) * ea[1] + absR(2, j) * ea[2];
+    const Real t = R(0, j) * T[0] + R(1, j) * T[1] + R(2, j) * T[2];
+    if (std::abs(t) > ra + eb[j] + margin) return false;
+  }
+  // Edge-edge axes A_i x B_j.
+  for (int i = 0; i < 3; ++i) {
+    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+    for (int j = 0; j < 3; ++j) {
+      const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+      const Real ra = ea[i1] * absR(i2, j) + ea[i2] * absR(i1, j);
+      const Real rb = eb[j1] * absR(i, j2) + eb[j2] * absR(i, j1);
+      const Real t = T[i2] * R(i1, j) - T[i1] * R(i2, j);
+      if (std::abs(t) > ra + rb + margin) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace dovetail::collision::detail

@@ -1,0 +1,140 @@
+#include "dovetail/collision/primitives.h"
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <string>
+#include <utility>
+
+namespace dovetail::collision {
+
+namespace {
+
+using Triangles = std::vector<TriangleIndices>;
+
+TriangleIndices tri(std::size_t a, std::size_t b, std::size_t c) {
+  return {static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
+          static_cast<std::uint32_t>(c)};
+}
+
+std::string describe(const char* what, int a, int b = -1) {
+  std::string s = "generated ";
+  s.append(what).append("(").append(std::to_string(a));
+  if (b >= 0) s.append(",").append(std::to_string(b));
+  s.append(")");
+  return s;
+}
+
+}  // namespace
+
+Mesh make_box(const Vec3& h) {
+  std::vector<Vec3> v;
+  for (int i = 0; i < 8; ++i) {
+    v.emplace_back((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(), (i & 4) ? h.z() : -h.z());
+  }
+  // Two triangles per face, outward counter-clockwise.
+  const Triangles t = {tri(0, 2, 3), tri(0, 3, 1), tri(4, 5, 7), tri(4, 7, 6),
+                       tri(0, 1, 5), tri(0, 5, 4), tri(2, 6, 7), tri(2, 7, 3),
+                       tri(0, 4, 6), tri(0, 6, 2), tri(1, 3, 7), tri(1, 7, 5)};
+  return make_mesh(std::move(v), t, "generated box");
+}
+
+Mesh make_sphere(Real radius, int subdivisions) {
+  const Real g = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Vec3> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
+                         {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  for (Vec3& p : v) p.normalize();
+  Triangles t = {tri(0, 11, 5), tri(0, 5, 1),  tri(0, 1, 7),   tri(0, 7, 10), tri(0, 10, 11),
+                 tri(1, 5, 9),  tri(5, 11, 4), tri(11, 10, 2), tri(10, 7, 6), tri(7, 1, 8),
+                 tri(3, 9, 4),  tri(3, 4, 2),  tri(3, 2, 6),   tri(3, 6, 8),  tri(3, 8, 9),
+                 tri(4, 9, 5),  tri(2, 4, 11), tri(6, 2, 10),  tri(8, 6, 7),  tri(9, 8, 1)};
+  for (int s = 0; s < subdivisions; ++s) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> midpoints;
+    auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
+      const auto key = std::minmax(a, b);
+      auto [it, inserted] = midpoints.try_emplace(key, static_cast<std::uint32_t>(v.size()));
+      if (inserted) v.push_back((v[a] + v[b]).normalized());
+      return it->second;
+    };
+    Triangles next;
+    next.reserve(t.size() * 4);
+    for (const TriangleIndices& f : t) {
+      const std::uint32_t ab = midpoint(f[0], f[1]);
+      const std::uint32_t bc = midpoint(f[1], f[2]);
+      const std::uint32_t ca = midpoint(f[2], f[0]);
+      next.push_back({f[0], ab, ca});
+      next.push_back({f[1], bc, ab});
+      next.push_back({f[2], ca, bc});
+      next.push_back({ab, bc, ca});
+    }
+    t = std::move(next);
+  }
+  for (Vec3& p : v) p *= radius;
+  return make_mesh(std::move(v), std::move(t), describe("sphere", subdivisions));
+}
+
+Mesh make_torus(Real major, Real minor, int rings, int sides) {
+  std::vector<Vec3> v;
+  Triangles t;
+  for (int i = 0; i < rings; ++i) {
+    const Real u = 2 * std::numbers::pi * i / rings;
+    for (int j = 0; j < sides; ++j) {
+      const Real w = 2 * std::numbers::pi * j / sides;
+      const Real r = major + minor * std::cos(w);
+      v.emplace_back(r * std::cos(u), r * std::sin(u), minor * std::sin(w));
+    }
+  }
+  auto at = [&](int i, int j) { return ((i % rings) * sides) + (j % sides); };
+  for (int i = 0; i < rings; ++i) {
+    for (int j = 0; j < sides; ++j) {
+      t.push_back(tri(at(i, j), at(i + 1, j), at(i + 1, j + 1)));
+      t.push_back(tri(at(i, j), at(i + 1, j + 1), at(i, j + 1)));
+    }
+  }
+  return make_mesh(std::move(v), std::move(t), describe("torus", rings, sides));
+}
+
+Mesh make_cylinder(Real radius, Real height, int sides) {
+  std::vector<Vec3> v;
+  Triangles t;
+  for (int j = 0; j < sides; ++j) {
+    const Real w = 2 * std::numbers::pi * j / sides;
+    v.emplace_back(radius * std::cos(w), radius * std::sin(w), 0);
+    v.emplace_back(radius * std::cos(w), radius * std::sin(w), height);
+  }
+  const std::size_t bottom = v.size();
+  v.emplace_back(0, 0, 0);
+  const std::size_t top = v.size();
+  v.emplace_back(0, 0, height);
+  for (int j = 0; j < sides; ++j) {
+    const std::size_t a0 = 2 * j, a1 = 2 * j + 1;
+    const std::size_t b0 = 2 * ((j + 1) % sides), b1 = b0 + 1;
+    t.push_back(tri(a0, b0, b1));
+    t.push_back(tri(a0, b1, a1));
+    t.push_back(tri(bottom, b0, a0));
+    t.push_back(tri(top, a1, b1));
+  }
+  return make_mesh(std::move(v), std::move(t), describe("cylinder", sides));
+}
+
+Mesh make_wavy_sheet(Real half, Real amplitude, Real freq, int n) {
+  std::vector<Vec3> v;
+  Triangles t;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const Real x = -half + 2 * half * i / (n - 1);
+      const Real y = -half + 2 * half * j / (n - 1);
+      v.emplace_back(x, y, amplitude * std::sin(x * freq) * std::cos(y * freq));
+    }
+  }
+  for (int i = 0; i + 1 < n; ++i) {
+    for (int j = 0; j + 1 < n; ++j) {
+      const int a = i * n + j;
+      t.push_back(tri(a, a + n, a + n + 1));
+      t.push_back(tri(a, a + n + 1, a + 1));
+    }
+  }
+  return make_mesh(std::move(v), std::move(t), describe("wavy sheet", n));
+}
+
+}  // namespace dovetail::collision

@@ -1,0 +1,256 @@
+// Every hierarchy must report exactly what the exhaustive reference reports:
+// the same yes/no verdict and the same set of intersecting triangle pairs.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "dovetail/collision/model.h"
+#include "dovetail/collision/pose_sampling.h"
+#include "dovetail/collision/primitives.h"
+
+namespace dovetail::collision {
+namespace {
+
+std::shared_ptr<const Mesh> share(Mesh m) { return std::make_shared<const Mesh>(std::move(m)); }
+
+/// Mesh with a transform applied to every vertex.
+Mesh transformed(const Mesh& m, const Transform& X) {
+  std::vector<Vec3> v;
+  for (const Vec3& p : m.vertices) v.push_back(X.apply(p));
+  return make_mesh(v, m.triangles, m.source + " (moved)");
+}
+
+struct Agreement {
+  int poses = 0;
+  int colliding = 0;
+  int disagreements = 0;
+};
+
+/// Runs every method on every pose and compares with brute force: verdicts of
+/// first-hit queries, and the full sorted pair lists of all-pairs queries.
+/// Reports the first few disagreements in full.
+Agreement expect_agreement(const std::shared_ptr<const Mesh>& a, const std::shared_ptr<const Mesh>& b,
+                           const std::vector<Transform>& poses, const std::string& scene) {
+  std::vector<std::shared_ptr<const CollisionModel>> models_a, models_b;
+  for (Method m : all_methods()) {
+    models_a.push_back(build_model(m, a));
+    models_b.push_back(build_model(m, b));
+  }
+  const std::size_t brute = models_a.size() - 1;
+  Agreement agreement;
+  auto disagree = [&](std::size_t p, std::size_t m, const std::string& what) {
+    if (++agreement.disagreements <= 5) {
+      ADD_FAILURE() << scene << " pose " << p << " method " << method_name(models_a[m]->method())
+                    << ": " << what << "\nR=\n" << poses[p].R << "\nt=" << poses[p].t.transpose();
+    }
+  };
+  for (std::size_t p = 0; p < poses.size(); ++p) {
+    const CollideResult reference = models_a[brute]->collide(*models_b[brute], poses[p], {.all_pairs = true});
+    agreement.colliding += reference.colliding ? 1 : 0;
+    ++agreement.poses;
+    for (std::size_t m = 0; m + 1 < models_a.size(); ++m) {
+      const CollideResult first = models_a[m]->collide(*models_b[m], poses[p]);
+      if (first.colliding != reference.colliding) {
+        disagree(p, m, "first-hit verdict differs from brute");
+      } else if (first.colliding &&
+                 (first.pairs.size() != 1 || !std::binary_search(reference.pairs.begin(),
+                                                                  reference.pairs.end(), first.pairs[0]))) {
+        disagree(p, m, "first-hit pair is not an intersecting pair");
+      }
+      const CollideResult all = models_a[m]->collide(*models_b[m], poses[p], {.all_pairs = true});
+      if (all.pairs != reference.pairs) {
+        disagree(p, m, "all-pairs list differs: " + std::to_string(all.pairs.size()) + " vs brute " +
+                           std::to_string(reference.pairs.size()));
+      }
+    }
+  }
+  EXPECT_EQ(agreement.disagreements, 0) << scene;
+  std::printf("[ agreement ] %s: %d poses (%d colliding) x %zu methods, %d disagreements\n",
+              scene.c_str(), agreement.poses, agreement.colliding, models_a.size() - 1,
+              agreement.disagreements);
+  return agreement;
+}
+
+std::vector<Transform> contact_poses(const std::shared_ptr<const Mesh>& a,
+                                     const std::shared_ptr<const Mesh>& b, int directions,
+                                     std::uint64_t seed) {
+  const auto ma = build_model(Method::kBoxtree, a);
+  const auto mb = build_model(Method::kBoxtree, b);
+  std::vector<Transform> out;
+  ContactPoseSettings settings;
+  settings.directions = directions;
+  settings.seed = seed;
+  // Besides the standard gaps, poses at the bisected contact distance itself.
+  settings.gaps.push_back(0.0);
+  for (const SampledPose& s : contact_distance_poses(*ma, *mb, settings)) out.push_back(s.X_AB);
+  return out;
+}
+
+TEST(Hierarchies, SphereAgainstTorusRandomAndContactPoses) {
+  const auto a = share(make_sphere(0.6, 2));
+  const auto b = share(make_torus(0.7, 0.25, 24, 12));
+  std::vector<Transform> poses = random_poses(2500, 1.2, 11);
+  const std::vector<Transform> contact = contact_poses(a, b, 120, 12);
+  poses.insert(poses.end(), contact.begin(), contact.end());
+  const Agreement r = expect_agreement(a, b, poses, "sphere/torus");
+  EXPECT_GE(r.poses, 3400);
+  // The pose set must exercise both verdicts.
+  EXPECT_GT(r.colliding, r.poses / 5);
+  EXPECT_LT(r.colliding, r.poses * 4 / 5);
+}
+
+TEST(Hierarchies, ParallelCloseProximityWavySheets) {
+  // Two copies of a wavy sheet, the second lifted by tiny amounts and slightly
+  // turned: many parallel, nearly touching faces.
+  const auto a = share(make_wavy_sheet(1.0, 0.1, 4.0, 22));
+  const auto b = a;
+  std::vector<Transform> poses;
+  const std::vector<Transform> jitter = random_poses(1500, 1.0, 21);
+  for (std::size_t i = 0; i < jitter.size(); ++i) {
+    Transform X;
+    const Real angle = 1e-3 * (static_cast<Real>(i % 7) - 3.0);
+    X.R = rotation_from_quaternion(std::cos(angle / 2), 0, 0, std::sin(angle / 2));
+    const Real dz = std::ldexp(1.0, -static_cast<int>(i % 40)) * ((i % 2) ? 1 : -1) * 0.05;
+    X.t = Vec3(0.01 * jitter[i].t.x(), 0.01 * jitter[i].t.y(), dz);
+    poses.push_back(X);
+  }
+  poses.push_back(Transform::identity());  // coincident: every face touches its twin
+  const Agreement r = expect_agreement(a, b, poses, "wavy sheets");
+  EXPECT_GT(r.colliding, 0);
+  EXPECT_LT(r.colliding, r.poses);
+}
+
+TEST(Hierarchies, BoxesTouchingFacesEdgesAndVertices) {
+  // Unit boxes placed exactly face to face, edge to edge, vertex to vertex,
+  // and a hair apart, under the 24 axis-aligned rotations (exact in floating point).
+  const auto a = share(make_box(Vec3(0.5, 0.5, 0.5)));
+  const auto b = share(make_box(Vec3(0.5, 0.5, 0.5)));
+  std::vector<Mat3> rotations;
+  for (int perm = 0; perm < 6; ++perm) {
+    const int order[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    for (int signs = 0; signs < 8; ++signs) {
+      Mat3 R = Mat3::Zero();
+      for (int r = 0; r < 3; ++r) R(r, order[perm][r]) = (signs >> r & 1) ? -1 : 1;
+      if (R.determinant() > 0) rotations.push_back(R);
+    }
+  }
+  std::vector<Transform> poses;
+  const Real eps = std::ldexp(1.0, -30);
+  for (const Mat3& R : rotations) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          for (Real extra : {0.0, eps, -eps, 0.25}) {
+            Transform X;
+            X.R = R;
+            X.t = Vec3(dx, dy, dz) * (1.0 + extra);
+            X.t.x() += dy == 0 ? 0.5 : 0.0;  // half-offset faces: partial overlap of coplanar faces
+            poses.push_back(X);
+          }
+        }
+      }
+    }
+  }
+  const Agreement r = expect_agreement(a, b, poses, "boxes");
+  EXPECT_GT(r.colliding, 0);
+  EXPECT_LT(r.colliding, r.poses);
+}
+
+TEST(Hierarchies, SliversAndSharedEdges) {
+  // A 128-sided thin cylinder (long sliver facets) against itself turned about
+  // its axis by exact multiples of its facet angle: facets share edges.
+  const auto a = share(make_cylinder(0.05, 3.0, 128));
+  std::vector<Transform> poses = random_poses(1500, 0.2, 31);
+  for (int k = 0; k < 64; ++k) {
+    Transform X;
+    X.R = rotation_from_quaternion(1, 0, 0, 0);
+    X.t = Vec3(0, 0, 0.5 * (k % 8));
+    poses.push_back(X);
+    X.t = Vec3(0.1, 0, 0);  // side by side, touching along a line
+    poses.push_back(X);
+  }
+  const Agreement r = expect_agreement(a, a, poses, "slivers");
+  EXPECT_GT(r.colliding, 0);
+  EXPECT_LT(r.colliding, r.poses);
+}
+
+TEST(Hierarchies, ScaledScenesAgree) {
+  // The same scene at 1e-3 and 1e3: the conservative margins scale with it.
+  for (Real scale : {1e-3, 1e3}) {
+    Transform S;
+    S.R = Mat3::Identity() * scale;
+    const auto a = share(transformed(make_sphere(0.6, 2), S));
+    const auto b = share(transformed(make_torus(0.7, 0.25, 16, 8), S));
+    std::vector<Transform> poses = random_poses(800, 1.2 * scale, 41);
+    const Agreement r = expect_agreement(a, b, poses, "scale " + std::to_string(scale));
+    EXPECT_GT(r.colliding, 0);
+    EXPECT_LT(r.colliding, r.poses);
+  }
+}
+
+TEST(Hierarchies, SurfaceOnlyTestsMissFullContainment) {
+  // Documented behaviour: a part fully inside another with no surface contact
+  // is not reported by the polygon level (containment is a separate query).
+  const auto outer = share(make_sphere(1.0, 2));
+  const auto inner = share(make_sphere(0.3, 1));
+  for (Method m : all_methods()) {
+    const auto a = build_model(m, outer);
+    const auto b = build_model(m, inner);
+    EXPECT_FALSE(a->collide(*b, Transform::identity()).colliding) << method_name(m);
+    Transform X;
+    X.t = Vec3(0.8, 0, 0);  // now it pokes through the shell
+    EXPECT_TRUE(a->collide(*b, X).colliding) << method_name(m);
+  }
+}
+
+TEST(Hierarchies, ModelsRejectMixedMethods) {
+  const auto mesh = share(make_box(Vec3(1, 1, 1)));
+  const auto a = build_model(Method::kBoxtree, mesh);
+  const auto b = build_model(Method::kDop14, mesh);
+  EXPECT_THROW(a->collide(*b, Transform::identity()), std::invalid_argument);
+}
+
+TEST(Hierarchies, InfoReportsShapeAndMemory) {
+  const auto mesh = share(make_sphere(1.0, 4));  // 5120 triangles
+  for (Method m : all_methods()) {
+    const ModelInfo info = build_model(m, mesh)->info();
+    EXPECT_GT(info.bytes, 0u) << method_name(m);
+    EXPECT_GT(info.bytes_per_triangle, 0.0) << method_name(m);
+    if (m != Method::kBrute) {
+      EXPECT_GT(info.nodes, info.leaves) << method_name(m);
+      EXPECT_GE(info.depth, 12u) << method_name(m);  // at least log2(5120 / leaf size)
+      EXPECT_LE(info.depth, 64u) << method_name(m);
+    }
+  }
+  // The boxtree is the smallest hierarchy.
+  const double boxtree = build_model(Method::kBoxtree, mesh)->info().bytes_per_triangle;
+  for (Method m : {Method::kDop6, Method::kDop26, Method::kAabb, Method::kObb}) {
+    EXPECT_LT(boxtree, build_model(m, mesh)->info().bytes_per_triangle) << method_name(m);
+  }
+}
+
+TEST(Hierarchies, RepeatedQueriesAreIdentical) {
+  const auto a = share(make_sphere(0.6, 3));
+  const auto b = share(make_torus(0.7, 0.25, 32, 16));
+  for (Method m : all_methods()) {
+    const auto ma = build_model(m, a);
+    const auto mb = build_model(m, b);
+    for (const Transform& X : random_poses(50, 1.0, 51)) {
+      const CollideResult r1 = ma->collide(*mb, X, {.all_pairs = true});
+      const CollideResult r2 = ma->collide(*mb, X, {.all_pairs = true});
+      EXPECT_EQ(r1.pairs, r2.pairs);
+      EXPECT_EQ(r1.stats.volume_tests, r2.stats.volume_tests);
+      EXPECT_EQ(r1.stats.triangle_tests, r2.stats.triangle_tests);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace dovetail::collision
