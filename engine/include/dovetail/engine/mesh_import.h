@@ -1,0 +1,68 @@
+#pragma once
+/// \file mesh_import.h
+/// Reading triangle meshes from any file format assimp understands.
+///
+/// Why: every part a user brings (OBJ, STL, PLY, OFF, glTF/GLB, ...) enters
+/// through this one door, so one place decides what counts as broken input.
+/// Node transforms are applied in double precision, triangles are the only
+/// primitives kept (points and lines are counted and skipped), and every
+/// result passes collision::make_mesh. Files that cannot become a mesh give an
+/// ImportError naming the file; declared sizes are checked against the file
+/// size and the limits before anything is allocated, and the importer may not
+/// read files outside the input file's folder.
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "dovetail/collision/mesh.h"
+
+namespace dovetail::engine {
+
+/// Thrown when a file cannot be imported; what() starts with the file's path
+/// and says what is wrong.
+class ImportError : public collision::MeshError {
+ public:
+  using collision::MeshError::MeshError;
+};
+
+/// How to import a file.
+struct ImportOptions {
+  /// true: one Mesh for the whole file; false: one part per mesh instance of
+  /// every node (a mesh used by two nodes gives two parts).
+  bool merge = true;
+  /// Checked before allocating (declared counts) and again by make_mesh.
+  collision::MeshLimits limits;
+};
+
+/// One imported mesh, in the file's root frame (node transforms applied).
+struct ImportedPart {
+  /// The node's name (or the mesh's, or "part" when both are empty), made
+  /// unique within the file by a suffix `_2`, `_3`, ... in depth-first order.
+  /// For a merged import: the file name without folder.
+  std::string name;
+  collision::Mesh mesh;
+  collision::MeshValidation validation;
+};
+
+/// Everything an import produced and noticed.
+struct ImportReport {
+  std::vector<ImportedPart> parts;  ///< one when merged; depth-first node order otherwise
+  std::size_t skipped_line_or_point_primitives = 0;  ///< not triangles, left out
+  std::vector<std::string> notes;                    ///< things worth telling the user, not errors
+};
+
+/// Imports `path`. Throws ImportError (message starts with the path) for a
+/// missing, unreadable, empty, truncated or malformed file, for non-finite
+/// coordinates, for declared sizes beyond the file or the limits, for a file
+/// without triangles, and when the format refers to files outside the input's
+/// folder.
+ImportReport import_file(const std::filesystem::path& path, const ImportOptions& options = {});
+
+/// Imports `path` merged into one Mesh with the default limits; `validation`
+/// (when given) receives what make_mesh found.
+collision::Mesh import_mesh(const std::filesystem::path& path,
+                            collision::MeshValidation* validation = nullptr);
+
+}  // namespace dovetail::engine

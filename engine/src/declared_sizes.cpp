@@ -1,0 +1,331 @@
+#include "declared_sizes.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string_view>
+#include <vector>
+
+namespace dovetail::engine::detail {
+
+namespace {
+
+constexpr std::size_t kHeadBytes = 64 * 1024;
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+std::string read_head(const std::filesystem::path& path, std::size_t bytes) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(bytes, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(bytes));
+  head.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return head;
+}
+
+/// A count as written in a header: a plain non-negative integer. `overflow`
+/// is set when the digits are valid but do not fit 64 bits.
+struct Count {
+  bool valid = false;
+  bool overflow = false;
+  std::uint64_t value = 0;
+};
+
+Count parse_count(std::string_view token) {
+  Count c;
+  if (token.empty()) return c;
+  const char* first = token.data();
+  const char* last = token.data() + token.size();
+  if (*first == '+') ++first;
+  const auto [ptr, ec] = std::from_chars(first, last, c.value);
+  if (ptr != last) return c;
+  if (ec == std::errc::result_out_of_range) {
+    c.overflow = true;
+    c.valid = true;
+    return c;
+  }
+  c.valid = ec == std::errc();
+  return c;
+}
+
+std::vector<std::string_view> split_words(std::string_view line) {
+  std::vector<std::string_view> words;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+    if (i > start) words.push_back(line.substr(start, i - start));
+  }
+  return words;
+}
+
+/// Size in bytes of a PLY scalar type; 0 for an unknown name.
+std::size_t ply_type_size(std::string_view type) {
+  static constexpr std::array<std::pair<std::string_view, std::size_t>, 16> kSizes = {{
+      {"char", 1},
+      {"uchar", 1},
+      {"int8", 1},
+      {"uint8", 1},
+      {"short", 2},
+      {"ushort", 2},
+      {"int16", 2},
+      {"uint16", 2},
+      {"int", 4},
+      {"uint", 4},
+      {"int32", 4},
+      {"uint32", 4},
+      {"float", 4},
+      {"float32", 4},
+      {"double", 8},
+      {"float64", 8},
+  }};
+  for (const auto& [name, size] : kSizes) {
+    if (name == type) return size;
+  }
+  return 0;
+}
+
+std::string too_many(std::uint64_t count, const char* what, std::size_t limit) {
+  return "declares " + std::to_string(count) + " " + what + ", over the limit of " +
+         std::to_string(limit);
+}
+
+std::string beyond_file(std::string_view format, long double needed, std::uintmax_t available) {
+  std::ostringstream out;
+  out.precision(0);
+  out << std::fixed << "the " << format
+      << " header declares more data than the file holds (at least " << needed << " bytes needed, "
+      << available << " bytes present); truncated or corrupt";
+  return out.str();
+}
+
+std::optional<std::string> check_ply(std::string_view head, std::uintmax_t file_size,
+                                     const collision::MeshLimits& limits) {
+  struct Element {
+    std::string name;
+    Count count;
+    std::size_t binary_bytes = 0;  // fixed bytes per element in binary formats
+    std::size_t properties = 0;
+  };
+  std::vector<Element> elements;
+  bool binary = false;
+  std::size_t pos = 0;
+  std::size_t header_end = std::string_view::npos;
+  while (pos < head.size()) {
+    std::size_t eol = head.find('\n', pos);
+    if (eol == std::string_view::npos) break;
+    const std::vector<std::string_view> w = split_words(head.substr(pos, eol - pos));
+    pos = eol + 1;
+    if (w.empty()) continue;
+    if (w[0] == "end_header") {
+      header_end = pos;
+      break;
+    }
+    if (w[0] == "format" && w.size() >= 2) {
+      binary = w[1] != "ascii";
+    } else if (w[0] == "element" && w.size() >= 3) {
+      Element e;
+      e.name = std::string(w[1]);
+      e.count = parse_count(w[2]);
+      if (!e.count.valid) {
+        return "PLY element '" + e.name + "' has count '" + std::string(w[2]) + "', not a number";
+      }
+      elements.push_back(std::move(e));
+    } else if (w[0] == "property" && !elements.empty()) {
+      Element& e = elements.back();
+      ++e.properties;
+      if (w.size() >= 3 && w[1] == "list") {
+        const std::size_t size = ply_type_size(w[2]);
+        if (size == 0) return std::nullopt;  // unknown type: the importer decides
+        e.binary_bytes += size;
+      } else if (w.size() >= 2) {
+        const std::size_t size = ply_type_size(w[1]);
+        if (size == 0) return std::nullopt;
+        e.binary_bytes += size;
+      }
+    }
+  }
+  if (header_end == std::string_view::npos) {
+    if (head.size() >= file_size) return "PLY header is not terminated by end_header";
+    return std::nullopt;  // header longer than what was read: leave it to the importer
+  }
+
+  const std::uintmax_t available = file_size - header_end;
+  long double needed = 0;
+  for (const Element& e : elements) {
+    if (e.count.overflow) {
+      return "PLY element '" + e.name + "' declares a count beyond 64 bits";
+    }
+    if (e.name == "vertex" && e.count.value > limits.max_vertices) {
+      return too_many(e.count.value, "vertices", limits.max_vertices);
+    }
+    if (e.name == "face" && e.count.value > limits.max_triangles) {
+      return too_many(e.count.value, "faces", limits.max_triangles);
+    }
+    if (e.count.value > file_size) {
+      return "PLY element '" + e.name + "' declares " + std::to_string(e.count.value) +
+             " entries, more than the file has bytes; truncated or corrupt";
+    }
+    // ASCII: every value takes a digit and a separator at least.
+    const std::size_t per_element = binary ? e.binary_bytes : 2 * e.properties;
+    needed += static_cast<long double>(e.count.value) * static_cast<long double>(per_element);
+  }
+  if (!binary && needed > 0) needed -= 1;  // the last value may end the file without separator
+  if (needed > static_cast<long double>(available)) return beyond_file("PLY", needed, available);
+  return std::nullopt;
+}
+
+/// Words of an OFF header with `#` comments removed, up to `max_words`,
+/// with the offset just past the last word taken.
+std::vector<std::string_view> off_words(std::string_view head, std::size_t max_words,
+                                        std::size_t& end_offset) {
+  std::vector<std::string_view> words;
+  std::size_t i = 0;
+  while (i < head.size() && words.size() < max_words) {
+    const char c = head[i];
+    if (c == '#') {
+      while (i < head.size() && head[i] != '\n') ++i;
+      continue;
+    }
+    if (std::isspace(static_cast<unsigned char>(c))) {
+      ++i;
+      continue;
+    }
+    const std::size_t start = i;
+    while (i < head.size() && head[i] != '#' && !std::isspace(static_cast<unsigned char>(head[i])))
+      ++i;
+    words.push_back(head.substr(start, i - start));
+  }
+  end_offset = i;
+  return words;
+}
+
+std::optional<std::string> check_off(std::string_view head, std::uintmax_t file_size,
+                                     const collision::MeshLimits& limits) {
+  std::size_t end_offset = 0;
+  std::vector<std::string_view> w = off_words(head, 5, end_offset);
+  if (w.empty()) return std::nullopt;
+  const std::string keyword = lower(w[0]);
+  if (keyword.size() < 3 || keyword.size() > 6 || keyword.substr(keyword.size() - 3) != "off") {
+    return std::nullopt;
+  }
+  std::size_t first_count = 1;
+  if (keyword.front() == 'n') ++first_count;  // nOFF: the dimension comes first
+  if (w.size() < first_count + 2) return std::nullopt;
+  if (lower(w[1]) == "binary") return std::nullopt;
+  const Count vertices = parse_count(w[first_count]);
+  const Count faces = parse_count(w[first_count + 1]);
+  if (!vertices.valid || !faces.valid) return std::nullopt;  // the importer reports it
+  if (vertices.overflow || vertices.value > limits.max_vertices) {
+    return vertices.overflow ? std::string("OFF header declares a vertex count beyond 64 bits")
+                             : too_many(vertices.value, "vertices", limits.max_vertices);
+  }
+  if (faces.overflow || faces.value > limits.max_triangles) {
+    return faces.overflow ? std::string("OFF header declares a face count beyond 64 bits")
+                          : too_many(faces.value, "faces", limits.max_triangles);
+  }
+  // Find where the counts end to know how many bytes follow.
+  std::size_t counts_end = 0;
+  off_words(head, first_count + 2, counts_end);
+  const std::uintmax_t available = file_size > counts_end ? file_size - counts_end : 0;
+  // "0 0 0\n" per vertex, "0\n" per face at least.
+  long double needed = static_cast<long double>(vertices.value) * 6.0L +
+                       static_cast<long double>(faces.value) * 2.0L;
+  if (needed > 0) needed -= 1;
+  if (needed > static_cast<long double>(available)) return beyond_file("OFF", needed, available);
+  return std::nullopt;
+}
+
+std::optional<std::string> check_binary_stl(std::string_view head, std::uintmax_t file_size,
+                                            const collision::MeshLimits& limits) {
+  std::size_t i = 0;
+  while (i < head.size() && std::isspace(static_cast<unsigned char>(head[i]))) ++i;
+  if (lower(head.substr(i, 5)) == "solid") return std::nullopt;  // ASCII (or ambiguous)
+  constexpr std::uintmax_t kHeader = 84;
+  constexpr std::uintmax_t kPerTriangle = 50;
+  if (file_size < kHeader) {
+    return "binary STL is shorter than its 84-byte header (" + std::to_string(file_size) +
+           " bytes); truncated or not an STL file";
+  }
+  if (head.size() < kHeader) return std::nullopt;
+  std::uint32_t count = 0;
+  for (int k = 3; k >= 0; --k) {
+    count = (count << 8) | static_cast<unsigned char>(head[80 + static_cast<std::size_t>(k)]);
+  }
+  if (count > limits.max_triangles) return too_many(count, "triangles", limits.max_triangles);
+  const std::uintmax_t needed = kHeader + kPerTriangle * count;
+  if (needed > file_size) {
+    return "binary STL declares " + std::to_string(count) + " triangles (" +
+           std::to_string(needed) + " bytes) but the file has " + std::to_string(file_size) +
+           " bytes; truncated";
+  }
+  return std::nullopt;
+}
+
+/// OBJ declares nothing; a file large enough to hold more vertex or face
+/// lines than the limits allow is counted line by line before parsing.
+std::optional<std::string> check_obj(const std::filesystem::path& path, std::uintmax_t file_size,
+                                     const collision::MeshLimits& limits) {
+  constexpr std::uintmax_t kMinLine = 8;  // "v 0 0 0\n", "f 1 2 3\n"
+  const std::uintmax_t most_lines = file_size / kMinLine + 1;
+  if (most_lines <= std::min(limits.max_vertices, limits.max_triangles)) return std::nullopt;
+
+  std::ifstream in(path, std::ios::binary);
+  std::vector<char> buffer(std::size_t{1} << 20);
+  std::uint64_t vertices = 0;
+  std::uint64_t faces = 0;
+  bool at_line_start = true;
+  char previous = '\0';  // first character of the line when it was 'v' or 'f'
+  while (in) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    const std::size_t got = static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0));
+    for (std::size_t k = 0; k < got; ++k) {
+      const char c = buffer[k];
+      if (previous != '\0') {
+        if (c == ' ' || c == '\t') {
+          if (previous == 'v') ++vertices;
+          if (previous == 'f') ++faces;
+        }
+        previous = '\0';
+      }
+      if (at_line_start && (c == 'v' || c == 'f')) previous = c;
+      at_line_start = c == '\n';
+    }
+    if (vertices > limits.max_vertices) {
+      return "has more than " + std::to_string(limits.max_vertices) +
+             " vertex lines, over the limit";
+    }
+    if (faces > limits.max_triangles) {
+      return "has more than " + std::to_string(limits.max_triangles) +
+             " face lines, over the triangle limit";
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::string> check_declared_sizes(const std::filesystem::path& path,
+                                                std::uintmax_t file_size,
+                                                const collision::MeshLimits& limits) {
+  const std::string head = read_head(path, kHeadBytes);
+  const std::string extension = lower(path.extension().string());
+
+  if (head.size() >= 4 && head.compare(0, 3, "ply") == 0 && (head[3] == '\n' || head[3] == '\r')) {
+    return check_ply(head, file_size, limits);
+  }
+  if (extension == ".stl") return check_binary_stl(head, file_size, limits);
+  if (extension == ".obj") return check_obj(path, file_size, limits);
+  if (std::optional<std::string> off = check_off(head, file_size, limits)) return off;
+  return std::nullopt;
+}
+
+}  // namespace dovetail::engine::detail

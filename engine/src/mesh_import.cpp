@@ -1,0 +1,400 @@
+#include "dovetail/engine/mesh_import.h"
+
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <utility>
+
+#include "declared_sizes.h"
+#include "folder_io_system.h"
+
+namespace dovetail::engine {
+
+namespace fs = std::filesystem;
+using collision::MeshLimits;
+using collision::TriangleIndices;
+using collision::Vec3;
+
+namespace {
+
+/// Affine 3x4 part of a node transform, in double: p_root = M * [p_node; 1].
+using Affine = Eigen::Matrix<double, 3, 4>;
+
+[[noreturn]] void fail(const fs::path& path, const std::string& what) {
+  throw ImportError(path.string() + ": " + what);
+}
+
+std::string plural(std::size_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+/// Everything about the file itself that can be told before any importer runs.
+std::uintmax_t check_file(const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (ec || !fs::exists(status)) {
+    if (ec && ec != std::errc::no_such_file_or_directory) {
+      fail(path, "cannot be accessed: " + ec.message());
+    }
+    fail(path, "file not found");
+  }
+  if (fs::is_directory(status)) fail(path, "is a directory, not a mesh file");
+  if (!fs::is_regular_file(status)) fail(path, "is not a regular file");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) fail(path, "cannot read its size: " + ec.message());
+  if (size == 0) fail(path, "file is empty");
+  std::ifstream probe(path, std::ios::binary);
+  if (!probe) fail(path, std::string("cannot be opened for reading: ") + std::strerror(errno));
+  return size;
+}
+
+Affine to_affine(const aiMatrix4x4& m) {
+  Affine a;
+  for (unsigned r = 0; r < 3; ++r) {
+    for (unsigned c = 0; c < 4; ++c) a(r, c) = static_cast<double>(m[r][c]);
+  }
+  return a;
+}
+
+/// X_PC composed: parent-to-root times child-to-parent, in double.
+Affine compose(const Affine& X_RP, const Affine& X_PC) {
+  Affine X_RC;
+  X_RC.leftCols<3>() = X_RP.leftCols<3>() * X_PC.leftCols<3>();
+  X_RC.col(3) = X_RP.leftCols<3>() * X_PC.col(3) + X_RP.col(3);
+  return X_RC;
+}
+
+Vec3 apply(const Affine& X, const aiVector3D& v) {
+  const double x = v.x, y = v.y, z = v.z;
+  return Vec3(X(0, 0) * x + X(0, 1) * y + X(0, 2) * z + X(0, 3),
+              X(1, 0) * x + X(1, 1) * y + X(1, 2) * z + X(1, 3),
+              X(2, 0) * x + X(2, 1) * y + X(2, 2) * z + X(2, 3));
+}
+
+/// One use of a mesh by a node, with the node's transform to the file's root.
+struct Instance {
+  const aiNode* node = nullptr;
+  unsigned mesh = 0;
+  Affine X_RN;
+};
+
+/// Depth-first (pre-order) list of every mesh instance; iterative so that a
+/// deep hierarchy cannot exhaust the stack, and each node visited once.
+std::vector<Instance> collect_instances(const fs::path& path, const aiScene& scene) {
+  std::vector<Instance> instances;
+  struct Pending {
+    const aiNode* node;
+    Affine X_RP;
+  };
+  std::vector<Pending> stack{{scene.mRootNode, Affine::Identity()}};
+  std::set<const aiNode*> visited;
+  while (!stack.empty()) {
+    const Pending top = stack.back();
+    stack.pop_back();
+    if (top.node == nullptr) continue;
+    if (!visited.insert(top.node).second) fail(path, "node hierarchy contains a cycle");
+    const Affine X_RN = compose(top.X_RP, to_affine(top.node->mTransformation));
+    for (unsigned k = 0; k < top.node->mNumMeshes; ++k) {
+      const unsigned mesh = top.node->mMeshes[k];
+      if (mesh >= scene.mNumMeshes) {
+        fail(path, "node '" + std::string(top.node->mName.C_Str()) + "' refers to mesh " +
+                       std::to_string(mesh) + " of " + std::to_string(scene.mNumMeshes));
+      }
+      instances.push_back({top.node, mesh, X_RN});
+    }
+    for (unsigned k = top.node->mNumChildren; k > 0; --k) {
+      stack.push_back({top.node->mChildren[k - 1], X_RN});
+    }
+  }
+  return instances;
+}
+
+/// Vertices and triangles of one part being assembled.
+struct Geometry {
+  std::vector<Vec3> vertices;
+  std::vector<TriangleIndices> triangles;
+};
+
+/// Counts of what one mesh holds, for limits and notes.
+struct FaceCounts {
+  std::size_t triangles = 0;
+  std::size_t lines_or_points = 0;
+  std::size_t polygons = 0;  ///< more than 3 corners left after triangulation
+};
+
+FaceCounts count_faces(const aiMesh& mesh) {
+  FaceCounts counts;
+  for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+    const unsigned n = mesh.mFaces[f].mNumIndices;
+    if (n == 3) {
+      ++counts.triangles;
+    } else if (n < 3) {
+      ++counts.lines_or_points;
+    } else {
+      ++counts.polygons;
+    }
+  }
+  return counts;
+}
+
+/// Appends the triangles of `mesh` transformed by X_RN; all the mesh's
+/// vertices are appended when it has at least one triangle.
+void append(const fs::path& path, const aiMesh& mesh, const Affine& X_RN, Geometry& out) {
+  const std::size_t offset = out.vertices.size();
+  for (unsigned v = 0; v < mesh.mNumVertices; ++v)
+    out.vertices.push_back(apply(X_RN, mesh.mVertices[v]));
+  // A mirroring transform turns the winding; swap to keep normals outward.
+  const bool mirrored = X_RN.leftCols<3>().determinant() < 0;
+  for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+    const aiFace& face = mesh.mFaces[f];
+    if (face.mNumIndices != 3) continue;
+    TriangleIndices t{};
+    for (unsigned k = 0; k < 3; ++k) {
+      if (face.mIndices[k] >= mesh.mNumVertices) {
+        fail(path, "mesh '" + std::string(mesh.mName.C_Str()) + "' face " + std::to_string(f) +
+                       " refers to vertex " + std::to_string(face.mIndices[k]) + " of " +
+                       std::to_string(mesh.mNumVertices));
+      }
+      t[k] = static_cast<std::uint32_t>(offset + face.mIndices[k]);
+    }
+    if (mirrored) std::swap(t[1], t[2]);
+    out.triangles.push_back(t);
+  }
+}
+
+/// Raw scene straight from the reader: coordinates must be finite and sizes
+/// within the limits before the post-processing steps work on them.
+void check_raw_scene(const fs::path& path, const aiScene& scene, const MeshLimits& limits) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* mesh = scene.mMeshes[m];
+    if (mesh == nullptr) fail(path, "mesh " + std::to_string(m) + " is missing");
+    std::string name = std::to_string(m);
+    if (mesh->mName.length > 0) name.assign(1, '\'').append(mesh->mName.C_Str()).append(1, '\'');
+    if (mesh->mNumVertices > limits.max_vertices) {
+      fail(path, "mesh " + name + " has " + std::to_string(mesh->mNumVertices) +
+                     " vertices, over the limit of " + std::to_string(limits.max_vertices));
+    }
+    if (mesh->mNumFaces > limits.max_triangles) {
+      fail(path, "mesh " + name + " has " + std::to_string(mesh->mNumFaces) +
+                     " faces, over the limit of " + std::to_string(limits.max_triangles));
+    }
+    if (mesh->mVertices == nullptr) {
+      if (mesh->mNumVertices > 0) fail(path, "mesh " + name + " has no vertex positions");
+      continue;
+    }
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+      const aiVector3D& p = mesh->mVertices[v];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        fail(path, "mesh " + name + " vertex " + std::to_string(v) + " is not finite (" +
+                       std::to_string(p.x) + ", " + std::to_string(p.y) + ", " +
+                       std::to_string(p.z) + ")");
+      }
+    }
+  }
+}
+
+std::string refused_message(const detail::FolderIOSystem& io) {
+  std::string text;
+  for (const std::string& p : io.refused()) {
+    text += (text.empty() ? "" : ", ") + ("'" + p + "'");
+  }
+  return "refers to " + text + " outside the model's folder, which is not read";
+}
+
+[[noreturn]] void fail_import(const fs::path& path, const Assimp::Importer& importer,
+                              const detail::FolderIOSystem& io) {
+  std::string what = importer.GetErrorString();
+  if (!io.refused().empty()) {
+    fail(path, refused_message(io) + (what.empty() ? "" : " (" + what + ")"));
+  }
+  if (what.empty()) what = "unknown reason";
+  fail(path, "cannot be read as a mesh: " + what);
+}
+
+std::string part_base_name(const Instance& instance, const aiScene& scene) {
+  std::string name = instance.node->mName.C_Str();
+  if (name.empty()) name = scene.mMeshes[instance.mesh]->mName.C_Str();
+  if (name.empty()) name = "part";
+  return name;
+}
+
+collision::Mesh validate(const fs::path& path, Geometry geometry, std::string source,
+                         const MeshLimits& limits, collision::MeshValidation& validation) {
+  (void)path;
+  try {
+    return collision::make_mesh(std::move(geometry.vertices), std::move(geometry.triangles),
+                                std::move(source), limits, &validation);
+  } catch (const ImportError&) {
+    throw;
+  } catch (const collision::MeshError& e) {
+    throw ImportError(e.what());
+  }
+}
+
+ImportReport import_scene(const fs::path& path, const aiScene& scene, const ImportOptions& options,
+                          std::vector<std::string> notes) {
+  ImportReport report;
+  report.notes = std::move(notes);
+  if (scene.mRootNode == nullptr) fail(path, "has no scene graph");
+  if (scene.mNumMeshes == 0) fail(path, "contains no meshes");
+
+  const std::vector<Instance> instances = collect_instances(path, scene);
+  std::vector<bool> referenced(scene.mNumMeshes, false);
+  std::size_t polygons = 0;
+
+  // Sizes first, so an instanced mesh cannot multiply past the limits.
+  std::size_t total_vertices = 0;
+  std::size_t total_triangles = 0;
+  std::vector<const Instance*> with_triangles;
+  for (const Instance& instance : instances) {
+    referenced[instance.mesh] = true;
+    const aiMesh& mesh = *scene.mMeshes[instance.mesh];
+    const FaceCounts counts = count_faces(mesh);
+    report.skipped_line_or_point_primitives += counts.lines_or_points;
+    polygons += counts.polygons;
+    if (counts.triangles == 0) continue;
+    with_triangles.push_back(&instance);
+    const std::size_t vertices =
+        options.merge ? total_vertices + mesh.mNumVertices : std::size_t{mesh.mNumVertices};
+    const std::size_t triangles =
+        options.merge ? total_triangles + counts.triangles : counts.triangles;
+    if (vertices > options.limits.max_vertices) {
+      fail(path, "node instances add up to more than " +
+                     std::to_string(options.limits.max_vertices) + " vertices, over the limit");
+    }
+    if (triangles > options.limits.max_triangles) {
+      fail(path, "node instances add up to more than " +
+                     std::to_string(options.limits.max_triangles) + " triangles, over the limit");
+    }
+    total_vertices = vertices;
+    total_triangles = triangles;
+  }
+
+  if (report.skipped_line_or_point_primitives > 0) {
+    report.notes.push_back("skipped " +
+                           plural(report.skipped_line_or_point_primitives,
+                                  "point or line primitive", "point or line primitives") +
+                           " (only triangles take part in collisions)");
+  }
+  if (polygons > 0) {
+    report.notes.push_back("skipped " + plural(polygons, "polygon", "polygons") +
+                           " that could not be triangulated");
+  }
+  const std::size_t unreferenced =
+      static_cast<std::size_t>(std::count(referenced.begin(), referenced.end(), false));
+  if (unreferenced > 0) {
+    report.notes.push_back("ignored " + plural(unreferenced, "mesh", "meshes") +
+                           " not placed by any node");
+  }
+  if (with_triangles.empty()) {
+    fail(path, "contains no triangles" +
+                   (report.skipped_line_or_point_primitives > 0
+                        ? " (only " +
+                              plural(report.skipped_line_or_point_primitives,
+                                     "point or line primitive", "point or line primitives") +
+                              ")"
+                        : std::string()));
+  }
+
+  if (options.merge) {
+    Geometry geometry;
+    geometry.vertices.reserve(total_vertices);
+    geometry.triangles.reserve(total_triangles);
+    for (const Instance* instance : with_triangles) {
+      append(path, *scene.mMeshes[instance->mesh], instance->X_RN, geometry);
+    }
+    ImportedPart part;
+    part.name = path.filename().string();
+    part.mesh = validate(path, std::move(geometry), path.string(), options.limits, part.validation);
+    report.parts.push_back(std::move(part));
+    return report;
+  }
+
+  std::set<std::string> used_names;
+  for (const Instance* instance : with_triangles) {
+    const std::string base = part_base_name(*instance, scene);
+    std::string name = base;
+    for (std::size_t k = 2; used_names.count(name) != 0; ++k) name = base + "_" + std::to_string(k);
+    used_names.insert(name);
+    Geometry geometry;
+    append(path, *scene.mMeshes[instance->mesh], instance->X_RN, geometry);
+    ImportedPart part;
+    part.name = name;
+    part.mesh = validate(path, std::move(geometry), path.string() + "#" + name, options.limits,
+                         part.validation);
+    report.parts.push_back(std::move(part));
+  }
+  return report;
+}
+
+}  // namespace
+
+ImportReport import_file(const fs::path& path, const ImportOptions& options) {
+  const std::uintmax_t size = check_file(path);
+  if (std::optional<std::string> wrong = detail::check_declared_sizes(path, size, options.limits)) {
+    fail(path, *wrong);
+  }
+
+  const fs::path absolute = fs::absolute(path).lexically_normal();
+  Assimp::Importer importer;
+  // The importer owns and deletes the IO system; `io` stays valid while it lives.
+  auto* io = new detail::FolderIOSystem(absolute.parent_path());
+  importer.SetIOHandler(io);
+  importer.SetPropertyBool(AI_CONFIG_PP_FD_REMOVE, true);
+  // Zero-area triangles are found exactly by make_mesh; assimp's area test uses
+  // an absolute threshold that would drop real triangles of small parts.
+  importer.SetPropertyBool(AI_CONFIG_PP_FD_CHECKAREA, false);
+  // Only positions matter for collisions; dropping the rest lets
+  // JoinIdenticalVertices weld by position.
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
+                              aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                  aiComponent_COLORS | aiComponent_TEXCOORDS |
+                                  aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
+                                  aiComponent_TEXTURES | aiComponent_LIGHTS | aiComponent_CAMERAS);
+
+  const aiScene* scene = nullptr;
+  try {
+    // Read and validate the structure only, check coordinates and sizes, then
+    // post-process: FindInvalidData would silently delete a mesh with a NaN
+    // vertex, and a broken file must be an error instead.
+    scene = importer.ReadFile(absolute.string(), aiProcess_ValidateDataStructure);
+    if (scene == nullptr) fail_import(path, importer, *io);
+    check_raw_scene(path, *scene, options.limits);
+    scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                         aiProcess_ValidateDataStructure |
+                                         aiProcess_FindDegenerates | aiProcess_FindInvalidData |
+                                         aiProcess_SortByPType | aiProcess_RemoveComponent);
+    if (scene == nullptr) fail_import(path, importer, *io);
+  } catch (const ImportError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    fail(path, "ran out of memory while reading");
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot be read as a mesh: ") + e.what());
+  } catch (...) {
+    fail(path, "cannot be read as a mesh: unknown failure in the importer");
+  }
+
+  std::vector<std::string> notes;
+  if (!io->refused().empty()) notes.push_back(refused_message(*io));
+  return import_scene(path, *scene, options, std::move(notes));
+}
+
+collision::Mesh import_mesh(const fs::path& path, collision::MeshValidation* validation) {
+  ImportReport report = import_file(path, {});
+  if (validation != nullptr) *validation = report.parts.front().validation;
+  return std::move(report.parts.front().mesh);
+}
+
+}  // namespace dovetail::engine

@@ -1,0 +1,550 @@
+#include "dovetail/engine/mesh_import.h"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace dovetail::engine {
+namespace {
+
+namespace fs = std::filesystem;
+using collision::Vec3;
+
+const fs::path kModels = DOVETAIL_ASSIMP_MODELS;
+const fs::path kData = DOVETAIL_TEST_DATA;
+
+/// A fresh folder under the system temp folder, removed with its content.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "dovetail_import_XXXXXX").string();
+    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const fs::path& path() const { return path_; }
+  fs::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  fs::path path_;
+};
+
+void write_file(const fs::path& path, const std::string& bytes) {
+  fs::create_directories(path.parent_path());
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_TRUE(out.good()) << path;
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// The ImportError message of importing `path`, failing the test when the
+/// import succeeds or throws anything else.
+std::string import_error(const fs::path& path, const ImportOptions& options = {}) {
+  try {
+    import_file(path, options);
+  } catch (const ImportError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << path << ": threw something other than ImportError: " << e.what();
+    return {};
+  }
+  ADD_FAILURE() << path << ": imported without error";
+  return {};
+}
+
+std::size_t total_triangles(const ImportReport& report) {
+  std::size_t n = 0;
+  for (const ImportedPart& part : report.parts) n += part.mesh.triangle_count();
+  return n;
+}
+
+Vec3 triangle_normal(const collision::Mesh& mesh, std::size_t t) {
+  const auto& tri = mesh.triangles[t];
+  const Vec3& a = mesh.vertices[tri[0]];
+  return (mesh.vertices[tri[1]] - a).cross(mesh.vertices[tri[2]] - a);
+}
+
+// ---------------------------------------------------------------- real files
+
+TEST(MeshImport, ObjBoxIsWeldedAndTriangulated) {
+  collision::MeshValidation validation;
+  const collision::Mesh mesh = import_mesh(kModels / "OBJ/box.obj", &validation);
+  EXPECT_EQ(mesh.triangle_count(), 12u);
+  EXPECT_EQ(mesh.vertex_count(), 8u);
+  EXPECT_EQ(validation.degenerate_removed, 0u);
+  EXPECT_EQ(validation.unused_vertices, 0u);
+  EXPECT_EQ(mesh.source, (kModels / "OBJ/box.obj").string());
+  const collision::Bounds b = collision::mesh_bounds(mesh);
+  EXPECT_EQ(b.min, Vec3(-0.5, -0.5, -0.5));
+  EXPECT_EQ(b.max, Vec3(0.5, 0.5, 0.5));
+}
+
+TEST(MeshImport, StlAsciiAndBinaryAgree) {
+  const collision::Mesh ascii = import_mesh(kModels / "STL/Spider_ascii.stl");
+  const collision::Mesh binary = import_mesh(kModels / "STL/Spider_binary.stl");
+  EXPECT_EQ(ascii.triangle_count(), 1312u);
+  EXPECT_EQ(binary.triangle_count(), ascii.triangle_count());
+  const collision::Bounds a = collision::mesh_bounds(ascii);
+  const collision::Bounds b = collision::mesh_bounds(binary);
+  EXPECT_TRUE(a.min.isApprox(b.min, 1e-5));
+  EXPECT_TRUE(a.max.isApprox(b.max, 1e-5));
+}
+
+TEST(MeshImport, PlyAsciiAndBinaryCubes) {
+  EXPECT_EQ(import_mesh(kModels / "PLY/cube.ply").triangle_count(), 12u);
+  EXPECT_EQ(import_mesh(kModels / "PLY/cube_binary.ply").triangle_count(), 12u);
+  EXPECT_EQ(import_mesh(kModels / "PLY/Wuson.ply").triangle_count(), 3732u);
+}
+
+TEST(MeshImport, OffCube) {
+  EXPECT_EQ(import_mesh(kModels / "OFF/Cube.off").triangle_count(), 12u);
+}
+
+TEST(MeshImport, GlbMergedEqualsItsParts) {
+  const fs::path file = kModels / "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+  const ImportReport merged = import_file(file);
+  ASSERT_EQ(merged.parts.size(), 1u);
+  EXPECT_EQ(merged.parts[0].name, "2CylinderEngine.glb");
+  EXPECT_GT(merged.parts[0].mesh.triangle_count(), 100000u);
+
+  ImportOptions per_part;
+  per_part.merge = false;
+  const ImportReport parts = import_file(file, per_part);
+  EXPECT_GT(parts.parts.size(), 50u);
+  EXPECT_EQ(total_triangles(parts), total_triangles(merged));
+
+  std::set<std::string> names;
+  collision::Bounds all = collision::mesh_bounds(parts.parts[0].mesh);
+  for (const ImportedPart& part : parts.parts) {
+    EXPECT_FALSE(part.name.empty());
+    EXPECT_TRUE(names.insert(part.name).second) << "duplicate part name " << part.name;
+    EXPECT_EQ(part.mesh.source, file.string() + "#" + part.name);
+    const collision::Bounds b = collision::mesh_bounds(part.mesh);
+    all.min = all.min.cwiseMin(b.min);
+    all.max = all.max.cwiseMax(b.max);
+  }
+  // Same placement merged or not: the union of the parts' bounds is the merged bounds.
+  const collision::Bounds m = collision::mesh_bounds(merged.parts[0].mesh);
+  EXPECT_EQ(all.min, m.min);
+  EXPECT_EQ(all.max, m.max);
+
+  // Deterministic: a second import gives the same names in the same order.
+  const ImportReport again = import_file(file, per_part);
+  ASSERT_EQ(again.parts.size(), parts.parts.size());
+  for (std::size_t i = 0; i < parts.parts.size(); ++i) {
+    EXPECT_EQ(again.parts[i].name, parts.parts[i].name);
+    EXPECT_EQ(again.parts[i].mesh.vertices, parts.parts[i].mesh.vertices);
+  }
+}
+
+TEST(MeshImport, PointsAndLinesAreSkippedWithANote) {
+  const ImportReport report = import_file(kModels / "OBJ/testmixed.obj");
+  EXPECT_EQ(total_triangles(report), 12u);
+  EXPECT_GT(report.skipped_line_or_point_primitives, 0u);
+  ASSERT_FALSE(report.notes.empty());
+  EXPECT_NE(report.notes[0].find("point or line"), std::string::npos);
+}
+
+TEST(MeshImport, OnlyLinesIsAnError) {
+  const std::string message = import_error(kModels / "OBJ/testline.obj");
+  EXPECT_NE(message.find("testline.obj"), std::string::npos);
+  EXPECT_NE(message.find("no triangles"), std::string::npos) << message;
+}
+
+// Every file assimp ships as invalid: an ImportError naming the file, or (if
+// assimp reads it) a valid mesh. Never a crash, never a hang.
+TEST(MeshImport, EveryShippedInvalidFileIsHandled) {
+  std::size_t files = 0;
+  for (const fs::directory_entry& entry : fs::directory_iterator(kModels / "invalid")) {
+    if (!entry.is_regular_file()) continue;
+    ++files;
+    const fs::path file = entry.path();
+    SCOPED_TRACE(file.string());
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      const ImportReport report = import_file(file);
+      ASSERT_EQ(report.parts.size(), 1u) << file;
+      EXPECT_GT(report.parts[0].mesh.triangle_count(), 0u) << file;
+      for (const auto& tri : report.parts[0].mesh.triangles) {
+        for (std::uint32_t v : tri) ASSERT_LT(v, report.parts[0].mesh.vertex_count()) << file;
+      }
+    } catch (const ImportError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(file.string(), 0), 0u)
+          << file << ": message does not start with the file: " << e.what();
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << file << ": unexpected exception " << e.what();
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_LT(seconds, 5.0) << file;
+  }
+  EXPECT_GT(files, 10u);
+}
+
+TEST(MeshImport, OutOfMemoryOffIsRefusedFromItsHeader) {
+  const std::string message = import_error(kModels / "invalid/OutOfMemory.off");
+  EXPECT_NE(message.find("353535235358"), std::string::npos) << message;
+}
+
+// ---------------------------------------------------------------- files and folders
+
+TEST(MeshImport, MissingFile) {
+  TempDir dir;
+  const std::string message = import_error(dir / "nothing.obj");
+  EXPECT_NE(message.find("nothing.obj"), std::string::npos);
+  EXPECT_NE(message.find("not found"), std::string::npos) << message;
+}
+
+TEST(MeshImport, DirectoryIsNotAMesh) {
+  TempDir dir;
+  fs::create_directory(dir / "model.obj");
+  const std::string message = import_error(dir / "model.obj");
+  EXPECT_NE(message.find("directory"), std::string::npos) << message;
+}
+
+TEST(MeshImport, EmptyFile) {
+  TempDir dir;
+  for (const char* name : {"empty.obj", "empty.stl", "empty.ply", "empty.glb", "empty"}) {
+    write_file(dir / name, "");
+    const std::string message = import_error(dir / name);
+    EXPECT_NE(message.find(name), std::string::npos) << message;
+    EXPECT_NE(message.find("empty"), std::string::npos) << message;
+  }
+}
+
+TEST(MeshImport, UnreadableFormat) {
+  TempDir dir;
+  std::string noise;
+  for (int i = 0; i < 4096; ++i) noise += static_cast<char>((i * 7919 + 13) % 251);
+  write_file(dir / "noise.bin", noise);
+  write_file(dir / "noise.obj", noise);
+  EXPECT_NE(import_error(dir / "noise.bin").find("noise.bin"), std::string::npos);
+  EXPECT_NE(import_error(dir / "noise.obj").find("noise.obj"), std::string::npos);
+}
+
+TEST(MeshImport, TruncatedBinaryStl) {
+  TempDir dir;
+  const std::string whole = read_file(kModels / "STL/Spider_binary.stl");
+  ASSERT_GT(whole.size(), 84u + 50u * 20u);
+  // Cut mid-triangle, on a triangle boundary, and inside the header.
+  for (std::size_t cut :
+       {std::size_t{84 + 50 * 10 + 7}, std::size_t{84 + 50 * 20}, std::size_t{60}}) {
+    SCOPED_TRACE(cut);
+    write_file(dir / "cut.stl", whole.substr(0, cut));
+    const std::string message = import_error(dir / "cut.stl");
+    EXPECT_NE(message.find("cut.stl"), std::string::npos);
+    EXPECT_NE(message.find("truncated"), std::string::npos) << message;
+  }
+}
+
+TEST(MeshImport, TruncatedObj) {
+  TempDir dir;
+  const std::string whole = read_file(kModels / "OBJ/box.obj");
+  // Inside the vertex list: faces are gone or refer to vertices that are not there.
+  const std::size_t vertices = whole.find("v 0.5 -0.5 -0.5");
+  ASSERT_NE(vertices, std::string::npos);
+  write_file(dir / "cut.obj", whole.substr(0, vertices + 5));
+  EXPECT_NE(import_error(dir / "cut.obj").find("cut.obj"), std::string::npos);
+
+  // Vertices complete, faces cut: a face now refers to a vertex beyond the list.
+  write_file(dir / "cut2.obj",
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 3");  // complete: reads fine
+  EXPECT_EQ(import_mesh(dir / "cut2.obj").triangle_count(), 2u);
+  write_file(dir / "cut3.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4");
+  EXPECT_NE(import_error(dir / "cut3.obj").find("cut3.obj"), std::string::npos);
+}
+
+TEST(MeshImport, NonFiniteVerticesInObj) {
+  TempDir dir;
+  for (const char* value : {"nan", "inf", "-inf", "1e999"}) {
+    SCOPED_TRACE(value);
+    write_file(dir / "bad.obj", std::string("v 0 0 0\nv 1 0 0\nv 0 1 ") + value + "\nv 0 0 1\n" +
+                                    "f 1 2 3\nf 1 2 4\n");
+    const std::string message = import_error(dir / "bad.obj");
+    EXPECT_NE(message.find("bad.obj"), std::string::npos);
+    EXPECT_NE(message.find("not finite"), std::string::npos) << message;
+  }
+  // A NaN in a second object must not silently drop that object.
+  write_file(dir / "two.obj",
+             "o good\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+             "o bad\nv 0 0 nan\nv 1 0 1\nv 0 1 1\nf 4 5 6\n");
+  EXPECT_NE(import_error(dir / "two.obj").find("not finite"), std::string::npos);
+}
+
+TEST(MeshImport, NonFiniteVerticesInGlb) {
+  const std::string message =
+      import_error(kModels / "glTF2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb");
+  EXPECT_NE(message.find("not finite"), std::string::npos) << message;
+}
+
+// ---------------------------------------------------------------- declared sizes
+
+/// Imports `path` expecting an ImportError within a fraction of a second.
+std::string fast_error(const fs::path& path, const ImportOptions& options = {}) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string message = import_error(path, options);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 0.5) << path;
+  return message;
+}
+
+TEST(MeshImport, PlyDeclaringHundredMillionVerticesFailsFast) {
+  TempDir dir;
+  const std::string ascii =
+      "ply\nformat ascii 1.0\nelement vertex 100000000\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  write_file(dir / "huge.ply", ascii);
+  std::string message = fast_error(dir / "huge.ply");
+  EXPECT_NE(message.find("huge.ply"), std::string::npos);
+  EXPECT_NE(message.find("100000000"), std::string::npos) << message;
+
+  // With limits high enough, the file size still gives it away.
+  ImportOptions roomy;
+  roomy.limits.max_vertices = std::size_t{1} << 32;
+  message = fast_error(dir / "huge.ply", roomy);
+  EXPECT_NE(message.find("truncated"), std::string::npos) << message;
+
+  std::string binary =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 100000000\nproperty float x\n"
+      "property float y\nproperty float z\nend_header\n";
+  binary += std::string(36, '\0');
+  write_file(dir / "huge_binary.ply", binary);
+  message = fast_error(dir / "huge_binary.ply", roomy);
+  EXPECT_NE(message.find("truncated"), std::string::npos) << message;
+
+  // A face count far beyond the file.
+  write_file(dir / "faces.ply",
+             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+             "property float z\nelement face 50000000\nproperty list uchar int vertex_indices\n"
+             "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_NE(fast_error(dir / "faces.ply").find("faces.ply"), std::string::npos);
+
+  // Counts that do not even fit 64 bits.
+  write_file(dir / "overflow.ply",
+             "ply\nformat ascii 1.0\nelement vertex 99999999999999999999999\nproperty float x\n"
+             "end_header\n0\n");
+  EXPECT_NE(fast_error(dir / "overflow.ply").find("overflow.ply"), std::string::npos);
+}
+
+TEST(MeshImport, OffDeclaringHundredMillionVerticesFailsFast) {
+  TempDir dir;
+  write_file(dir / "huge.off", "OFF\n100000000 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  std::string message = fast_error(dir / "huge.off");
+  EXPECT_NE(message.find("100000000"), std::string::npos) << message;
+
+  ImportOptions roomy;
+  roomy.limits.max_vertices = std::size_t{1} << 32;
+  message = fast_error(dir / "huge.off", roomy);
+  EXPECT_NE(message.find("truncated"), std::string::npos) << message;
+
+  // Comments before the counts, counts on the keyword's line.
+  write_file(dir / "comment.off", "OFF # header\n# counts follow\n3 90000000 0\n0 0 0\n");
+  EXPECT_NE(fast_error(dir / "comment.off", roomy).find("comment.off"), std::string::npos);
+}
+
+TEST(MeshImport, BinaryStlDeclaringTooManyTrianglesFailsFast) {
+  TempDir dir;
+  std::string stl(80, 'x');
+  const std::uint32_t count = 100000000;
+  for (int k = 0; k < 4; ++k) stl += static_cast<char>((count >> (8 * k)) & 0xff);
+  stl += std::string(50, '\0');
+  write_file(dir / "huge.stl", stl);
+  EXPECT_NE(fast_error(dir / "huge.stl").find("100000000"), std::string::npos);
+}
+
+TEST(MeshImport, LimitsApply) {
+  ImportOptions tight;
+  tight.limits.max_triangles = 5;
+  EXPECT_NE(import_error(kModels / "OBJ/box.obj", tight).find("box.obj"), std::string::npos);
+  tight = {};
+  tight.limits.max_vertices = 4;
+  EXPECT_NE(import_error(kModels / "OBJ/box.obj", tight).find("box.obj"), std::string::npos);
+}
+
+// ---------------------------------------------------------------- transforms and parts
+
+/// A glTF scene: `nodes_json` placed over one triangle mesh named "tri" with
+/// vertices (0,0,0), (1,0,0), (0,1,0) from `buffer_uri` (written next to it
+/// as tri.bin unless the uri says otherwise).
+std::string gltf(const std::string& nodes_json, const std::string& scene_nodes,
+                 const std::string& buffer_uri = "tri.bin") {
+  return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":)" + scene_nodes +
+         R"(}],"nodes":)" + nodes_json +
+         R"(,"meshes":[{"name":"tri","primitives":[{"attributes":{"POSITION":0}}]}],)"
+         R"("buffers":[{"uri":")" +
+         buffer_uri +
+         R"(","byteLength":36}],)"
+         R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36}],)"
+         R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",)"
+         R"("min":[0,0,0],"max":[1,1,0]}]})";
+}
+
+std::string triangle_buffer() {
+  const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::string bytes(sizeof xyz, '\0');
+  std::memcpy(bytes.data(), xyz, sizeof xyz);
+  return bytes;
+}
+
+TEST(MeshImport, NodeTransformsAreAccumulated) {
+  TempDir dir;
+  write_file(dir / "tri.bin", triangle_buffer());
+  // Parent moves by (10, 0, 0); child scales by 2 and turns 90 degrees about z.
+  const double s = std::sqrt(0.5);
+  write_file(dir / "scene.gltf",
+             gltf(R"([{"name":"base","translation":[10,0,0],"children":[1]},)"
+                  R"({"name":"arm","scale":[2,2,2],"rotation":[0,0,)" +
+                      std::to_string(s) + "," + std::to_string(s) + R"(],"mesh":0}])",
+                  "[0]"));
+  const collision::Mesh mesh = import_mesh(dir / "scene.gltf");
+  ASSERT_EQ(mesh.triangle_count(), 1u);
+  const auto& tri = mesh.triangles[0];
+  // p = (10,0,0) + Rz(90) * 2 * p_mesh
+  EXPECT_TRUE(mesh.vertices[tri[0]].isApprox(Vec3(10, 0, 0), 1e-6));
+  EXPECT_TRUE(mesh.vertices[tri[1]].isApprox(Vec3(10, 2, 0), 1e-6));
+  EXPECT_TRUE(mesh.vertices[tri[2]].isApprox(Vec3(8, 0, 0), 1e-6));
+  EXPECT_GT(triangle_normal(mesh, 0).z(), 0);
+}
+
+TEST(MeshImport, MirroringTransformKeepsNormalsOutward) {
+  TempDir dir;
+  write_file(dir / "tri.bin", triangle_buffer());
+  write_file(dir / "mirror.gltf", gltf(R"([{"scale":[-1,1,1],"mesh":0}])", "[0]"));
+  const collision::Mesh mesh = import_mesh(dir / "mirror.gltf");
+  ASSERT_EQ(mesh.triangle_count(), 1u);
+  // The unmirrored triangle faces +z; mirrored in x it still faces +z once the winding is turned.
+  EXPECT_GT(triangle_normal(mesh, 0).z(), 0);
+  EXPECT_LE(collision::mesh_bounds(mesh).max.x(), 0);
+}
+
+TEST(MeshImport, PartsAreNamedUniquelyPerInstance) {
+  TempDir dir;
+  write_file(dir / "tri.bin", triangle_buffer());
+  write_file(
+      dir / "parts.gltf",
+      gltf(R"([{"name":"peg","mesh":0},{"name":"peg","translation":[0,0,5],"mesh":0},)"
+           R"({"mesh":0,"translation":[0,0,9]},{"name":"peg_2","translation":[0,0,7],"mesh":0}])",
+           "[0,1,2,3]"));
+  ImportOptions per_part;
+  per_part.merge = false;
+  const ImportReport report = import_file(dir / "parts.gltf", per_part);
+  ASSERT_EQ(report.parts.size(), 4u);
+  std::set<std::string> names;
+  for (const ImportedPart& part : report.parts) names.insert(part.name);
+  EXPECT_EQ(names.size(), 4u);
+  EXPECT_EQ(report.parts[0].name, "peg");
+  EXPECT_EQ(report.parts[1].name, "peg_2");
+  EXPECT_EQ(report.parts[1].mesh.vertices[0].z(), 5);
+  EXPECT_EQ(report.parts[2].mesh.vertices[0].z(), 9);
+  EXPECT_EQ(report.parts[3].mesh.vertices[0].z(), 7);
+  EXPECT_NE(report.parts[3].name, "peg_2");
+
+  // Merged: one mesh holding all four instances.
+  const collision::Mesh merged = import_mesh(dir / "parts.gltf");
+  EXPECT_EQ(merged.triangle_count(), 4u);
+}
+
+TEST(MeshImport, DegenerateTrianglesAreCounted) {
+  TempDir dir;
+  write_file(dir / "flat.obj",
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n");  // second is collinear
+  collision::MeshValidation validation;
+  const collision::Mesh mesh = import_mesh(dir / "flat.obj", &validation);
+  EXPECT_EQ(mesh.triangle_count(), 1u);
+  EXPECT_EQ(validation.degenerate_removed, 1u);
+  EXPECT_EQ(validation.unused_vertices, 1u);
+}
+
+TEST(MeshImport, SmallPartsKeepTheirTinyTriangles) {
+  TempDir dir;
+  // A 0.1 mm triangle (area 5e-9 m^2) is a real triangle, not a degenerate one.
+  write_file(dir / "tiny.obj", "v 0 0 0\nv 0.0001 0 0\nv 0 0.0001 0\nf 1 2 3\n");
+  EXPECT_EQ(import_mesh(dir / "tiny.obj").triangle_count(), 1u);
+}
+
+// ---------------------------------------------------------------- reading outside the folder
+
+TEST(MeshImport, GltfBufferInItsFolderIsRead) {
+  TempDir dir;
+  write_file(dir / "model/tri.bin", triangle_buffer());
+  write_file(dir / "model/ok.gltf", gltf(R"([{"mesh":0}])", "[0]"));
+  EXPECT_EQ(import_mesh(dir / "model/ok.gltf").triangle_count(), 1u);
+  // Also through a relative path with `..` that stays inside.
+  write_file(dir / "model/sub/tri.bin", triangle_buffer());
+  write_file(dir / "model/inside.gltf", gltf(R"([{"mesh":0}])", "[0]", "sub/../sub/tri.bin"));
+  EXPECT_EQ(import_mesh(dir / "model/inside.gltf").triangle_count(), 1u);
+}
+
+TEST(MeshImport, GltfBufferOutsideItsFolderIsRefused) {
+  TempDir dir;
+  write_file(dir / "secret.bin", triangle_buffer());
+  write_file(dir / "model/up.gltf", gltf(R"([{"mesh":0}])", "[0]", "../secret.bin"));
+  std::string message = import_error(dir / "model/up.gltf");
+  EXPECT_NE(message.find("up.gltf"), std::string::npos);
+  EXPECT_NE(message.find("outside the model's folder"), std::string::npos) << message;
+  EXPECT_NE(message.find("secret.bin"), std::string::npos) << message;
+
+  write_file(dir / "model/deep.gltf", gltf(R"([{"mesh":0}])", "[0]", "a/../../secret.bin"));
+  message = import_error(dir / "model/deep.gltf");
+  EXPECT_NE(message.find("outside the model's folder"), std::string::npos) << message;
+
+  const std::string absolute = (dir / "secret.bin").string();
+  write_file(dir / "model/absolute.gltf", gltf(R"([{"mesh":0}])", "[0]", absolute));
+  message = import_error(dir / "model/absolute.gltf");
+  EXPECT_NE(message.find("absolute.gltf"), std::string::npos) << message;
+
+  write_file(dir / "model/uri.gltf", gltf(R"([{"mesh":0}])", "[0]", "file://" + absolute));
+  message = import_error(dir / "model/uri.gltf");
+  EXPECT_NE(message.find("uri.gltf"), std::string::npos) << message;
+}
+
+TEST(MeshImport, ObjMaterialOutsideItsFolderIsNotRead) {
+  TempDir dir;
+  write_file(dir / "outside.mtl", "newmtl red\nKd 1 0 0\n");
+  write_file(dir / "model/part.obj",
+             "mtllib ../outside.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const ImportReport report = import_file(dir / "model/part.obj");
+  EXPECT_EQ(total_triangles(report), 1u);
+  bool noted = false;
+  for (const std::string& note : report.notes) {
+    noted = noted || note.find("outside.mtl") != std::string::npos;
+  }
+  EXPECT_TRUE(noted) << "the refused material library is mentioned in the notes";
+}
+
+TEST(MeshImport, RelativePathsWork) {
+  const fs::path before = fs::current_path();
+  fs::current_path(kModels / "OBJ");
+  collision::Mesh mesh;
+  EXPECT_NO_THROW(mesh = import_mesh("box.obj"));
+  fs::current_path(before);
+  EXPECT_EQ(mesh.triangle_count(), 12u);
+  EXPECT_EQ(mesh.source, "box.obj");
+}
+
+TEST(MeshImport, CheckedInTestData) {
+  EXPECT_EQ(import_mesh(kData / "cube.obj").triangle_count(), 12u);
+  EXPECT_EQ(import_mesh(kData / "tetrahedron.obj").triangle_count(), 4u);
+}
+
+}  // namespace
+}  // namespace dovetail::engine
