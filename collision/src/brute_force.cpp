@@ -34,7 +34,8 @@ CollideResult BruteForce::collide(const Mesh& mesh_a, const BruteForce& /*b*/, c
           lo_b[j].y() > hi_[i].y() || lo_[i].z() > hi_b[j].z() || lo_b[j].z() > hi_[i].z()) {
         continue;
       }
-      tester.test(i, j);
+      const TriangleIndices& t = mesh_b.triangles[j];
+      tester.test_transformed(i, j, {vertices_b[t[0]], vertices_b[t[1]], vertices_b[t[2]]});
     }
   }
   tester.finish();

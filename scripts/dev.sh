@@ -1,0 +1,27 @@
+#!/bin/sh
+# One entry point for users and CI:
+#   scripts/dev.sh run     install what is missing, build Release, run the default job
+#   scripts/dev.sh test    install what is missing, build Release, run every test
+#   scripts/dev.sh build   install what is missing, build Release
+#   scripts/dev.sh bench   build, then run the polygon-level benchmark on built-in meshes
+# Environment: BUILD_DIR (default build), JOBS (default: number of cores),
+# DOVETAIL_WERROR=ON to treat warnings as errors (CI does).
+set -eu
+here=$(cd "$(dirname "$0")/.." && pwd)
+cd "$here"
+build_dir=${BUILD_DIR:-build}
+jobs=${JOBS:-$(nproc 2>/dev/null || echo 2)}
+command=${1:-run}
+
+sh scripts/install-deps.sh
+
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DDOVETAIL_WERROR="${DOVETAIL_WERROR:-OFF}" >/dev/null
+cmake --build "$build_dir" -j "$jobs"
+
+case "$command" in
+  build) ;;
+  run) "$build_dir/apps/dovetail" run ;;
+  test) ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" ;;
+  bench) "$build_dir/bench/polygon_bench" ;;
+  *) echo "dev.sh: unknown command '$command' (run, test, build, bench)" >&2; exit 2 ;;
+esac

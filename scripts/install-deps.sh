@@ -1,0 +1,30 @@
+#!/bin/sh
+# Installs what Dovetail needs to build and test on Debian 12 (as root).
+# Runs apt only when something is missing, so it is cheap to call every time.
+set -eu
+
+# Build and library dependencies.
+packages="g++ cmake make pkg-config ccache libeigen3-dev libassimp-dev libtbb-dev libgtest-dev"
+# Test-only: exact oracle for the triangle test, and the model files of the import tests.
+packages="$packages libcgal-dev assimp-testmodels"
+# Bench-only peers (optional for the library, used by bench/).
+packages="$packages libfcl-dev"
+
+missing=""
+for p in $packages; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing="$missing $p"
+  fi
+done
+
+if [ -n "$missing" ]; then
+  echo "install-deps: installing$missing" >&2
+  if [ "$(id -u)" -ne 0 ]; then
+    echo "install-deps: missing packages and not root; run as root or install:$missing" >&2
+    exit 1
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  # shellcheck disable=SC2086
+  apt-get install -y -qq --no-install-recommends $missing >/dev/null
+fi
