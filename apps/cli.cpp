@@ -1,0 +1,280 @@
+#include "cli.h"
+
+#include <unistd.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+namespace dovetail::cli {
+
+namespace {
+
+std::string see_help(const std::string& command) {
+  return " (see 'dovetail " + command + " --help')";
+}
+
+}  // namespace
+
+Args::Args(std::string command, std::span<const std::string> argv,
+           std::set<std::string> value_options, std::set<std::string> flags)
+    : command_(std::move(command)) {
+  bool only_positional = false;
+  for (std::size_t i = 0; i < argv.size(); ++i) {
+    const std::string& arg = argv[i];
+    if (only_positional || arg.size() < 2 || arg[0] != '-') {
+      positional_.push_back(arg);
+      continue;
+    }
+    if (arg == "--") {
+      only_positional = true;
+      continue;
+    }
+    if (arg == "--help" || arg == "-h") {
+      help_ = true;
+      continue;
+    }
+    if (arg.rfind("--", 0) != 0) {
+      throw UsageError(command_ + ": unknown option '" + arg + "'" + see_help(command_));
+    }
+    std::string name = arg.substr(2);
+    std::optional<std::string> inline_value;
+    if (const std::size_t eq = name.find('='); eq != std::string::npos) {
+      inline_value = name.substr(eq + 1);
+      name.resize(eq);
+    }
+    if (flags.count(name) != 0) {
+      if (inline_value) {
+        throw UsageError(command_ + ": option '--" + name + "' takes no value");
+      }
+      flags_set_.insert(name);
+    } else if (value_options.count(name) != 0) {
+      if (!inline_value) {
+        if (i + 1 >= argv.size()) {
+          throw UsageError(command_ + ": option '--" + name + "' needs a value" +
+                           see_help(command_));
+        }
+        inline_value = argv[++i];
+      }
+      if (values_.count(name) != 0) {
+        throw UsageError(command_ + ": option '--" + name + "' given twice");
+      }
+      values_[name] = *inline_value;
+    } else {
+      throw UsageError(command_ + ": unknown option '--" + name + "'" + see_help(command_));
+    }
+  }
+}
+
+std::optional<std::string> Args::value(const std::string& name) const {
+  const auto it = values_.find(name);
+  if (it == values_.end()) return std::nullopt;
+  return it->second;
+}
+
+void Args::expect_positional(std::size_t count, std::string_view what) const {
+  if (positional_.size() != count) {
+    throw UsageError(command_ + ": expected " + std::string(what) + ", got " +
+                     std::to_string(positional_.size()) + " argument" +
+                     (positional_.size() == 1 ? "" : "s") + see_help(command_));
+  }
+}
+
+std::string Args::required(const std::string& name) const {
+  std::optional<std::string> v = value(name);
+  if (!v) throw UsageError(command_ + ": missing --" + name + see_help(command_));
+  return *v;
+}
+
+std::optional<std::int64_t> Args::integer(const std::string& name, std::int64_t min,
+                                          std::int64_t max) const {
+  const std::optional<std::string> text = value(name);
+  if (!text) return std::nullopt;
+  std::int64_t v = 0;
+  const auto [ptr, ec] = std::from_chars(text->data(), text->data() + text->size(), v);
+  if (ec != std::errc() || ptr != text->data() + text->size() || v < min || v > max) {
+    throw UsageError(command_ + ": --" + name + " must be an integer from " + std::to_string(min) +
+                     " to " + std::to_string(max) + ", not '" + *text + "'");
+  }
+  return v;
+}
+
+std::optional<std::uint64_t> Args::unsigned_integer(const std::string& name) const {
+  const std::optional<std::string> text = value(name);
+  if (!text) return std::nullopt;
+  std::uint64_t v = 0;
+  const auto [ptr, ec] = std::from_chars(text->data(), text->data() + text->size(), v);
+  if (ec != std::errc() || ptr != text->data() + text->size()) {
+    throw UsageError(command_ + ": --" + name + " must be a non-negative integer, not '" + *text +
+                     "'");
+  }
+  return v;
+}
+
+std::optional<std::vector<double>> Args::number_list(const std::string& name) const {
+  const std::optional<std::string> text = value(name);
+  if (!text) return std::nullopt;
+  std::vector<double> numbers;
+  std::size_t start = 0;
+  while (start <= text->size()) {
+    std::size_t end = text->find(',', start);
+    if (end == std::string::npos) end = text->size();
+    const std::string item = text->substr(start, end - start);
+    const char* first = item.data();
+    if (!item.empty() && item[0] == '+') ++first;
+    double v = 0;
+    const auto [ptr, ec] = std::from_chars(first, item.data() + item.size(), v);
+    if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() ||
+        !std::isfinite(v)) {
+      throw UsageError(command_ + ": --" + name +
+                       " must be a comma-separated list of finite numbers; '" + item +
+                       "' is not one");
+    }
+    numbers.push_back(v);
+    start = end + 1;
+  }
+  return numbers;
+}
+
+collision::Method Args::method(collision::Method fallback) const {
+  const std::optional<std::string> name = value("method");
+  if (!name) return fallback;
+  const std::optional<collision::Method> m = collision::parse_method(*name);
+  if (!m) {
+    throw UsageError(command_ + ": unknown method '" + *name +
+                     "'; valid methods: " + method_list());
+  }
+  return *m;
+}
+
+std::string method_list() {
+  std::string list;
+  for (collision::Method m : collision::all_methods()) {
+    if (!list.empty()) list += ", ";
+    list += collision::method_name(m);
+  }
+  return list;
+}
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+LoadedMesh load_mesh(const std::string& path) {
+  try {
+    engine::ImportReport report = engine::import_file(path, {});
+    LoadedMesh loaded;
+    loaded.validation = report.parts.front().validation;
+    loaded.mesh = std::make_shared<const collision::Mesh>(std::move(report.parts.front().mesh));
+    report.parts.clear();
+    loaded.report = std::move(report);
+    return loaded;
+  } catch (const collision::MeshError& e) {
+    throw InputError(e.what());
+  }
+}
+
+BuiltModel build_timed(collision::Method method, std::shared_ptr<const collision::Mesh> mesh) {
+  const auto start = std::chrono::steady_clock::now();
+  BuiltModel built;
+  built.model = collision::build_model(method, std::move(mesh));
+  built.build_ms = ms_since(start);
+  return built;
+}
+
+bool stderr_is_terminal() { return isatty(STDERR_FILENO) != 0; }
+
+std::string json_string(std::string_view text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buffer[8];
+          std::snprintf(buffer, sizeof buffer, "\\u%04x", static_cast<unsigned>(c));
+          out += buffer;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_array(const std::vector<std::string>& items) {
+  std::string out(1, '[');
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (i > 0) out += ',';
+    out += items[i];
+  }
+  out += ']';
+  return out;
+}
+
+std::string json_number(double value) {
+  if (!std::isfinite(value)) return "null";
+  char buffer[32];
+  const auto [ptr, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  if (ec != std::errc()) return "null";
+  return std::string(buffer, ptr);
+}
+
+void JsonLine::key(std::string_view k) {
+  if (!body_.empty()) body_ += ",";
+  body_ += json_string(k) + ":";
+}
+
+JsonLine& JsonLine::add(std::string_view k, std::string_view text) {
+  key(k);
+  body_ += json_string(text);
+  return *this;
+}
+
+JsonLine& JsonLine::add(std::string_view k, double number) {
+  key(k);
+  body_ += json_number(number);
+  return *this;
+}
+
+JsonLine& JsonLine::add(std::string_view k, std::uint64_t number) {
+  key(k);
+  body_ += std::to_string(number);
+  return *this;
+}
+
+JsonLine& JsonLine::add(std::string_view k, std::int64_t number) {
+  key(k);
+  body_ += std::to_string(number);
+  return *this;
+}
+
+JsonLine& JsonLine::add(std::string_view k, bool value) {
+  key(k);
+  body_ += value ? "true" : "false";
+  return *this;
+}
+
+JsonLine& JsonLine::add_raw(std::string_view k, std::string_view json) {
+  key(k);
+  body_ += json;
+  return *this;
+}
+
+}  // namespace dovetail::cli

@@ -1,0 +1,130 @@
+#pragma once
+/// \file cli.h
+/// What every `dovetail` command shares: argument parsing, the two kinds of
+/// failure (usage, input) with their exit codes, timing, JSON output, and
+/// loading meshes and models.
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "dovetail/collision/model.h"
+#include "dovetail/engine/mesh_import.h"
+
+namespace dovetail::cli {
+
+/// Exit codes of the command line.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitInputError = 1;   ///< bad input file, unwritable output, I/O failure
+inline constexpr int kExitUsage = 2;        ///< unknown command or option, missing argument
+inline constexpr int kExitCheckFailed = 3;  ///< a self-check failed (`run`: methods disagree)
+
+/// The command line was wrong; exit code 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// An input could not be used or an output not written; exit code 1.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Parsed arguments of one command: positionals in order, `--name value` (or
+/// `--name=value`) options and `--flag` switches. Only names the command
+/// declares are accepted.
+class Args {
+ public:
+  /// `value_options` take a value, `flags` do not. `--help`/`-h` is always known.
+  Args(std::string command, std::span<const std::string> argv, std::set<std::string> value_options,
+       std::set<std::string> flags);
+
+  bool help() const { return help_; }
+  const std::vector<std::string>& positional() const { return positional_; }
+  bool flag(const std::string& name) const { return flags_set_.count(name) != 0; }
+  std::optional<std::string> value(const std::string& name) const;
+
+  /// Requires exactly `count` positional arguments named by `what` for messages.
+  void expect_positional(std::size_t count, std::string_view what) const;
+  /// The value of a required option; UsageError when absent.
+  std::string required(const std::string& name) const;
+
+  /// Option parsers; UsageError naming the option when malformed.
+  std::optional<std::int64_t> integer(const std::string& name, std::int64_t min,
+                                      std::int64_t max) const;
+  std::optional<std::uint64_t> unsigned_integer(const std::string& name) const;
+  std::optional<std::vector<double>> number_list(const std::string& name) const;
+  /// --method, default `fallback`; UsageError listing the valid names.
+  collision::Method method(collision::Method fallback) const;
+
+  const std::string& command() const { return command_; }
+
+ private:
+  std::string command_;
+  bool help_ = false;
+  std::vector<std::string> positional_;
+  std::map<std::string, std::string> values_;
+  std::set<std::string> flags_set_;
+};
+
+/// "boxtree, dop6, ..., brute".
+std::string method_list();
+
+/// Milliseconds since `start`.
+double ms_since(std::chrono::steady_clock::time_point start);
+
+/// A mesh imported merged, with the import's findings.
+struct LoadedMesh {
+  std::shared_ptr<const collision::Mesh> mesh;
+  engine::ImportReport report;  ///< parts emptied; validation and notes kept
+  collision::MeshValidation validation;
+};
+/// Imports `path` merged; engine::ImportError becomes InputError.
+LoadedMesh load_mesh(const std::string& path);
+
+/// A built model and how long the build took.
+struct BuiltModel {
+  std::shared_ptr<const collision::CollisionModel> model;
+  double build_ms = 0;
+};
+BuiltModel build_timed(collision::Method method, std::shared_ptr<const collision::Mesh> mesh);
+
+/// True when stderr is a terminal (progress is shown only then).
+bool stderr_is_terminal();
+
+/// A one-line JSON object built key by key, in insertion order.
+class JsonLine {
+ public:
+  JsonLine& add(std::string_view key, std::string_view text);
+  JsonLine& add(std::string_view key, const char* text) { return add(key, std::string_view(text)); }
+  JsonLine& add(std::string_view key, double number);
+  JsonLine& add(std::string_view key, std::uint64_t number);
+  JsonLine& add(std::string_view key, std::int64_t number);
+  JsonLine& add(std::string_view key, int number) { return add(key, std::int64_t{number}); }
+  JsonLine& add(std::string_view key, bool value);
+  /// A value that is already JSON (an array or object).
+  JsonLine& add_raw(std::string_view key, std::string_view json);
+  std::string str() const { return "{" + body_ + "}"; }
+
+ private:
+  void key(std::string_view k);
+  std::string body_;
+};
+
+/// `text` as a JSON string literal, quotes included.
+std::string json_string(std::string_view text);
+/// `[item,item,...]` from items that are already JSON.
+std::string json_array(const std::vector<std::string>& items);
+/// A finite double as JSON (shortest round-trip form); null when not finite.
+std::string json_number(double value);
+
+}  // namespace dovetail::cli

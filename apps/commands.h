@@ -1,0 +1,21 @@
+#pragma once
+/// \file commands.h
+/// The `dovetail` commands. Each takes the arguments after its name, writes
+/// its results to stdout, and returns the exit code; failures are thrown as
+/// cli::UsageError or cli::InputError and reported by main.
+
+#include <span>
+#include <string>
+
+namespace dovetail::cli {
+
+/// `dovetail query A B --poses FILE ...`: collision flags for a pose list.
+int query_command(std::span<const std::string> args);
+/// `dovetail inspect MESH ...`: mesh statistics and per-method hierarchy sizes.
+int inspect_command(std::span<const std::string> args);
+/// `dovetail poses A B --out FILE ...`: writes a contact-distance pose list.
+int poses_command(std::span<const std::string> args);
+/// `dovetail run`: the built-in default job (every method against brute force).
+int run_command(std::span<const std::string> args);
+
+}  // namespace dovetail::cli

@@ -1,0 +1,171 @@
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "cli.h"
+#include "commands.h"
+
+namespace dovetail::cli {
+
+namespace {
+
+constexpr const char* kHelp =
+    R"(usage: dovetail inspect MESH [--json] [--method M] [--parts]
+
+Reads a mesh file (any format assimp reads) as `query` does and reports what
+was found: vertices, triangles, validation findings (degenerate triangles
+removed, unused vertices, skipped point/line primitives, notes), bounds, and
+for every method the hierarchy built over it: nodes, leaves, depth, bytes,
+bytes per triangle and build time.
+
+  --json       one JSON object on one line instead of the text report
+  --method M   only this method (boxtree, dop6, dop14, dop18, dop26, aabb, obb, brute)
+  --parts      also list the parts (one per mesh instance of every node)
+)";
+
+double round_ms(double ms) { return std::round(ms * 1000.0) / 1000.0; }
+
+std::string json_vec(const collision::Vec3& v) {
+  return json_array({json_number(v.x()), json_number(v.y()), json_number(v.z())});
+}
+
+struct MethodRow {
+  collision::Method method;
+  collision::ModelInfo info;
+  double build_ms = 0;
+};
+
+struct PartRow {
+  std::string name;
+  std::size_t vertices = 0;
+  std::size_t triangles = 0;
+};
+
+}  // namespace
+
+int inspect_command(std::span<const std::string> argv) {
+  const Args args("inspect", argv, {"method"}, {"json", "parts"});
+  if (args.help()) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  args.expect_positional(1, "one mesh file");
+  const std::string& path = args.positional()[0];
+  std::vector<collision::Method> methods;
+  if (args.value("method")) {
+    methods.push_back(args.method(collision::Method::kBoxtree));
+  } else {
+    methods.assign(collision::all_methods().begin(), collision::all_methods().end());
+  }
+
+  const LoadedMesh loaded = load_mesh(path);
+  const collision::Mesh& mesh = *loaded.mesh;
+  const collision::Bounds bounds = collision::mesh_bounds(mesh);
+  const double diagonal = (bounds.max - bounds.min).norm();
+
+  std::vector<PartRow> parts;
+  if (args.flag("parts")) {
+    engine::ImportOptions per_part;
+    per_part.merge = false;
+    try {
+      for (const engine::ImportedPart& part : engine::import_file(path, per_part).parts) {
+        parts.push_back({part.name, part.mesh.vertex_count(), part.mesh.triangle_count()});
+      }
+    } catch (const collision::MeshError& e) {
+      throw InputError(e.what());
+    }
+  }
+
+  const bool terminal = stderr_is_terminal();
+  std::vector<MethodRow> rows;
+  for (collision::Method m : methods) {
+    if (terminal) {
+      std::fprintf(stderr, "\rbuilding %-8s", std::string(collision::method_name(m)).c_str());
+    }
+    const BuiltModel built = build_timed(m, loaded.mesh);
+    rows.push_back({m, built.model->info(), built.build_ms});
+  }
+  if (terminal) std::fputs("\r                 \r", stderr);
+
+  const collision::MeshValidation& v = loaded.validation;
+  if (args.flag("json")) {
+    std::vector<std::string> notes;
+    for (const std::string& note : loaded.report.notes) notes.push_back(json_string(note));
+    std::vector<std::string> method_items;
+    for (const MethodRow& row : rows) {
+      JsonLine item;
+      item.add("method", collision::method_name(row.method))
+          .add("nodes", std::uint64_t{row.info.nodes})
+          .add("leaves", std::uint64_t{row.info.leaves})
+          .add("depth", std::uint64_t{row.info.depth})
+          .add("bytes", std::uint64_t{row.info.bytes})
+          .add("bytes_per_triangle", row.info.bytes_per_triangle)
+          .add("build_ms", round_ms(row.build_ms));
+      method_items.push_back(item.str());
+    }
+    JsonLine json;
+    json.add("file", path)
+        .add("vertices", std::uint64_t{mesh.vertex_count()})
+        .add("triangles", std::uint64_t{mesh.triangle_count()})
+        .add("input_vertices", std::uint64_t{v.input_vertices})
+        .add("input_triangles", std::uint64_t{v.input_triangles})
+        .add("degenerate_removed", std::uint64_t{v.degenerate_removed})
+        .add("unused_vertices", std::uint64_t{v.unused_vertices})
+        .add("skipped_line_or_point_primitives",
+             std::uint64_t{loaded.report.skipped_line_or_point_primitives})
+        .add_raw("notes", json_array(notes))
+        .add_raw("bounds_min", json_vec(bounds.min))
+        .add_raw("bounds_max", json_vec(bounds.max))
+        .add("diagonal", diagonal);
+    if (args.flag("parts")) {
+      std::vector<std::string> part_items;
+      for (const PartRow& part : parts) {
+        JsonLine item;
+        item.add("name", part.name)
+            .add("vertices", std::uint64_t{part.vertices})
+            .add("triangles", std::uint64_t{part.triangles});
+        part_items.push_back(item.str());
+      }
+      json.add_raw("parts", json_array(part_items));
+    }
+    json.add_raw("methods", json_array(method_items));
+    std::fputs((json.str() + "\n").c_str(), stdout);
+    return kExitOk;
+  }
+
+  std::printf("file                %s\n", path.c_str());
+  std::printf("vertices            %zu\n", mesh.vertex_count());
+  std::printf("triangles           %zu\n", mesh.triangle_count());
+  std::printf("read                %zu vertices, %zu triangles\n", v.input_vertices,
+              v.input_triangles);
+  std::printf("degenerate removed  %zu\n", v.degenerate_removed);
+  std::printf("unused vertices     %zu\n", v.unused_vertices);
+  std::printf("skipped primitives  %zu (points and lines)\n",
+              loaded.report.skipped_line_or_point_primitives);
+  std::printf("bounds min          %.9g %.9g %.9g\n", bounds.min.x(), bounds.min.y(),
+              bounds.min.z());
+  std::printf("bounds max          %.9g %.9g %.9g\n", bounds.max.x(), bounds.max.y(),
+              bounds.max.z());
+  std::printf("diagonal            %.9g\n", diagonal);
+  for (const std::string& note : loaded.report.notes) {
+    std::printf("note                %s\n", note.c_str());
+  }
+  if (args.flag("parts")) {
+    std::printf("\n%-32s %10s %10s\n", "part", "vertices", "triangles");
+    for (const PartRow& part : parts) {
+      std::printf("%-32s %10zu %10zu\n", part.name.c_str(), part.vertices, part.triangles);
+    }
+  }
+  std::printf("\n%-8s %10s %10s %6s %12s %10s %10s\n", "method", "nodes", "leaves", "depth",
+              "bytes", "bytes/tri", "build ms");
+  for (const MethodRow& row : rows) {
+    std::printf("%-8s %10zu %10zu %6zu %12zu %10.2f %10.3f\n",
+                std::string(collision::method_name(row.method)).c_str(), row.info.nodes,
+                row.info.leaves, row.info.depth, row.info.bytes, row.info.bytes_per_triangle,
+                row.build_ms);
+  }
+  return kExitOk;
+}
+
+}  // namespace dovetail::cli

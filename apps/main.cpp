@@ -1,0 +1,112 @@
+/// \file main.cpp
+/// `dovetail <command> ...`: dispatches to the commands, turns every failure
+/// into a message on stderr and an exit code, never an uncaught exception.
+
+#include <cstdio>
+#include <new>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cli.h"
+#include "commands.h"
+#include "dovetail/collision/mesh.h"
+#include "dovetail/engine/pose_list.h"
+
+namespace {
+
+using dovetail::cli::kExitInputError;
+using dovetail::cli::kExitOk;
+using dovetail::cli::kExitUsage;
+
+constexpr const char* kUsage =
+    R"(usage: dovetail <command> [arguments]
+
+Headless VR assembly simulator: exact collision queries between meshes.
+
+commands:
+  query     test mesh B against mesh A at every pose of a pose list
+  inspect   mesh statistics and the size of every method's hierarchy
+  poses     write a contact-distance pose list for two meshes
+  run       the built-in job: every method against brute force
+  version   print the version
+
+'dovetail <command> --help' describes a command.
+exit codes: 0 success, 1 input error, 2 usage error, 3 failed check.
+)";
+
+struct Command {
+  std::string_view name;
+  int (*run)(std::span<const std::string>);
+};
+
+int version_command(std::span<const std::string> args) {
+  const dovetail::cli::Args parsed("version", args, {}, {});
+  if (parsed.help()) {
+    std::fputs("usage: dovetail version\n\nPrints the version of dovetail.\n", stdout);
+    return kExitOk;
+  }
+  parsed.expect_positional(0, "no arguments");
+  std::printf("dovetail %s\n", DOVETAIL_VERSION);
+  return kExitOk;
+}
+
+constexpr Command kCommands[] = {
+    {"query", dovetail::cli::query_command},
+    {"inspect", dovetail::cli::inspect_command},
+    {"poses", dovetail::cli::poses_command},
+    {"run", dovetail::cli::run_command},
+    {"version", version_command},
+};
+
+int dispatch(const std::vector<std::string>& args) {
+  if (args.empty()) {
+    std::fputs(kUsage, stderr);
+    return kExitUsage;
+  }
+  const std::string& name = args[0];
+  if (name == "--help" || name == "-h" || name == "help") {
+    std::fputs(kUsage, stdout);
+    return kExitOk;
+  }
+  if (name == "--version") return version_command({});
+  for (const Command& command : kCommands) {
+    if (command.name == name) {
+      return command.run(std::span<const std::string>(args).subspan(1));
+    }
+  }
+  throw dovetail::cli::UsageError("unknown command '" + name + "' (see 'dovetail --help')");
+}
+
+int report(const char* message, int code) {
+  std::fprintf(stderr, "dovetail: %s\n", message);
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int code = kExitOk;
+  try {
+    code = dispatch(std::vector<std::string>(argv + 1, argv + argc));
+  } catch (const dovetail::cli::UsageError& e) {
+    code = report(e.what(), kExitUsage);
+  } catch (const dovetail::cli::InputError& e) {
+    code = report(e.what(), kExitInputError);
+  } catch (const dovetail::engine::PoseListError& e) {
+    code = report(e.what(), kExitInputError);
+  } catch (const dovetail::collision::MeshError& e) {
+    code = report(e.what(), kExitInputError);
+  } catch (const std::bad_alloc&) {
+    code = report("out of memory", kExitInputError);
+  } catch (const std::exception& e) {
+    code = report(e.what(), kExitInputError);
+  } catch (...) {
+    code = report("unexpected failure", kExitInputError);
+  }
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    return report("cannot write to standard output", kExitInputError);
+  }
+  return code;
+}
