@@ -380,6 +380,18 @@ TEST(MeshImport, LimitsApply) {
   EXPECT_NE(import_error(kModels / "OBJ/box.obj", tight).find("box.obj"), std::string::npos);
 }
 
+TEST(MeshImport, ObjWithMoreVertexLinesThanTheLimitIsRefusedBeforeParsing) {
+  TempDir dir;
+  std::string obj;
+  for (int i = 0; i < 40; ++i) obj += "v " + std::to_string(i) + " 0 0\n";
+  obj += "v 0 1 0\nf 1 2 41\n";
+  write_file(dir / "many.obj", obj);
+  ImportOptions tight;
+  tight.limits.max_vertices = 16;
+  const std::string message = fast_error(dir / "many.obj", tight);
+  EXPECT_NE(message.find("more than 16 vertex lines"), std::string::npos) << message;
+}
+
 // ---------------------------------------------------------------- transforms and parts
 
 /// A glTF scene: `nodes_json` placed over one triangle mesh named "tri" with
