@@ -174,8 +174,11 @@ void append(const fs::path& path, const aiMesh& mesh, const Affine& X_RN, Geomet
 }
 
 /// Raw scene straight from the reader: coordinates must be finite and sizes
-/// within the limits before the post-processing steps work on them.
-void check_raw_scene(const fs::path& path, const aiScene& scene, const MeshLimits& limits) {
+/// within the limits before the post-processing steps work on them. Returns
+/// the number of triangles with a repeated vertex position, which the
+/// post-processing removes.
+std::size_t check_raw_scene(const fs::path& path, const aiScene& scene, const MeshLimits& limits) {
+  std::size_t repeated = 0;
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
     const aiMesh* mesh = scene.mMeshes[m];
     if (mesh == nullptr) fail(path, "mesh " + std::to_string(m) + " is missing");
@@ -201,15 +204,25 @@ void check_raw_scene(const fs::path& path, const aiScene& scene, const MeshLimit
                        std::to_string(p.z) + ")");
       }
     }
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices != 3 || face.mIndices == nullptr) continue;
+      const unsigned i = face.mIndices[0], j = face.mIndices[1], k = face.mIndices[2];
+      if (i >= mesh->mNumVertices || j >= mesh->mNumVertices || k >= mesh->mNumVertices) continue;
+      const aiVector3D &a = mesh->mVertices[i], &b = mesh->mVertices[j], &c = mesh->mVertices[k];
+      if (a == b || b == c || a == c) ++repeated;
+    }
   }
+  return repeated;
 }
 
 std::string refused_message(const detail::FolderIOSystem& io) {
-  std::string text;
-  for (const std::string& p : io.refused()) {
-    text += (text.empty() ? "" : ", ") + ("'" + p + "'");
+  std::string text = "refers to ";
+  for (std::size_t i = 0; i < io.refused().size(); ++i) {
+    if (i > 0) text += ", ";
+    text.append(1, '\'').append(io.refused()[i]).append(1, '\'');
   }
-  return "refers to " + text + " outside the model's folder, which is not read";
+  return text + " outside the model's folder, which is not read";
 }
 
 [[noreturn]] void fail_import(const fs::path& path, const Assimp::Importer& importer,
@@ -229,9 +242,8 @@ std::string part_base_name(const Instance& instance, const aiScene& scene) {
   return name;
 }
 
-collision::Mesh validate(const fs::path& path, Geometry geometry, std::string source,
-                         const MeshLimits& limits, collision::MeshValidation& validation) {
-  (void)path;
+collision::Mesh validate(Geometry geometry, std::string source, const MeshLimits& limits,
+                         collision::MeshValidation& validation) {
   try {
     return collision::make_mesh(std::move(geometry.vertices), std::move(geometry.triangles),
                                 std::move(source), limits, &validation);
@@ -316,7 +328,7 @@ ImportReport import_scene(const fs::path& path, const aiScene& scene, const Impo
     }
     ImportedPart part;
     part.name = path.filename().string();
-    part.mesh = validate(path, std::move(geometry), path.string(), options.limits, part.validation);
+    part.mesh = validate(std::move(geometry), path.string(), options.limits, part.validation);
     report.parts.push_back(std::move(part));
     return report;
   }
@@ -331,8 +343,8 @@ ImportReport import_scene(const fs::path& path, const aiScene& scene, const Impo
     append(path, *scene.mMeshes[instance->mesh], instance->X_RN, geometry);
     ImportedPart part;
     part.name = name;
-    part.mesh = validate(path, std::move(geometry), path.string() + "#" + name, options.limits,
-                         part.validation);
+    part.mesh =
+        validate(std::move(geometry), path.string() + "#" + name, options.limits, part.validation);
     report.parts.push_back(std::move(part));
   }
   return report;
@@ -364,13 +376,16 @@ ImportReport import_file(const fs::path& path, const ImportOptions& options) {
                                   aiComponent_TEXTURES | aiComponent_LIGHTS | aiComponent_CAMERAS);
 
   const aiScene* scene = nullptr;
+  std::size_t repeated = 0;
+  unsigned raw_meshes = 0;
   try {
     // Read and validate the structure only, check coordinates and sizes, then
     // post-process: FindInvalidData would silently delete a mesh with a NaN
     // vertex, and a broken file must be an error instead.
     scene = importer.ReadFile(absolute.string(), aiProcess_ValidateDataStructure);
     if (scene == nullptr) fail_import(path, importer, *io);
-    check_raw_scene(path, *scene, options.limits);
+    repeated = check_raw_scene(path, *scene, options.limits);
+    raw_meshes = scene->mNumMeshes;
     scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                                          aiProcess_ValidateDataStructure |
                                          aiProcess_FindDegenerates | aiProcess_FindInvalidData |
@@ -386,8 +401,17 @@ ImportReport import_file(const fs::path& path, const ImportOptions& options) {
     fail(path, "cannot be read as a mesh: unknown failure in the importer");
   }
 
+  if (scene->mNumMeshes == 0 && raw_meshes > 0 && repeated > 0) {
+    fail(path, "contains no usable triangles: every face repeats a vertex");
+  }
   std::vector<std::string> notes;
   if (!io->refused().empty()) notes.push_back(refused_message(*io));
+  if (repeated > 0) {
+    notes.push_back(
+        "removed " +
+        plural(repeated, "triangle with a repeated vertex", "triangles with a repeated vertex") +
+        " while reading");
+  }
   return import_scene(path, *scene, options, std::move(notes));
 }
 

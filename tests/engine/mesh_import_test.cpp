@@ -486,6 +486,24 @@ TEST(MeshImport, DegenerateTrianglesAreCounted) {
   EXPECT_EQ(validation.unused_vertices, 1u);
 }
 
+TEST(MeshImport, TrianglesWithRepeatedVerticesAreRemovedWithANote) {
+  TempDir dir;
+  write_file(dir / "repeat.obj",
+             "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 5 0 0\nv 6 0 0\nf 4 4 5\n");
+  const ImportReport report = import_file(dir / "repeat.obj");
+  EXPECT_EQ(total_triangles(report), 1u);
+  bool noted = false;
+  for (const std::string& note : report.notes) {
+    noted = noted || note.find("1 triangle with a repeated vertex") != std::string::npos;
+  }
+  EXPECT_TRUE(noted);
+
+  write_file(dir / "all_repeat.obj", "v 0 0 0\nv 1 0 0\nf 1 1 2\n");
+  const std::string message = import_error(dir / "all_repeat.obj");
+  EXPECT_NE(message.find("all_repeat.obj"), std::string::npos);
+  EXPECT_NE(message.find("no usable triangles"), std::string::npos) << message;
+}
+
 TEST(MeshImport, SmallPartsKeepTheirTinyTriangles) {
   TempDir dir;
   // A 0.1 mm triangle (area 5e-9 m^2) is a real triangle, not a degenerate one.
