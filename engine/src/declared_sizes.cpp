@@ -107,6 +107,9 @@ std::string beyond_file(std::string_view format, long double needed, std::uintma
   return out.str();
 }
 
+/// PLY headers are checked strictly: importers are fragile on malformed ones
+/// (missing end_header, unknown types, malformed element or property lines),
+/// so these are refused here with the offending line.
 std::optional<std::string> check_ply(std::string_view head, std::uintmax_t file_size,
                                      const collision::MeshLimits& limits) {
   struct Element {
@@ -117,46 +120,72 @@ std::optional<std::string> check_ply(std::string_view head, std::uintmax_t file_
   };
   std::vector<Element> elements;
   bool binary = false;
+  bool has_format = false;
   std::size_t pos = 0;
+  std::size_t line = 0;
   std::size_t header_end = std::string_view::npos;
+  auto bad = [&line](const std::string& what) {
+    return "PLY header line " + std::to_string(line) + ": " + what;
+  };
   while (pos < head.size()) {
-    std::size_t eol = head.find('\n', pos);
+    const std::size_t eol = head.find('\n', pos);
     if (eol == std::string_view::npos) break;
-    const std::vector<std::string_view> w = split_words(head.substr(pos, eol - pos));
+    const std::string_view text = head.substr(pos, eol - pos);
+    const std::vector<std::string_view> w = split_words(text);
     pos = eol + 1;
+    ++line;
+    if (line == 1) continue;  // "ply", checked by the caller
     if (w.empty()) continue;
-    if (w[0] == "end_header") {
+    if (w[0] == "end_header" && w.size() == 1) {
       header_end = pos;
       break;
     }
-    if (w[0] == "format" && w.size() >= 2) {
+    if (w[0] == "comment" || w[0] == "obj_info") continue;
+    if (w[0] == "format") {
+      if (has_format || w.size() != 3 ||
+          (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian")) {
+        return bad("invalid format line");
+      }
+      has_format = true;
       binary = w[1] != "ascii";
-    } else if (w[0] == "element" && w.size() >= 3) {
+    } else if (w[0] == "element") {
+      if (w.size() != 3) return bad("an element needs a name and a count");
       Element e;
       e.name = std::string(w[1]);
       e.count = parse_count(w[2]);
       if (!e.count.valid) {
-        return "PLY element '" + e.name + "' has count '" + std::string(w[2]) + "', not a number";
+        return bad("element '" + e.name + "' has count '" + std::string(w[2]) + "', not a number");
       }
       elements.push_back(std::move(e));
-    } else if (w[0] == "property" && !elements.empty()) {
+    } else if (w[0] == "property") {
+      if (elements.empty()) return bad("property before any element");
       Element& e = elements.back();
       ++e.properties;
-      if (w.size() >= 3 && w[1] == "list") {
-        const std::size_t size = ply_type_size(w[2]);
-        if (size == 0) return std::nullopt;  // unknown type: the importer decides
-        e.binary_bytes += size;
-      } else if (w.size() >= 2) {
+      if (w.size() >= 2 && w[1] == "list") {
+        if (w.size() != 5) return bad("a list property needs two types and a name");
+        const std::size_t count_size = ply_type_size(w[2]);
+        const std::string_view count_type = w[2];
+        if (count_size == 0 || count_type.find("float") != std::string_view::npos ||
+            count_type == "double") {
+          return bad("list count type '" + std::string(w[2]) + "' is not an integer type");
+        }
+        if (ply_type_size(w[3]) == 0) return bad("unknown type '" + std::string(w[3]) + "'");
+        e.binary_bytes += count_size;
+      } else {
+        if (w.size() != 3) return bad("a property needs a type and a name");
         const std::size_t size = ply_type_size(w[1]);
-        if (size == 0) return std::nullopt;
+        if (size == 0) return bad("unknown type '" + std::string(w[1]) + "'");
         e.binary_bytes += size;
       }
     }
+    // Other lines are skipped: some exporters write comments without `comment`.
   }
   if (header_end == std::string_view::npos) {
     if (head.size() >= file_size) return "PLY header is not terminated by end_header";
-    return std::nullopt;  // header longer than what was read: leave it to the importer
+    return "PLY header is longer than " + std::to_string(kHeadBytes / 1024) +
+           " KiB or not terminated by end_header";
   }
+  if (!has_format) return "PLY header has no format line";
 
   const std::uintmax_t available = file_size - header_end;
   long double needed = 0;

@@ -345,6 +345,59 @@ TEST(MeshImport, PlyDeclaringHundredMillionVerticesFailsFast) {
   EXPECT_NE(fast_error(dir / "overflow.ply").find("overflow.ply"), std::string::npos);
 }
 
+// Malformed PLY headers once made the importer hang or crash; they are refused
+// before it runs, naming the header line.
+TEST(MeshImport, MalformedPlyHeadersAreRefused) {
+  TempDir dir;
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string vertex = "element vertex 3\nproperty float x\nproperty float y\n";
+  const std::string face = "element face 1\nproperty list uchar int vertex_indices\n";
+  struct Case {
+    const char* name;
+    std::string text;
+    const char* what;
+  };
+  const Case cases[] = {
+      {"unknown_type.ply",
+       "ply\nformat ascii 1.0\n" + vertex + "property floaoat z\n" + face + "end_header\n" + body,
+       "line 6: unknown type 'floaoat'"},
+      {"no_end.ply", "ply\nformat ascii 1.0\n" + vertex + "property float z\n" + face + body,
+       "not terminated by end_header"},
+      {"broken_end.ply",
+       "ply\nformat ascii 1.0\n" + vertex + "property float z\n" + face + "end_heajer\n" + body,
+       "not terminated by end_header"},
+      {"short_list.ply",
+       "ply\nformat ascii 1.0\n" + vertex +
+           "property float z\nelement face 1\nproperty list uint8\nend_header\n" + body,
+       "line 8: a list property needs two types and a name"},
+      {"float_count.ply",
+       "ply\nformat ascii 1.0\n" + vertex +
+           "property float z\nelement face 1\nproperty list float int idx\nend_header\n" + body,
+       "is not an integer type"},
+      {"no_count.ply", "ply\nformat ascii 1.0\nelement vertex\nend_header\n" + body,
+       "line 3: an element needs a name and a count"},
+      {"orphan_property.ply", "ply\nformat ascii 1.0\nproperty float x\nend_header\n" + body,
+       "line 3: property before any element"},
+      {"bad_format.ply",
+       "ply\nformat asc1i 1.0\n" + vertex + "property float z\n" + face + "end_header\n" + body,
+       "line 2: invalid format line"},
+      {"no_format.ply", "ply\n" + vertex + "property float z\n" + face + "end_header\n" + body,
+       "no format line"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    write_file(dir / c.name, c.text);
+    const std::string message = fast_error(dir / c.name);
+    EXPECT_EQ(message.rfind((dir / c.name).string() + ": ", 0), 0u) << message;
+    EXPECT_NE(message.find(c.what), std::string::npos) << message;
+  }
+  // Exporters that write comments without `comment` are still read.
+  write_file(dir / "loose_comment.ply", "ply\nformat ascii 1.0\nCreated by some exporter\n" +
+                                            vertex + "property float z\n" + face + "end_header\n" +
+                                            body);
+  EXPECT_EQ(import_mesh(dir / "loose_comment.ply").triangle_count(), 1u);
+}
+
 TEST(MeshImport, OffDeclaringHundredMillionVerticesFailsFast) {
   TempDir dir;
   write_file(dir / "huge.off", "OFF\n100000000 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
