@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <utility>
 
 namespace dovetail::cli {
@@ -146,6 +147,21 @@ collision::Method Args::method(collision::Method fallback) const {
                      "'; valid methods: " + method_list());
   }
   return *m;
+}
+
+void refuse_overwriting_input(const std::string& command, const std::string& output,
+                              std::span<const std::string> inputs) {
+  namespace fs = std::filesystem;
+  for (const std::string& input : inputs) {
+    std::error_code ec;
+    const bool same = fs::exists(output, ec) ? fs::equivalent(output, input, ec)
+                                             : fs::absolute(output, ec).lexically_normal() ==
+                                                   fs::absolute(input, ec).lexically_normal();
+    if (same && !ec) {
+      throw UsageError(command + ": the output '" + output + "' is the input '" + input +
+                       "'; it would be overwritten");
+    }
+  }
 }
 
 std::string method_list() {

@@ -76,6 +76,11 @@ class Args {
   std::set<std::string> flags_set_;
 };
 
+/// UsageError when `output` names the same file as one of `inputs`: writing
+/// it would destroy an input before it is read.
+void refuse_overwriting_input(const std::string& command, const std::string& output,
+                              std::span<const std::string> inputs);
+
 /// "boxtree, dop6, ..., brute".
 std::string method_list();
 

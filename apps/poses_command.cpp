@@ -62,6 +62,8 @@ int poses_command(std::span<const std::string> argv) {
   settings.seed = args.unsigned_integer("seed").value_or(settings.seed);
   if (std::optional<std::vector<double>> gaps = args.number_list("gaps")) settings.gaps = *gaps;
 
+  const std::string inputs[] = {args.positional()[0], args.positional()[1]};
+  refuse_overwriting_input("poses", out_path, inputs);
   std::ofstream out(out_path, std::ios::binary | std::ios::trunc);
   if (!out) throw InputError(out_path + ": cannot be written: " + std::strerror(errno));
 

@@ -67,6 +67,8 @@ int query_command(std::span<const std::string> argv) {
   // Open the output first: an unwritable destination should fail before any work.
   std::ofstream out;
   if (out_path) {
+    const std::string inputs[] = {args.positional()[0], args.positional()[1], poses_path};
+    refuse_overwriting_input("query", *out_path, inputs);
     out.open(*out_path, std::ios::binary | std::ios::trunc);
     if (!out) throw InputError(*out_path + ": cannot be written: " + std::strerror(errno));
   }

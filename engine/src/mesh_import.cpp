@@ -103,7 +103,8 @@ std::vector<Instance> collect_instances(const fs::path& path, const aiScene& sce
     const Pending top = stack.back();
     stack.pop_back();
     if (top.node == nullptr) continue;
-    if (!visited.insert(top.node).second) fail(path, "node hierarchy contains a cycle");
+    if (!visited.insert(top.node).second)
+      fail(path, "node hierarchy contains a cycle or a shared node");
     const Affine X_RN = compose(top.X_RP, to_affine(top.node->mTransformation));
     for (unsigned k = 0; k < top.node->mNumMeshes; ++k) {
       const unsigned mesh = top.node->mMeshes[k];
