@@ -47,22 +47,25 @@ std::size_t AabbTree::bytes() const {
 
 class AabbPolicy {
  public:
-  struct Enc {
+  using EncA = detail::NoEnclosure;
+  struct EncB {
     Vec3 centre;  ///< B's box centre in A's frame
     Vec3 half;    ///< B's half extents along B's axes
   };
 
+  EncA enclose_a(std::uint32_t) const { return {}; }
+
   AabbPolicy(const AabbTree& a, const AabbTree& b, const Transform& X_AB)
       : a_(a), b_(b), X_AB_(X_AB), margin_(detail::query_margin(a.max_abs_, b.max_abs_, X_AB)) {}
 
-  Enc enclose_b(std::uint32_t n) const {
+  EncB enclose_b(std::uint32_t n) const {
     const AabbTree::Node& node = b_.nodes_[n];
     const Vec3 lo(node.lo[0], node.lo[1], node.lo[2]);
     const Vec3 hi(node.hi[0], node.hi[1], node.hi[2]);
     return {X_AB_.apply((lo + hi) * 0.5), (hi - lo) * 0.5};
   }
 
-  bool overlap(std::uint32_t n, const Enc& e) const {
+  bool overlap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
     const AabbTree::Node& node = a_.nodes_[n];
     const Vec3 lo(node.lo[0], node.lo[1], node.lo[2]);
     const Vec3 hi(node.hi[0], node.hi[1], node.hi[2]);
@@ -206,11 +209,14 @@ std::size_t ObbTree::bytes() const {
 
 class ObbPolicy {
  public:
-  struct Enc {
+  using EncA = detail::NoEnclosure;
+  struct EncB {
     Mat3 axes;  ///< B's box axes in A's frame
     Vec3 centre;
     Vec3 half;
   };
+
+  EncA enclose_a(std::uint32_t) const { return {}; }
 
   ObbPolicy(const ObbTree& a, const ObbTree& b, const Transform& X_AB)
       : a_(a), b_(b), X_AB_(X_AB), margin_(detail::query_margin(a.max_abs_, b.max_abs_, X_AB)) {
@@ -219,12 +225,12 @@ class ObbPolicy {
     margin_ += 0x1.0p-40 * (a.max_abs_ + b.max_abs_);
   }
 
-  Enc enclose_b(std::uint32_t n) const {
+  EncB enclose_b(std::uint32_t n) const {
     const ObbTree::Node& node = b_.nodes_[n];
     return {X_AB_.R * node.axes, X_AB_.apply(node.centre), node.half};
   }
 
-  bool overlap(std::uint32_t n, const Enc& e) const {
+  bool overlap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
     const ObbTree::Node& node = a_.nodes_[n];
     const Mat3 R = node.axes.transpose() * e.axes;
     const Vec3 T = node.axes.transpose() * (e.centre - node.centre);

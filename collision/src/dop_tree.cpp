@@ -102,34 +102,38 @@ std::size_t DopTree::bytes() const {
          links_.capacity() * sizeof(detail::NodeLink) + order_.capacity() * sizeof(std::uint32_t);
 }
 
-/// Per-query tables: for every axis i of A, the cone of B's directions that
-/// contains R^T n_i, as three weights and the bound each weight multiplies.
-class DopPolicy {
+/// Per-query table that encloses one tree's DOPs (the source) in the other
+/// tree's frame (the target): for every target axis i, the cone of source
+/// directions containing the axis seen from the source frame, as three
+/// weights and the source bounds they multiply. Built once per query; each
+/// enclosure then costs 6 multiply-adds per axis.
+class TumbleTable {
  public:
   struct Enc {
-    std::array<double, 2 * DopBasis::kMaxAxes> d;  ///< lo[axes] then hi[axes] in A's frame
+    std::array<double, 2 * DopBasis::kMaxAxes> d;  ///< lo[axes] then hi[axes] in the target frame
   };
 
-  DopPolicy(const DopTree& a, const DopTree& b, const Transform& X_AB) : a_(a), b_(b) {
-    axes_ = a.basis_.axes;
-    const Mat3 R_BA = X_AB.R.transpose();
-    const Real margin = detail::query_margin(a.max_abs_, b.max_abs_, X_AB);
+  /// M and t map source coordinates to target coordinates.
+  TumbleTable(const DopBasis& source, const DopBasis& target, const Mat3& M, const Vec3& t,
+              Real margin)
+      : axes_(target.axes) {
+    const Mat3 M_inverse = M.transpose();
     for (int i = 0; i < axes_; ++i) {
-      const Vec3& n = a.basis_.normal[i];
-      offset_[i] = n.dot(X_AB.t);
+      const Vec3& n = target.normal[i];
+      offset_[i] = n.dot(t);
       margin_[i] = margin * n.lpNorm<1>();
-      const Vec3 c = R_BA * n;  // the direction n_i seen from B's frame
+      const Vec3 c = M_inverse * n;  // the target axis seen from the source frame
       // The most interior cone: largest smallest weight.
-      const DopBasis::Cone* best = nullptr;
+      const DopBasis::Cone* best = &source.cones.front();
       Vec3 best_w = Vec3::Zero();
       Real best_min = -std::numeric_limits<Real>::infinity();
-      for (const DopBasis::Cone& cone : b.basis_.cones) {
+      for (const DopBasis::Cone& cone : source.cones) {
         const Vec3 w = cone.inverse * c;
         if (w.minCoeff() > best_min) best_min = w.minCoeff(), best = &cone, best_w = w;
       }
       for (int m = 0; m < 3; ++m) {
-        // max over B's DOP of c.y <= sum w_m * (bound of direction m); a
-        // direction -normal[j] is bounded by -lo[j].
+        // max over the source DOP of c.y <= sum w_m * (bound of direction m);
+        // a direction -normal[j] is bounded by -lo[j].
         const int dir = best->direction[m];
         const bool negative = dir >= axes_;
         const int j = negative ? dir - axes_ : dir;
@@ -141,8 +145,7 @@ class DopPolicy {
     }
   }
 
-  Enc enclose_b(std::uint32_t node) const {
-    const float* d = &b_.bounds_[node * 2 * axes_];
+  Enc enclose(const float* d) const {
     Enc e;
     for (int i = 0; i < axes_; ++i) {
       double lo = offset_[i], hi = offset_[i];
@@ -156,33 +159,65 @@ class DopPolicy {
     return e;
   }
 
-  bool overlap(std::uint32_t node, const Enc& e) const {
-    const float* d = &a_.bounds_[node * 2 * axes_];
+  /// Whether a target-frame DOP `d` overlaps an enclosure on every axis.
+  bool overlaps(const float* d, const Enc& e) const {
     for (int i = 0; i < axes_; ++i) {
       if (d[i] > e.d[axes_ + i] || e.d[i] > d[axes_ + i]) return false;
     }
     return true;
   }
 
+ private:
+  int axes_ = 0;
+  std::array<double, DopBasis::kMaxAxes> offset_{}, margin_{};
+  std::array<std::array<double, 3>, DopBasis::kMaxAxes> weight_{};
+  std::array<std::array<int, 3>, DopBasis::kMaxAxes> hi_index_{}, lo_index_{};
+};
+
+/// The DOP-tree test, made symmetric: B's DOP tumbled into A's frame against
+/// A's DOP, and A's DOP tumbled into B's frame against B's DOP. Each
+/// enclosure is computed once per node and re-used while the other tree
+/// descends; the second direction prunes elongated volumes that one
+/// direction alone lets through.
+class DopPolicy {
+ public:
+  using EncA = TumbleTable::Enc;
+  using EncB = TumbleTable::Enc;
+
+  DopPolicy(const DopTree& a, const DopTree& b, const Transform& X_AB)
+      : a_(a),
+        b_(b),
+        axes_(a.basis_.axes),
+        margin_(detail::query_margin(a.max_abs_, b.max_abs_, X_AB)),
+        b_in_a_(b.basis_, a.basis_, X_AB.R, X_AB.t, margin_),
+        a_in_b_(a.basis_, b.basis_, X_AB.R.transpose(), -(X_AB.R.transpose() * X_AB.t), margin_) {}
+
+  EncA enclose_a(std::uint32_t n) const { return a_in_b_.enclose(dop(a_, n)); }
+  EncB enclose_b(std::uint32_t n) const { return b_in_a_.enclose(dop(b_, n)); }
+
+  bool overlap(std::uint32_t a, const EncA& enc_a, std::uint32_t b, const EncB& enc_b) const {
+    return b_in_a_.overlaps(dop(a_, a), enc_b) && a_in_b_.overlaps(dop(b_, b), enc_a);
+  }
+
   detail::NodeLink link_a(std::uint32_t n) const { return a_.links_[n]; }
   detail::NodeLink link_b(std::uint32_t n) const { return b_.links_[n]; }
-  Real size_a(std::uint32_t n) const { return size(a_, n); }
-  Real size_b(std::uint32_t n) const { return size(b_, n); }
+  Real size_a(std::uint32_t n) const { return size(dop(a_, n)); }
+  Real size_b(std::uint32_t n) const { return size(dop(b_, n)); }
   const std::uint32_t* slots_a() const { return a_.order_.data(); }
   const std::uint32_t* slots_b() const { return b_.order_.data(); }
 
  private:
-  Real size(const DopTree& t, std::uint32_t n) const {
-    const float* d = &t.bounds_[n * 2 * axes_];
+  const float* dop(const DopTree& t, std::uint32_t n) const { return &t.bounds_[n * 2 * axes_]; }
+  Real size(const float* d) const {
     return (d[axes_] - d[0]) + (d[axes_ + 1] - d[1]) + (d[axes_ + 2] - d[2]);
   }
 
   const DopTree& a_;
   const DopTree& b_;
-  int axes_ = 0;
-  std::array<double, DopBasis::kMaxAxes> offset_{}, margin_{};
-  std::array<std::array<double, 3>, DopBasis::kMaxAxes> weight_{};
-  std::array<std::array<int, 3>, DopBasis::kMaxAxes> hi_index_{}, lo_index_{};
+  int axes_;
+  Real margin_;
+  TumbleTable b_in_a_;
+  TumbleTable a_in_b_;
 };
 
 CollideResult DopTree::collide(const Mesh& mesh_a, const DopTree& b, const Mesh& mesh_b,

@@ -9,27 +9,30 @@
 namespace dovetail::collision::detail {
 
 /// Policy interface:
-///   using Enc;                           B's node volume expressed in A's frame
-///   Enc enclose_b(uint32_t b) const;
-///   bool overlap(uint32_t a, const Enc&) const;
+///   using EncA, EncB;                      a node's volume expressed in the other's frame
+///   EncA enclose_a(uint32_t a) const;      (an empty struct where a test needs none)
+///   EncB enclose_b(uint32_t b) const;
+///   bool overlap(uint32_t a, const EncA&, uint32_t b, const EncB&) const;
 ///   NodeLink link_a(uint32_t), link_b(uint32_t) const;
 ///   Real size_a(uint32_t), size_b(uint32_t) const;
 ///   const uint32_t* slots_a(), *slots_b() const;  leaf slot -> triangle index
 template <typename Policy>
 class PairTraversal {
  public:
-  using Enc = typename Policy::Enc;
+  using EncA = typename Policy::EncA;
+  using EncB = typename Policy::EncB;
 
   PairTraversal(const Policy& policy, LeafTester& tester) : p_(policy), tester_(tester) {}
 
   void run() {
-    const Enc root_b = p_.enclose_b(0);
+    const EncA root_a = p_.enclose_a(0);
+    const EncB root_b = p_.enclose_b(0);
     tester_.count_volume_test();
-    if (p_.overlap(0, root_b)) visit(0, 0, root_b);
+    if (p_.overlap(0, root_a, 0, root_b)) visit(0, root_a, 0, root_b);
   }
 
  private:
-  void visit(std::uint32_t a, std::uint32_t b, const Enc& enc_b) {
+  void visit(std::uint32_t a, const EncA& enc_a, std::uint32_t b, const EncB& enc_b) {
     const NodeLink la = p_.link_a(a);
     const NodeLink lb = p_.link_b(b);
     if (la.is_leaf() && lb.is_leaf()) {
@@ -39,15 +42,16 @@ class PairTraversal {
     }
     if (!la.is_leaf() && (lb.is_leaf() || p_.size_a(a) >= p_.size_b(b))) {
       for (std::uint32_t c = la.first_child(); c < la.first_child() + 2; ++c) {
+        const EncA enc_c = p_.enclose_a(c);
         tester_.count_volume_test();
-        if (p_.overlap(c, enc_b)) visit(c, b, enc_b);
+        if (p_.overlap(c, enc_c, b, enc_b)) visit(c, enc_c, b, enc_b);
         if (tester_.done()) return;
       }
     } else {
       for (std::uint32_t c = lb.first_child(); c < lb.first_child() + 2; ++c) {
-        const Enc enc_c = p_.enclose_b(c);
+        const EncB enc_c = p_.enclose_b(c);
         tester_.count_volume_test();
-        if (p_.overlap(a, enc_c)) visit(a, c, enc_c);
+        if (p_.overlap(a, enc_a, c, enc_c)) visit(a, enc_a, c, enc_c);
         if (tester_.done()) return;
       }
     }
@@ -56,6 +60,9 @@ class PairTraversal {
   const Policy& p_;
   LeafTester& tester_;
 };
+
+/// For policies whose test needs nothing cached on A's side.
+struct NoEnclosure {};
 
 /// Separating-axis test of two boxes (Gottschalk et al., OBB-Tree, 15 axes):
 /// box A with half extents ea in its own frame, box B with half extents eb,
