@@ -240,7 +240,13 @@ class BoxtreeTraversal {
  public:
   BoxtreeTraversal(const Boxtree& a, const Boxtree& b, const Transform& X_AB,
                    detail::LeafTester& tester)
-      : a_(a), b_(b), R_AB_(X_AB.R), R_BA_(X_AB.R.transpose()), tester_(tester) {
+      : a_(a),
+        b_(b),
+        R_AB_(X_AB.R),
+        R_BA_(X_AB.R.transpose()),
+        split_AB_(R_AB_),
+        split_BA_(R_BA_),
+        tester_(tester) {
     t_AB_ = X_AB.t;
     t_BA_ = -(R_BA_ * X_AB.t);
     margin_ = detail::query_margin(a.max_abs_, b.max_abs_, X_AB);
@@ -287,23 +293,39 @@ class BoxtreeTraversal {
     return x.lo[k] <= y.hi[k] + margin_ && y.lo[k] - margin_ <= x.hi[k];
   }
 
-  /// Moves the upper face on `axis` of s's box down to `split`, updating its
-  /// enclosure with the three entries of column `axis` of M.
-  static void move_upper(Side& s, int axis, double split, const Mat3& M) {
+  /// The rotation from one tree's frame to the other's, split into its
+  /// positive and negative parts so that moving a face updates the enclosure
+  /// without branches.
+  struct SplitRotation {
+    double pos[3][3];  ///< pos[axis][i] = max(M(i, axis), 0)
+    double neg[3][3];  ///< neg[axis][i] = min(M(i, axis), 0)
+    explicit SplitRotation(const Mat3& M) {
+      for (int k = 0; k < 3; ++k) {
+        for (int i = 0; i < 3; ++i) {
+          pos[k][i] = std::max(M(i, k), 0.0);
+          neg[k][i] = std::min(M(i, k), 0.0);
+        }
+      }
+    }
+  };
+
+  /// Moves the upper face on `axis` of s's box down to `split`: the enclosure's
+  /// upper bounds drop where the axis maps positively, its lower bounds where negatively.
+  static void move_upper(Side& s, int axis, double split, const SplitRotation& M) {
     const double d = s.box.hi[axis] - split;
     s.box.hi[axis] = split;
     for (int i = 0; i < 3; ++i) {
-      const double m = M(i, axis) * d;
-      if (m > 0) s.enc.hi[i] -= m; else s.enc.lo[i] -= m;
+      s.enc.hi[i] -= M.pos[axis][i] * d;
+      s.enc.lo[i] -= M.neg[axis][i] * d;
     }
   }
 
-  static void move_lower(Side& s, int axis, double split, const Mat3& M) {
+  static void move_lower(Side& s, int axis, double split, const SplitRotation& M) {
     const double d = split - s.box.lo[axis];
     s.box.lo[axis] = split;
     for (int i = 0; i < 3; ++i) {
-      const double m = M(i, axis) * d;
-      if (m > 0) s.enc.lo[i] += m; else s.enc.hi[i] += m;
+      s.enc.lo[i] += M.pos[axis][i] * d;
+      s.enc.hi[i] += M.neg[axis][i] * d;
     }
   }
 
@@ -333,14 +355,14 @@ class BoxtreeTraversal {
     }
     const bool descend_a = !na.is_leaf() && (nb.is_leaf() || size(a.box) >= size(b.box));
     if (descend_a) {
-      descend(na, a, R_BA_, b, [&](const Side& child) { visit(child, b); });
+      descend(na, a, split_BA_, b, [&](const Side& child) { visit(child, b); });
     } else {
-      descend(nb, b, R_AB_, a, [&](const Side& child) { visit(a, child); });
+      descend(nb, b, split_AB_, a, [&](const Side& child) { visit(a, child); });
     }
   }
 
   template <typename Visit>
-  void descend(const BoxtreeNode& n, const Side& s, const Mat3& M, const Side& other,
+  void descend(const BoxtreeNode& n, const Side& s, const SplitRotation& M, const Side& other,
                Visit&& next) {
     const int axis = static_cast<int>(n.axis());
     const std::uint32_t kind = n.kind();
@@ -363,6 +385,7 @@ class BoxtreeTraversal {
   const Boxtree& a_;
   const Boxtree& b_;
   Mat3 R_AB_, R_BA_;
+  SplitRotation split_AB_, split_BA_;
   Vec3 t_AB_, t_BA_;
   double margin_ = 0;
   detail::LeafTester& tester_;

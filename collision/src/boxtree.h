@@ -19,8 +19,8 @@ namespace dovetail::collision {
 
 /// Build settings of a Boxtree.
 struct BoxtreeSettings {
-  int max_leaf_size = 2;        ///< triangles per leaf, 1..4
-  double slab_threshold = 0.3;  ///< split off an empty slab wider than this fraction of the box
+  int max_leaf_size = 4;        ///< triangles per leaf, 1..4
+  double slab_threshold = 0.1;  ///< split off an empty slab wider than this fraction of the box
   int bins = 16;                ///< candidate split positions per axis
 };
 
