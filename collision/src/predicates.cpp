@@ -127,14 +127,11 @@ int sum_expansions(const Real* e, int m, const Real* f, int n, Real* h) {
 /// (capacity 4 * kMaxE); returns the length of h.
 template <int kMaxE>
 int multiply_by_short(const Real* s, int ns, const Real* e, int ne, Real* h) {
+  if (ns == 0) return 0;
+  if (ns == 1) return scale_expansion(e, ne, s[0], h);
   Real first[2 * kMaxE];
   Real second[2 * kMaxE];
-  if (ns == 0) return 0;
   const int n_first = scale_expansion(e, ne, s[0], first);
-  if (ns == 1) {
-    for (int i = 0; i < n_first; ++i) h[i] = first[i];
-    return n_first;
-  }
   const int n_second = scale_expansion(e, ne, s[1], second);
   return sum_expansions(first, n_first, second, n_second, h);
 }
@@ -163,6 +160,93 @@ int sign_of(const Real* e, int m) {
 
 namespace detail {
 
+bool orient3d_rounding_free(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int& sign) {
+  // Every operation of the plain evaluation, checked by its exact error term.
+  Real u[3], v[3], w[3], error;
+  bool exact = true;
+  for (int k = 0; k < 3; ++k) {
+    two_diff(b[k], a[k], u[k], error);
+    exact &= error == 0;
+    two_diff(c[k], a[k], v[k], error);
+    exact &= error == 0;
+    two_diff(d[k], a[k], w[k], error);
+    exact &= error == 0;
+  }
+  Real terms[3];
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3;
+    const int j = (k + 2) % 3;
+    Real left, right, normal;
+    two_product(u[i], v[j], left, error);
+    exact &= error == 0;
+    two_product(u[j], v[i], right, error);
+    exact &= error == 0;
+    two_diff(left, right, normal, error);
+    exact &= error == 0;
+    two_product(normal, w[k], terms[k], error);
+    exact &= error == 0;
+  }
+  Real partial, det;
+  two_sum(terms[0], terms[1], partial, error);
+  exact &= error == 0;
+  two_sum(partial, terms[2], det, error);
+  exact &= error == 0;
+  sign = (det > 0) - (det < 0);
+  return exact;
+}
+
+bool orient3d_twice_precision(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
+                              int& sign) {
+  // Rounded differences u, v, w and their exact tails (u_tail etc.).
+  Real u[3], u_tail[3], v[3], v_tail[3], w[3], w_tail[3];
+  for (int k = 0; k < 3; ++k) {
+    two_diff(b[k], a[k], u[k], u_tail[k]);
+    two_diff(c[k], a[k], v[k], v_tail[k]);
+    two_diff(d[k], a[k], w[k], w_tail[k]);
+  }
+  // B = u . (v x w) as sum over k of high[k] + low[k]; first-order tail terms.
+  Real high[3], low[3], first_order[3];
+  Real perm = 0;
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3;
+    const int j = (k + 2) % 3;
+    Real p, p_error, q, q_error, minor, minor_error, term_error;
+    two_product(v[i], w[j], p, p_error);
+    two_product(v[j], w[i], q, q_error);
+    two_diff(p, q, minor, minor_error);
+    const Real minor_low = minor_error + (p_error - q_error);
+    two_product(u[k], minor, high[k], term_error);
+    low[k] = term_error + u[k] * minor_low;
+    perm = perm + std::abs(u[k]) * (std::abs(p) + std::abs(q));
+    first_order[k] = u_tail[k] * minor + u[k] * ((v_tail[i] * w[j] - v_tail[j] * w[i]) +
+                                                 (v[i] * w_tail[j] - v[j] * w_tail[i]));
+  }
+  Real s1, s1_error, s2, s2_error;
+  two_sum(high[0], high[1], s1, s1_error);
+  two_sum(s1, high[2], s2, s2_error);
+  const Real lows = (((low[0] + low[1]) + low[2]) + s1_error) + s2_error;
+  const Real tails = (first_order[0] + first_order[1]) + first_order[2];
+  const Real det = s2 + (lows + tails);
+  const Real bound = kOrient3dBoundTwice * perm;
+  if (det > bound) {
+    sign = 1;
+  } else if (det < -bound) {
+    sign = -1;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+int orient3d_adaptive(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  // Coincident points (shared vertices of mesh neighbours): zero, no arithmetic.
+  if (a == b || a == c || a == d || b == c || b == d || c == d) return 0;
+  int sign = 0;
+  if (orient3d_rounding_free(a, b, c, d, sign)) return sign;
+  if (orient3d_twice_precision(a, b, c, d, sign)) return sign;
+  return orient3d_exact(a, b, c, d);
+}
+
 int orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   // Exact differences u = b - a, v = c - a, w = d - a.
   Real u[3][kDifference], v[3][kDifference], w[3][kDifference];
@@ -188,6 +272,14 @@ int orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   Real det[kDet3];
   const int n_det = sum_expansions(partial, n_partial, terms[2], n_terms[2], det);
   return sign_of(det, n_det);
+}
+
+int orient2d_adaptive(Real ax, Real ay, Real bx, Real by, Real cx, Real cy) {
+  const bool a_is_b = ax == bx && ay == by;
+  const bool a_is_c = ax == cx && ay == cy;
+  const bool b_is_c = bx == cx && by == cy;
+  if (a_is_b || a_is_c || b_is_c) return 0;
+  return orient2d_exact(ax, ay, bx, by, cx, cy);
 }
 
 int orient2d_exact(Real ax, Real ay, Real bx, Real by, Real cx, Real cy) {

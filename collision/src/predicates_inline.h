@@ -33,6 +33,24 @@
 /// permanent |l| + |r| likewise, so kOrient2dBound = (4 + 64 eps) eps
 /// >= g4 / (1 - eps)^5 by the same argument.
 ///
+/// Twice-precision filter (orient3d_twice_precision, in predicates.cpp), the
+/// stage for inputs the first filter leaves open, such as rotated coplanar
+/// faces. With rounded differences u = fl(b - a) etc. and exact tails
+/// u' = (b - a) - u, |u'| <= eps |u|, let P = sum |u_i v_j w_k| over the six
+/// terms. Then D = B + R1 + R2, where B = det[u, v, w], R1 = det[u', v, w] +
+/// det[u, v', w] + det[u, v, w'] and |R2| <= (3 eps^2 + eps^3) P. B is
+/// formed from exact products: minor_k = (p - q) exactly as minor + minor_low
+/// up to (3 + 6 eps) eps^2 A_k (A_k = |v_i w_j| + |v_j w_i|), each term u_k
+/// minor_k as high + low up to 8.01 eps^2 |u_k| A_k, the highs summed exactly
+/// and the five lows in floating point (20.01 eps^2 P); R1 in floating point
+/// costs at most 20.01 eps^2 P (seven roundings on terms totalling 2 eps P,
+/// four on u' minor, plus |u'| |minor_k - minor| <= 2.01 eps^2 |u_k| A_k); the
+/// two final additions add 8.01 eps^2 P + eps |det|. In all
+///   |det - D| <= 59.1 eps^2 P + eps |det| / (1 - eps),
+/// and with perm >= (1 - eps)^5 P (five roundings per term),
+/// kOrient3dBoundTwice = 64 eps^2 gives |det| > bound => sign(det) = sign(D).
+/// It decides unless |D| is below about 1e-30 P.
+///
 /// TrianglePlane evaluates the same expression as orient3d, with u, v, n and
 /// na computed once per triangle, and one permanent for three points built
 /// from the componentwise maximum of their |w|: rounding is monotone, so that
@@ -47,12 +65,31 @@ namespace dovetail::collision::detail {
 inline constexpr Real kEpsilon = 0x1p-53;
 inline constexpr Real kOrient3dBound = (8.0 + 256.0 * kEpsilon) * kEpsilon;
 inline constexpr Real kOrient2dBound = (4.0 + 64.0 * kEpsilon) * kEpsilon;
+inline constexpr Real kOrient3dBoundTwice = 64.0 * kEpsilon * kEpsilon;
 
-/// Sign of det[b - a, c - a, d - a] by exact expansion arithmetic (no filter).
+/// Sign of det[b - a, c - a, d - a] by exact expansion arithmetic alone.
 int orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
-/// Sign of (b - a) x (c - a) in 2-D by exact expansion arithmetic (no filter).
+/// Sign of (b - a) x (c - a) in 2-D by exact expansion arithmetic alone.
 int orient2d_exact(Real ax, Real ay, Real bx, Real by, Real cx, Real cy);
+
+/// Stages after the first filter, cheapest first: coincident points, a
+/// rounding-free plain evaluation, the twice-precision filter, the exact
+/// evaluation. Same result as orient3d_exact.
+int orient3d_adaptive(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+/// Coincident points, then orient2d_exact.
+int orient2d_adaptive(Real ax, Real ay, Real bx, Real by, Real cx, Real cy);
+
+/// True, with the exact sign in `sign`, when the plain evaluation of
+/// orient3d_filtered commits no rounding error (small integer or grid
+/// coordinates, exactly coplanar ones included).
+bool orient3d_rounding_free(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int& sign);
+
+/// True, with the exact sign in `sign`, when the twice-precision evaluation
+/// decides (see kOrient3dBoundTwice).
+bool orient3d_twice_precision(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
+                              int& sign);
 
 /// Filtered orient3d: same result as orient3d_exact.
 inline int orient3d_filtered(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
@@ -69,7 +106,7 @@ inline int orient3d_filtered(const Vec3& a, const Vec3& b, const Vec3& c, const 
   const Real bound = kOrient3dBound * perm;
   if (det > bound) return 1;
   if (det < -bound) return -1;
-  return orient3d_exact(a, b, c, d);
+  return orient3d_adaptive(a, b, c, d);
 }
 
 /// Filtered orient2d: same result as orient2d_exact.
@@ -80,7 +117,7 @@ inline int orient2d_filtered(Real ax, Real ay, Real bx, Real by, Real cx, Real c
   const Real bound = kOrient2dBound * (std::abs(left) + std::abs(right));
   if (det > bound) return 1;
   if (det < -bound) return -1;
-  return orient2d_exact(ax, ay, bx, by, cx, cy);
+  return orient2d_adaptive(ax, ay, bx, by, cx, cy);
 }
 
 /// The supporting plane of triangle (p, q, r), prepared once for exact side
@@ -126,7 +163,7 @@ class TrianglePlane {
       } else if (det < -bound) {
         out[i] = -1;
       } else {
-        out[i] = orient3d_exact(p_, q_, r_, *points[i]);
+        out[i] = orient3d_adaptive(p_, q_, r_, *points[i]);
       }
     }
   }

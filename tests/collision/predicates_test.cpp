@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -206,6 +207,14 @@ void expect_orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Ve
   ASSERT_EQ(orient3d(a, b, c, d), expected) << a.transpose() << " | " << b.transpose() << " | "
                                             << c.transpose() << " | " << d.transpose();
   ASSERT_EQ(detail::orient3d_exact(a, b, c, d), expected);
+  ASSERT_EQ(detail::orient3d_adaptive(a, b, c, d), expected);
+  // Each intermediate stage, when it decides, decides right.
+  if (int sign; detail::orient3d_rounding_free(a, b, c, d, sign)) {
+    ASSERT_EQ(sign, expected);
+  }
+  if (int sign; detail::orient3d_twice_precision(a, b, c, d, sign)) {
+    ASSERT_EQ(sign, expected);
+  }
   int sides[3];
   // The shared bound must cover every point, not only the first one.
   detail::TrianglePlane(a, b, c).sides(a, d, c, sides);
@@ -290,6 +299,53 @@ TEST(Orient3d, NearlyCoplanarPointsMatchReference) {
     expect_orient3d_exact(a, b, c, d);
     if (HasFatalFailure()) return;
   }
+}
+
+TEST(Orient3d, RotatedCoplanarPointsAreDecidedByTwicePrecision) {
+  // Exactly coplanar grid points, then rotated: the rounded points are off
+  // the plane by about one ulp, too close for the first filter.
+  Random random(19);
+  int first_filter_open = 0;
+  int twice_decided = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 e1 = random.grid_point(5), e2 = random.grid_point(5), o = random.grid_point(100);
+    const auto at = [&] {
+      return o + Real(random.integer(-9, 9)) * e1 + Real(random.integer(-9, 9)) * e2;
+    };
+    const Vec3 p[4] = {at(), at(), at(), at()};
+    const Real angle = random.uniform(0, 6.283185307179586);
+    const Vec3 axis = Vec3(random.uniform(-1, 1), random.uniform(-1, 1), 1).normalized();
+    const Mat3 R = Eigen::AngleAxis<Real>(angle, axis).toRotationMatrix();
+    const Vec3 a = R * p[0], b = R * p[1], c = R * p[2], d = R * p[3];
+    expect_orient3d_exact(a, b, c, d);
+    if (HasFatalFailure()) return;
+    const Vec3 u = b - a, v = c - a, w = d - a;
+    const Real det = u.cross(v).dot(w);
+    const Real perm = (u.cwiseAbs().cross(v.cwiseAbs())).cwiseAbs().dot(w.cwiseAbs());
+    if (std::abs(det) <= 8 * detail::kEpsilon * perm * 4) {
+      ++first_filter_open;
+      int sign;
+      twice_decided += detail::orient3d_twice_precision(a, b, c, d, sign);
+    }
+  }
+  // The family is hard for the first filter and the second one settles it.
+  EXPECT_GT(first_filter_open, 5000);
+  EXPECT_GT(twice_decided, first_filter_open * 9 / 10);
+}
+
+TEST(Orient3d, RoundingFreeStageDecidesSmallGrids) {
+  Random random(20);
+  for (int i = 0; i < 5000; ++i) {
+    const Vec3 a = random.grid_point(1000), b = random.grid_point(1000),
+               c = random.grid_point(1000), d = random.grid_point(1000);
+    int sign;
+    ASSERT_TRUE(detail::orient3d_rounding_free(a, b, c, d, sign));
+    ASSERT_EQ(sign, reference_orient3d(a, b, c, d));
+  }
+  // A product that needs more than 53 bits is not rounding-free.
+  int sign;
+  EXPECT_FALSE(detail::orient3d_rounding_free(Vec3(0, 0, 0), Vec3(0x1p30 + 1, 0, 0),
+                                              Vec3(0, 0x1p30 + 1, 0), Vec3(0, 0, 1), sign));
 }
 
 TEST(Orient3d, SliverAndFarOffsetInputsMatchReference) {
