@@ -3,12 +3,13 @@
 // distributions. Prints ns per test as the median of 5 runs, and how often the
 // plain test disagrees with the exact one.
 //
-// Build from the repository root (see docs/triangle-test.md):
+// Built as the `tri_tri_bench` target with DOVETAIL_BUILD_BENCH=ON, or alone
+// from the repository root:
 //   g++ -O3 -DNDEBUG -std=c++20 -ffp-contract=off -I collision/include
 //       -I /usr/include/eigen3 bench/tri_tri_bench.cpp collision/src/predicates.cpp
 //       collision/src/tri_tri.cpp -o tri_tri_bench
+// An optional argument runs only the workloads whose name contains it.
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -228,7 +229,6 @@ double median_of_5(const std::vector<Pair>& pairs, bool (*test)(const Tri&, cons
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Optional argument: run only the workloads whose name contains it.
   const std::string only = argc > 1 ? argv[1] : "";
   constexpr int kPairs = 1 << 16;
   std::printf("%-36s %12s %12s %9s %9s %12s\n", "workload", "exact ns", "plain ns", "ratio", "hits",

@@ -161,7 +161,8 @@ int sign_of(const Real* e, int m) {
 namespace detail {
 
 bool orient3d_rounding_free(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int& sign) {
-  // Every operation of the plain evaluation, checked by its exact error term.
+  // Every operation of the plain evaluation, checked by its exact error term;
+  // gives up at the first level that rounds.
   Real u[3], v[3], w[3], error;
   bool exact = true;
   for (int k = 0; k < 3; ++k) {
@@ -172,18 +173,23 @@ bool orient3d_rounding_free(const Vec3& a, const Vec3& b, const Vec3& c, const V
     two_diff(d[k], a[k], w[k], error);
     exact &= error == 0;
   }
-  Real terms[3];
+  if (!exact) return false;
+  Real normal[3];
   for (int k = 0; k < 3; ++k) {
     const int i = (k + 1) % 3;
     const int j = (k + 2) % 3;
-    Real left, right, normal;
+    Real left, right;
     two_product(u[i], v[j], left, error);
     exact &= error == 0;
     two_product(u[j], v[i], right, error);
     exact &= error == 0;
-    two_diff(left, right, normal, error);
+    two_diff(left, right, normal[k], error);
     exact &= error == 0;
-    two_product(normal, w[k], terms[k], error);
+  }
+  if (!exact) return false;
+  Real terms[3];
+  for (int k = 0; k < 3; ++k) {
+    two_product(normal[k], w[k], terms[k], error);
     exact &= error == 0;
   }
   Real partial, det;

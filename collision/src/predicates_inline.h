@@ -48,8 +48,9 @@
 /// two final additions add 8.01 eps^2 P + eps |det|. In all
 ///   |det - D| <= 59.1 eps^2 P + eps |det| / (1 - eps),
 /// and with perm >= (1 - eps)^5 P (five roundings per term),
-/// kOrient3dBoundTwice = 64 eps^2 gives |det| > bound => sign(det) = sign(D).
-/// It decides unless |D| is below about 1e-30 P.
+/// kOrient3dBoundTwice = 64 eps^2 gives |det| > bound => sign(det) = sign(D)
+/// (a subnormal bound is handled as above). It decides unless |D| is below
+/// about 1e-30 P.
 ///
 /// TrianglePlane evaluates the same expression as orient3d, with u, v, n and
 /// na computed once per triangle, and one permanent for three points built
@@ -145,26 +146,22 @@ class TrianglePlane {
   /// Exact signs of orient3d(p, q, r, x) for x = a, b, c, written to `out`.
   void sides(const Vec3& a, const Vec3& b, const Vec3& c, int out[3]) const {
     const Vec3* const points[3] = {&a, &b, &c};
-    Real w[3][3];
+    Real det[3];
     Real w_max[3] = {0, 0, 0};
     for (int i = 0; i < 3; ++i) {
-      for (int k = 0; k < 3; ++k) {
-        w[i][k] = (*points[i])[k] - p_[k];
-        const Real w_abs = std::abs(w[i][k]);
-        w_max[k] = w_abs > w_max[k] ? w_abs : w_max[k];
-      }
+      const Real wx = (*points[i]).x() - p_.x();
+      const Real wy = (*points[i]).y() - p_.y();
+      const Real wz = (*points[i]).z() - p_.z();
+      det[i] = (n_[0] * wx + n_[1] * wy) + n_[2] * wz;
+      w_max[0] = std::abs(wx) > w_max[0] ? std::abs(wx) : w_max[0];
+      w_max[1] = std::abs(wy) > w_max[1] ? std::abs(wy) : w_max[1];
+      w_max[2] = std::abs(wz) > w_max[2] ? std::abs(wz) : w_max[2];
     }
     const Real perm = (n_abs_[0] * w_max[0] + n_abs_[1] * w_max[1]) + n_abs_[2] * w_max[2];
     const Real bound = kOrient3dBound * perm;
+    for (int i = 0; i < 3; ++i) out[i] = (det[i] > bound) - (det[i] < -bound);
     for (int i = 0; i < 3; ++i) {
-      const Real det = (n_[0] * w[i][0] + n_[1] * w[i][1]) + n_[2] * w[i][2];
-      if (det > bound) {
-        out[i] = 1;
-      } else if (det < -bound) {
-        out[i] = -1;
-      } else {
-        out[i] = orient3d_adaptive(p_, q_, r_, *points[i]);
-      }
+      if (out[i] == 0) out[i] = orient3d_adaptive(p_, q_, r_, *points[i]);
     }
   }
 

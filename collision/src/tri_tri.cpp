@@ -140,19 +140,18 @@ bool triangles_intersect(const Vec3& p1, const Vec3& q1, const Vec3& r1, const V
   detail::TrianglePlane(p2, q2, r2).sides(p1, q1, r1, s1.data());
   if (strictly_one_side(s1)) return false;
 
-  // Sides of T2's vertices against T1's plane; the same rejection.
+  // T1 in T2's plane: both in one plane (T2 being non-degenerate).
   const detail::TrianglePlane plane1(p1, q1, r1);
+  Triangle t1 = {&p1, &q1, &r1};
+  Triangle t2 = {&p2, &q2, &r2};
+  if (all_on_plane(s1)) return coplanar_triangles_intersect(t1, t2, plane1.approximate_normal());
+
+  // Sides of T2's vertices against T1's plane; the same rejection.
   Signs s2;
   plane1.sides(p2, q2, r2, s2.data());
   if (strictly_one_side(s2)) return false;
-
-  Triangle t1 = {&p1, &q1, &r1};
-  Triangle t2 = {&p2, &q2, &r2};
-
-  // Both in one plane (for degenerate input, one sign triple may vanish alone).
-  if (all_on_plane(s1) || all_on_plane(s2)) {
-    return coplanar_triangles_intersect(t1, t2, plane1.approximate_normal());
-  }
+  // Only a degenerate T1 gets here with all of T2 on its plane.
+  if (all_on_plane(s2)) return coplanar_triangles_intersect(t1, t2, plane1.approximate_normal());
 
   // Canonical T1: apex first, on the positive side of T2's plane.
   const Apex apex1 = find_apex(s1);

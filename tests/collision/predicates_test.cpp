@@ -348,6 +348,33 @@ TEST(Orient3d, RoundingFreeStageDecidesSmallGrids) {
                                               Vec3(0, 0x1p30 + 1, 0), Vec3(0, 0, 1), sign));
 }
 
+TEST(Orient3d, PlaneSidesShareOneBoundForAllThreePoints) {
+  // Planes facing each axis; the near-plane point comes after a vertex, whose
+  // w = 0 must not shrink the bound shared by the three points.
+  Random random(22);
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int i = 0; i < 3000; ++i) {
+      auto on_plane = [&](Real height) {
+        Vec3 p;
+        p[axis] = height;
+        p[(axis + 1) % 3] = random.uniform(-1, 1);
+        p[(axis + 2) % 3] = random.uniform(-1, 1);
+        return p;
+      };
+      const Vec3 a = on_plane(0.5), b = on_plane(0.5 + random.uniform(-1e-3, 1e-3)),
+                 c = on_plane(0.5 + random.uniform(-1e-3, 1e-3));
+      const Real s = random.uniform(-1, 2), t = random.uniform(-1, 2);
+      const Vec3 d = nudge(random, a + s * (b - a) + t * (c - a), 2);
+      const int expected = reference_orient3d(a, b, c, d);
+      int sides[3];
+      detail::TrianglePlane(a, b, c).sides(a, d, b, sides);
+      ASSERT_EQ(sides[1], expected) << "axis " << axis << " case " << i;
+      detail::TrianglePlane(a, b, c).sides(c, b, d, sides);
+      ASSERT_EQ(sides[2], expected) << "axis " << axis << " case " << i;
+    }
+  }
+}
+
 TEST(Orient3d, SliverAndFarOffsetInputsMatchReference) {
   Random random(15);
   for (int i = 0; i < 5000; ++i) {
