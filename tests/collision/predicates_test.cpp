@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "../../collision/src/predicates_inline.h"
+#include "predicates_inline.h"
 
 namespace dovetail::collision {
 namespace {
