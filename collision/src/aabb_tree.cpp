@@ -232,9 +232,8 @@ class ObbPolicy {
 
   bool overlap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
     const ObbTree::Node& node = a_.nodes_[n];
-    const Mat3 R = node.axes.transpose() * e.axes;
-    const Vec3 T = node.axes.transpose() * (e.centre - node.centre);
-    return detail::boxes_overlap(R, T, node.half, e.half, margin_);
+    return detail::oriented_boxes_overlap(node.axes, node.centre, node.half, e.axes, e.centre,
+                                          e.half, margin_);
   }
 
   detail::NodeLink link_a(std::uint32_t n) const { return a_.nodes_[n].link; }

@@ -64,21 +64,11 @@ class PairTraversal {
 /// For policies whose test needs nothing cached on A's side.
 struct NoEnclosure {};
 
-/// Separating-axis test of two boxes (Gottschalk et al., OBB-Tree, 15 axes):
-/// box A with half extents ea in its own frame, box B with half extents eb,
-/// axes the columns of R and centre T, both in A's frame. `margin` widens
-/// every projected radius so that rounding never separates touching boxes.
-inline bool boxes_overlap(const Mat3& R, const Vec3& T, const Vec3& ea, const Vec3& eb,
-                          Real margin) {
-  Mat3 absR;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) absR(i, j) = std::abs(R(i, j));
-  }
-  // A's face axes.
-  for (int i = 0; i < 3; ++i) {
-    const Real rb = absR(i, 0) * eb[0] + absR(i, 1) * eb[1] + absR(i, 2) * eb[2];
-    if (std::abs(T[i]) > ea[i] + rb + margin) return false;
-  }
+/// The twelve separating axes after A's faces: B's face axes and the nine
+/// edge-edge axes A_i x B_j (R: B's axes in A's frame, absR = |R|, T: B's
+/// centre in A's frame).
+inline bool boxes_overlap_remaining_axes(const Mat3& R, const Mat3& absR, const Vec3& T,
+                                         const Vec3& ea, const Vec3& eb, Real margin) {
   // B's face axes.
   for (int j = 0; j < 3; ++j) {
     const Real ra = absR(0, j) * ea[0] + absR(1, j) * ea[1] + absR(2, j) * ea[2];
@@ -97,6 +87,47 @@ inline bool boxes_overlap(const Mat3& R, const Vec3& T, const Vec3& ea, const Ve
     }
   }
   return true;
+}
+
+/// Separating-axis test of two boxes (Gottschalk et al., OBB-Tree, 15 axes):
+/// box A with half extents ea in its own frame, box B with half extents eb,
+/// axes the columns of R and centre T, both in A's frame. `margin` widens
+/// every projected radius so that rounding never separates touching boxes.
+inline bool boxes_overlap(const Mat3& R, const Vec3& T, const Vec3& ea, const Vec3& eb,
+                          Real margin) {
+  Mat3 absR;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) absR(i, j) = std::abs(R(i, j));
+  }
+  // A's face axes.
+  for (int i = 0; i < 3; ++i) {
+    const Real rb = absR(i, 0) * eb[0] + absR(i, 1) * eb[1] + absR(i, 2) * eb[2];
+    if (std::abs(T[i]) > ea[i] + rb + margin) return false;
+  }
+  return boxes_overlap_remaining_axes(R, absR, T, ea, eb, margin);
+}
+
+/// boxes_overlap for two boxes given by their axes (columns), centres and
+/// half extents, all in one frame. The relative rotation is built row by row
+/// while A's face axes are tested, so a rejection on one of those three axes
+/// (the common case) skips most of its cost.
+inline bool oriented_boxes_overlap(const Mat3& axes_a, const Vec3& centre_a, const Vec3& ea,
+                                   const Mat3& axes_b, const Vec3& centre_b, const Vec3& eb,
+                                   Real margin) {
+  const Vec3 d = centre_b - centre_a;
+  Mat3 R, absR;
+  Vec3 T;
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 a = axes_a.col(i);
+    for (int j = 0; j < 3; ++j) {
+      R(i, j) = a.dot(axes_b.col(j));
+      absR(i, j) = std::abs(R(i, j));
+    }
+    T[i] = a.dot(d);
+    const Real rb = absR(i, 0) * eb[0] + absR(i, 1) * eb[1] + absR(i, 2) * eb[2];
+    if (std::abs(T[i]) > ea[i] + rb + margin) return false;
+  }
+  return boxes_overlap_remaining_axes(R, absR, T, ea, eb, margin);
 }
 
 }  // namespace dovetail::collision::detail
