@@ -100,6 +100,15 @@ CollideResult AabbTree::collide(const Mesh& mesh_a, const AabbTree& b, const Mes
   return result;
 }
 
+CollideResult AabbTree::collide_parallel(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
+                                   const Transform& X_AB, const CollideRequest& request,
+                                   TaskSystem& tasks) const {
+  const AabbPolicy policy(*this, b, X_AB);
+  return detail::collide_in_parallel(mesh_a, mesh_b, X_AB, request, tasks, [&](detail::LeafTester& t) {
+    return detail::PairTraversal<AabbPolicy>(policy, t);
+  });
+}
+
 // ----------------------------------------------------------------- OBB tree
 
 namespace {
@@ -258,6 +267,15 @@ CollideResult ObbTree::collide(const Mesh& mesh_a, const ObbTree& b, const Mesh&
   detail::PairTraversal<ObbPolicy>(policy, tester).run();
   tester.finish();
   return result;
+}
+
+CollideResult ObbTree::collide_parallel(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
+                                   const Transform& X_AB, const CollideRequest& request,
+                                   TaskSystem& tasks) const {
+  const ObbPolicy policy(*this, b, X_AB);
+  return detail::collide_in_parallel(mesh_a, mesh_b, X_AB, request, tasks, [&](detail::LeafTester& t) {
+    return detail::PairTraversal<ObbPolicy>(policy, t);
+  });
 }
 
 }  // namespace dovetail::collision

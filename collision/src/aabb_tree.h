@@ -10,6 +10,7 @@
 #include "binary_layout.h"
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/mesh.h"
+#include "dovetail/collision/task_system.h"
 
 namespace dovetail::collision {
 
@@ -20,6 +21,9 @@ class AabbTree {
 
   CollideResult collide(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
                         const Transform& X_AB, const CollideRequest& request) const;
+  CollideResult collide_parallel(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
+                                 const Transform& X_AB, const CollideRequest& request,
+                                 TaskSystem& tasks) const;
 
   std::size_t node_count() const { return nodes_.size(); }
   std::size_t leaf_count() const { return leaves_; }
@@ -47,6 +51,9 @@ class ObbTree {
 
   CollideResult collide(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
                         const Transform& X_AB, const CollideRequest& request) const;
+  CollideResult collide_parallel(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
+                                 const Transform& X_AB, const CollideRequest& request,
+                                 TaskSystem& tasks) const;
 
   std::size_t node_count() const { return nodes_.size(); }
   std::size_t leaf_count() const { return leaves_; }

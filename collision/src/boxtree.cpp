@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <deque>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -252,17 +253,6 @@ class BoxtreeTraversal {
     margin_ = detail::query_margin(a.max_abs_, b.max_abs_, X_AB);
   }
 
-  void run() {
-    Side a = root(a_, R_BA_, t_BA_);
-    Side b = root(b_, R_AB_, t_AB_);
-    tester_.count_volume_test();
-    for (int k = 0; k < 3; ++k) {
-      if (!overlap(a.box, b.enc, k) || !overlap(b.box, a.enc, k)) return;
-    }
-    visit(a, b);
-  }
-
- private:
   /// One tree's current node: its box in its own frame and the enclosure of
   /// that box in the other tree's frame.
   struct Side {
@@ -270,6 +260,59 @@ class BoxtreeTraversal {
     Box box;
     Box enc;
   };
+  /// A pair of overlapping nodes.
+  struct Entry {
+    Side a;
+    Side b;
+  };
+
+  void run() {
+    const Entry e = root_entry();
+    if (roots_overlap(e)) visit(e.a, e.b);
+  }
+
+  /// Overlapping node pairs breadth-first from the roots, until there are at
+  /// least `target` or only leaf pairs remain.
+  std::vector<Entry> frontier(std::size_t target) {
+    std::deque<Entry> queue;
+    const Entry root = root_entry();
+    if (roots_overlap(root)) queue.push_back(root);
+    for (std::size_t leaf_pairs = 0; queue.size() < target && leaf_pairs < queue.size();) {
+      const Entry e = queue.front();
+      queue.pop_front();
+      const BoxtreeNode& na = a_.nodes_[e.a.node];
+      const BoxtreeNode& nb = b_.nodes_[e.b.node];
+      if (na.is_leaf() && nb.is_leaf()) {
+        queue.push_back(e);
+        ++leaf_pairs;
+        continue;
+      }
+      leaf_pairs = 0;
+      if (descends_a(na, nb, e.a, e.b)) {
+        descend(na, e.a, split_BA_, e.b, [&](const Side& child) { queue.push_back({child, e.b}); });
+      } else {
+        descend(nb, e.b, split_AB_, e.a, [&](const Side& child) { queue.push_back({e.a, child}); });
+      }
+    }
+    return {queue.begin(), queue.end()};
+  }
+
+  void run_from(const Entry& e) { visit(e.a, e.b); }
+
+ private:
+  Entry root_entry() const { return {root(a_, R_BA_, t_BA_), root(b_, R_AB_, t_AB_)}; }
+
+  bool roots_overlap(const Entry& e) const {
+    tester_.count_volume_test();
+    for (int k = 0; k < 3; ++k) {
+      if (!overlap(e.a.box, e.b.enc, k) || !overlap(e.b.box, e.a.enc, k)) return false;
+    }
+    return true;
+  }
+
+  static bool descends_a(const BoxtreeNode& na, const BoxtreeNode& nb, const Side& a, const Side& b) {
+    return !na.is_leaf() && (nb.is_leaf() || size(a.box) >= size(b.box));
+  }
 
   static Side root(const Boxtree& tree, const Mat3& M, const Vec3& t) {
     Side s;
@@ -353,8 +396,7 @@ class BoxtreeTraversal {
                           nb.leaf_count());
       return;
     }
-    const bool descend_a = !na.is_leaf() && (nb.is_leaf() || size(a.box) >= size(b.box));
-    if (descend_a) {
+    if (descends_a(na, nb, a, b)) {
       descend(na, a, split_BA_, b, [&](const Side& child) { visit(child, b); });
     } else {
       descend(nb, b, split_AB_, a, [&](const Side& child) { visit(a, child); });
@@ -390,6 +432,14 @@ class BoxtreeTraversal {
   double margin_ = 0;
   detail::LeafTester& tester_;
 };
+
+CollideResult Boxtree::collide_parallel(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,
+                                        const Transform& X_AB, const CollideRequest& request,
+                                        TaskSystem& tasks) const {
+  return detail::collide_in_parallel(mesh_a, mesh_b, X_AB, request, tasks, [&](detail::LeafTester& t) {
+    return BoxtreeTraversal(*this, b, X_AB, t);
+  });
+}
 
 CollideResult Boxtree::collide(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,
                                const Transform& X_AB, const CollideRequest& request) const {

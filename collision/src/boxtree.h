@@ -14,6 +14,7 @@
 
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/mesh.h"
+#include "dovetail/collision/task_system.h"
 
 namespace dovetail::collision {
 
@@ -55,6 +56,12 @@ class Boxtree {
   /// Query with this tree over `mesh_a` as A and `b` over `mesh_b` as B.
   CollideResult collide(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,
                         const Transform& X_AB, const CollideRequest& request) const;
+
+  /// The same query split into independent parts run on `tasks` (see
+  /// detail::collide_in_parallel for what is identical to collide()).
+  CollideResult collide_parallel(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,
+                                 const Transform& X_AB, const CollideRequest& request,
+                                 TaskSystem& tasks) const;
 
   std::size_t node_count() const { return nodes_.size(); }
   std::size_t leaf_count() const { return leaves_; }

@@ -5,8 +5,13 @@
 
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/mesh.h"
+#include "dovetail/collision/task_system.h"
 
 namespace dovetail::collision {
+
+namespace detail {
+class LeafTester;
+}
 
 /// Exhaustive reference. Each pair is first compared by the exact bounding
 /// boxes of the two triangles (computed from the same transformed vertices the
@@ -19,9 +24,19 @@ class BruteForce {
   CollideResult collide(const Mesh& mesh_a, const BruteForce& b, const Mesh& mesh_b,
                         const Transform& X_AB, const CollideRequest& request) const;
 
+  /// The same query split into independent parts run on `tasks` (see
+  /// detail::collide_in_parallel for what is identical to collide()).
+  CollideResult collide_parallel(const Mesh& mesh_a, const BruteForce& b, const Mesh& mesh_b,
+                                 const Transform& X_AB, const CollideRequest& request,
+                                 TaskSystem& tasks) const;
+
   std::size_t bytes() const;
 
  private:
+  /// Rows [begin, end) of A against every triangle of B (`transformed`: B in A's frame).
+  void test_rows(std::uint32_t begin, std::uint32_t end, const Mesh& mesh_b, const void* transformed,
+                 detail::LeafTester& tester) const;
+
   std::vector<Vec3> lo_, hi_;  ///< per-triangle bounds in the mesh's own frame
 };
 

@@ -232,3 +232,17 @@ CollideResult DopTree::collide(const Mesh& mesh_a, const DopTree& b, const Mesh&
 }
 
 }  // namespace dovetail::collision
+
+namespace dovetail::collision {
+
+CollideResult DopTree::collide_parallel(const Mesh& mesh_a, const DopTree& b, const Mesh& mesh_b,
+                                        const Transform& X_AB, const CollideRequest& request,
+                                        TaskSystem& tasks) const {
+  if (b.k() != k()) throw std::invalid_argument("DOP-tree: both trees need the same k");
+  const DopPolicy policy(*this, b, X_AB);
+  return detail::collide_in_parallel(mesh_a, mesh_b, X_AB, request, tasks, [&](detail::LeafTester& t) {
+    return detail::PairTraversal<DopPolicy>(policy, t);
+  });
+}
+
+}  // namespace dovetail::collision

@@ -11,6 +11,7 @@
 
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/mesh.h"
+#include "dovetail/collision/task_system.h"
 #include "dovetail/collision/tri_tri.h"
 
 namespace dovetail::collision::detail {
@@ -138,5 +139,48 @@ class LeafTester {
   bool done_ = false;
   CollideResult& result_;
 };
+
+/// Folds the results of a query's independent parts into `result`: sorted
+/// pairs, or for a first-hit query the smallest first hit.
+inline void merge_parts(CollideResult& result, const std::vector<CollideResult>& parts,
+                        const CollideRequest& request) {
+  for (const CollideResult& part : parts) {
+    result.colliding = result.colliding || part.colliding;
+    result.stats.volume_tests += part.stats.volume_tests;
+    result.stats.triangle_tests += part.stats.triangle_tests;
+    result.pairs.insert(result.pairs.end(), part.pairs.begin(), part.pairs.end());
+  }
+  std::sort(result.pairs.begin(), result.pairs.end());
+  if (!request.all_pairs && result.pairs.size() > 1) result.pairs.resize(1);
+}
+
+/// Node pairs a fine-grained parallel query is split into: fixed, not tied
+/// to the thread count, so the result is the same for any number of threads.
+inline constexpr std::size_t kFrontierTarget = 64;
+
+/// Runs one query as independent sub-traversals. `make(tester)` gives a
+/// traversal over the pair that reports to `tester`, with
+/// `frontier(target)`, a breadth-first expansion of the overlapping node
+/// pairs near the roots, and `run_from(entry)`. For all-pairs queries the
+/// result equals the serial one (the set of node pairs visited does not
+/// depend on the order); for first-hit queries the reported pair is the
+/// smallest of the sub-traversals' first hits.
+template <typename MakeTraversal>
+CollideResult collide_in_parallel(const Mesh& a, const Mesh& b, const Transform& X_AB,
+                                  const CollideRequest& request, TaskSystem& tasks,
+                                  MakeTraversal&& make) {
+  CollideResult result;
+  LeafTester head(a, b, X_AB, request.all_pairs, result);
+  const auto entries = make(head).frontier(kFrontierTarget);
+  std::vector<CollideResult> parts(entries.size());
+  tasks.parallel_for(entries.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      LeafTester tester(a, b, X_AB, request.all_pairs, parts[i]);
+      make(tester).run_from(entries[i]);
+    }
+  });
+  merge_parts(result, parts, request);
+  return result;
+}
 
 }  // namespace dovetail::collision::detail

@@ -42,14 +42,23 @@ class StructureModel final : public CollisionModel {
     return info;
   }
 
-  CollideResult collide(const CollisionModel& b, const Transform& X_AB,
-                        const CollideRequest& request) const override {
+  const StructureModel& same_method(const CollisionModel& b) const {
     if (b.method() != method()) {
       throw std::invalid_argument("collide: models of methods " + std::string(method_name(method())) +
                                   " and " + std::string(method_name(b.method())) + " cannot be paired");
     }
-    const auto& other = static_cast<const StructureModel&>(b);
-    return structure_.collide(mesh(), other.structure_, b.mesh(), X_AB, request);
+    return static_cast<const StructureModel&>(b);
+  }
+
+  CollideResult collide(const CollisionModel& b, const Transform& X_AB,
+                        const CollideRequest& request) const override {
+    return structure_.collide(mesh(), same_method(b).structure_, b.mesh(), X_AB, request);
+  }
+
+  CollideResult collide_parallel(const CollisionModel& b, const Transform& X_AB,
+                                 const CollideRequest& request, TaskSystem& tasks) const override {
+    return structure_.collide_parallel(mesh(), same_method(b).structure_, b.mesh(), X_AB, request,
+                                       tasks);
   }
 
  private:

@@ -3,6 +3,9 @@
 // volume test tree). B's volume is brought into A's frame once per B node
 // (the policy's Enc) and re-used while A descends; the larger node descends.
 
+#include <deque>
+#include <vector>
+
 #include "binary_layout.h"
 #include "hierarchy_common.h"
 
@@ -24,14 +27,69 @@ class PairTraversal {
 
   PairTraversal(const Policy& policy, LeafTester& tester) : p_(policy), tester_(tester) {}
 
+  /// A pair of overlapping nodes with their enclosures.
+  struct Entry {
+    std::uint32_t a;
+    EncA enc_a;
+    std::uint32_t b;
+    EncB enc_b;
+  };
+
   void run() {
-    const EncA root_a = p_.enclose_a(0);
-    const EncB root_b = p_.enclose_b(0);
-    tester_.count_volume_test();
-    if (p_.overlap(0, root_a, 0, root_b)) visit(0, root_a, 0, root_b);
+    const Entry root = root_entry();
+    if (overlapping(root)) visit(root.a, root.enc_a, root.b, root.enc_b);
   }
 
+  /// Overlapping node pairs breadth-first from the roots, until there are at
+  /// least `target` or only leaf pairs remain.
+  std::vector<Entry> frontier(std::size_t target) {
+    std::deque<Entry> queue;
+    const Entry root = root_entry();
+    if (overlapping(root)) queue.push_back(root);
+    for (std::size_t leaf_pairs = 0; queue.size() < target && leaf_pairs < queue.size();) {
+      const Entry e = queue.front();
+      queue.pop_front();
+      if (p_.link_a(e.a).is_leaf() && p_.link_b(e.b).is_leaf()) {
+        queue.push_back(e);
+        ++leaf_pairs;
+        continue;
+      }
+      leaf_pairs = 0;
+      children(e, [&](const Entry& c) { queue.push_back(c); });
+    }
+    return {queue.begin(), queue.end()};
+  }
+
+  void run_from(const Entry& e) { visit(e.a, e.enc_a, e.b, e.enc_b); }
+
  private:
+  Entry root_entry() const { return {0, p_.enclose_a(0), 0, p_.enclose_b(0)}; }
+
+  bool overlapping(const Entry& e) {
+    tester_.count_volume_test();
+    return p_.overlap(e.a, e.enc_a, e.b, e.enc_b);
+  }
+
+  /// Calls next(child entry) for every overlapping child pair of a non-leaf pair.
+  template <typename Next>
+  void children(const Entry& e, Next&& next) {
+    const NodeLink la = p_.link_a(e.a);
+    const NodeLink lb = p_.link_b(e.b);
+    if (!la.is_leaf() && (lb.is_leaf() || p_.size_a(e.a) >= p_.size_b(e.b))) {
+      for (std::uint32_t c = la.first_child(); c < la.first_child() + 2; ++c) {
+        const Entry child{c, p_.enclose_a(c), e.b, e.enc_b};
+        if (overlapping(child)) next(child);
+        if (tester_.done()) return;
+      }
+    } else {
+      for (std::uint32_t c = lb.first_child(); c < lb.first_child() + 2; ++c) {
+        const Entry child{e.a, e.enc_a, c, p_.enclose_b(c)};
+        if (overlapping(child)) next(child);
+        if (tester_.done()) return;
+      }
+    }
+  }
+
   void visit(std::uint32_t a, const EncA& enc_a, std::uint32_t b, const EncB& enc_b) {
     const NodeLink la = p_.link_a(a);
     const NodeLink lb = p_.link_b(b);

@@ -14,6 +14,7 @@
 #include "dovetail/collision/model.h"
 #include "dovetail/collision/pose_sampling.h"
 #include "dovetail/collision/primitives.h"
+#include "dovetail/collision/task_system.h"
 
 namespace dovetail::collision {
 namespace {
@@ -249,6 +250,43 @@ TEST(Hierarchies, RepeatedQueriesAreIdentical) {
       EXPECT_EQ(r1.stats.volume_tests, r2.stats.volume_tests);
       EXPECT_EQ(r1.stats.triangle_tests, r2.stats.triangle_tests);
     }
+  }
+}
+
+}  // namespace
+}  // namespace dovetail::collision
+
+namespace dovetail::collision {
+namespace {
+
+TEST(Hierarchies, ParallelQueriesEqualSerialAtAnyThreadCount) {
+  const auto a = share(make_sphere(0.6, 3));
+  const auto b = share(make_torus(0.7, 0.25, 48, 24));
+  const std::vector<Transform> poses = random_poses(40, 0.8, 71);
+  const auto serial = make_task_system(1);
+  const auto two = make_task_system(2);
+  const auto eight = make_task_system(8);
+  for (Method m : all_methods()) {
+    const auto ma = build_model(m, a);
+    const auto mb = build_model(m, b);
+    int colliding = 0;
+    for (const Transform& X : poses) {
+      const CollideResult reference = ma->collide(*mb, X, {.all_pairs = true});
+      colliding += reference.colliding;
+      for (TaskSystem* tasks : {serial.get(), two.get(), eight.get()}) {
+        const CollideResult all = ma->collide_parallel(*mb, X, {.all_pairs = true}, *tasks);
+        EXPECT_EQ(all.pairs, reference.pairs) << method_name(m);
+        EXPECT_EQ(all.stats.volume_tests, reference.stats.volume_tests) << method_name(m);
+        EXPECT_EQ(all.stats.triangle_tests, reference.stats.triangle_tests) << method_name(m);
+        const CollideResult first = ma->collide_parallel(*mb, X, {}, *tasks);
+        EXPECT_EQ(first.colliding, reference.colliding) << method_name(m);
+        const CollideResult first_serial = ma->collide_parallel(*mb, X, {}, *serial);
+        EXPECT_EQ(first.pairs, first_serial.pairs) << method_name(m);
+        EXPECT_EQ(first.stats.volume_tests, first_serial.stats.volume_tests) << method_name(m);
+      }
+    }
+    EXPECT_GT(colliding, 5) << method_name(m);
+    EXPECT_LT(colliding, 38) << method_name(m);
   }
 }
 

@@ -15,6 +15,7 @@
 
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/mesh.h"
+#include "dovetail/collision/task_system.h"
 #include "dovetail/collision/types.h"
 
 namespace dovetail::collision {
@@ -54,6 +55,15 @@ class CollisionModel {
   /// A's frame. Throws std::invalid_argument when b was built for another Method.
   virtual CollideResult collide(const CollisionModel& b, const Transform& X_AB,
                                 const CollideRequest& request = {}) const = 0;
+
+  /// The same query split into a fixed number of independent sub-traversals
+  /// (node pairs near the top of the traversal) run on `tasks`: the fine-grain
+  /// parallelism for one heavy pair. The verdict is that of collide(); an
+  /// all-pairs result equals collide()'s exactly; a first-hit result reports
+  /// the smallest of the parts' first hits, which may differ from collide()'s
+  /// pair. Either way the result is the same for any thread count.
+  virtual CollideResult collide_parallel(const CollisionModel& b, const Transform& X_AB,
+                                         const CollideRequest& request, TaskSystem& tasks) const = 0;
 
  protected:
   CollisionModel(Method method, std::shared_ptr<const Mesh> mesh)
