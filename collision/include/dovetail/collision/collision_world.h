@@ -1,0 +1,143 @@
+#pragma once
+/// \file collision_world.h
+/// The collision pipeline: many moving parts, pruned at the object level
+/// (broad phase over world boxes), then by the convex level (a separating
+/// plane cached per pair), then decided exactly at the polygon level, with
+/// the pairs spread over worker threads.
+///
+/// Why: this is what a frame of the simulation asks: "what touches what
+/// now, and what changed since the last frame". Each stage is cheaper than
+/// the next and prunes it; each pair is tested no more precisely than it
+/// needs (its level of detail), pairs nobody is interested in are never
+/// tested, and hierarchies and hulls are built once per mesh, only when a
+/// pair first needs them, and shared by every part using that mesh.
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dovetail/collision/broadphase.h"
+#include "dovetail/collision/collide.h"
+#include "dovetail/collision/mesh.h"
+#include "dovetail/collision/model.h"
+
+namespace dovetail::collision {
+
+/// Identifies a part of a CollisionWorld: slot index and generation, so an id
+/// of a removed part is recognised as stale.
+struct PartId {
+  std::uint32_t index = std::numeric_limits<std::uint32_t>::max();
+  std::uint32_t generation = 0;
+  bool valid() const { return index != std::numeric_limits<std::uint32_t>::max(); }
+  friend bool operator==(const PartId&, const PartId&) = default;
+  friend auto operator<=>(const PartId&, const PartId&) = default;
+};
+
+/// How precisely a pair is decided.
+enum class LevelOfDetail : std::uint8_t {
+  kBox,    ///< world boxes overlap
+  kHull,   ///< convex hulls intersect
+  kExact,  ///< triangles intersect (the polygon level)
+};
+
+/// A part to add.
+struct PartDef {
+  std::shared_ptr<const Mesh> mesh;  ///< shared between instances of the same mesh
+  Transform X_WP;                    ///< pose of the part in the world
+  bool movable = true;               ///< pairs of two fixed parts are never tested
+  /// The level this part needs; a pair uses the coarser of its two parts'
+  /// levels unless set_pair_level overrides it.
+  LevelOfDetail level = LevelOfDetail::kExact;
+  std::string name;
+};
+
+/// Pipeline settings.
+struct WorldSettings {
+  Method method = Method::kObb;  ///< polygon-level hierarchy
+  BroadphaseMethod broadphase = BroadphaseMethod::kSweepAndPrune;
+  bool convex_level = true;  ///< separating-plane test before the polygon level
+  int threads = 1;           ///< 1 = fully serial; 0 = one per hardware thread
+};
+
+/// Marks a contact found at the box or hull level, which has no triangles.
+inline constexpr std::uint32_t kNoTriangle = std::numeric_limits<std::uint32_t>::max();
+
+/// One contact: at the polygon level an intersecting triangle pair (indices
+/// into each part's Mesh::triangles); at coarser levels one entry per pair
+/// with kNoTriangle. `a` has the smaller index.
+struct Contact {
+  PartId a;
+  PartId b;
+  std::uint32_t triangle_a = kNoTriangle;
+  std::uint32_t triangle_b = kNoTriangle;
+  friend bool operator==(const Contact&, const Contact&) = default;
+};
+
+/// A pair of parts, `a` with the smaller index.
+struct PartPair {
+  PartId a;
+  PartId b;
+  friend bool operator==(const PartPair&, const PartPair&) = default;
+  friend auto operator<=>(const PartPair&, const PartPair&) = default;
+};
+
+/// What one step did at each level.
+struct StepStats {
+  std::size_t parts = 0;
+  std::size_t box_pairs = 0;         ///< overlapping world boxes (broad phase)
+  std::size_t tested_pairs = 0;      ///< of those, pairs of interest
+  std::size_t convex_tests = 0;      ///< separating-plane tests
+  std::size_t convex_separated = 0;  ///< pairs the convex level proved apart
+  std::size_t cached_planes = 0;     ///< ... with last frame's plane
+  std::size_t polygon_pairs = 0;     ///< pairs decided at the polygon level
+  std::size_t colliding_pairs = 0;
+  CollideStats polygon;              ///< volume and triangle tests
+};
+
+/// Result of a step: deterministic, the same bits for any thread count.
+struct StepResult {
+  std::vector<Contact> contacts;   ///< sorted by (a, b, triangle_a, triangle_b)
+  std::vector<PartPair> colliding; ///< sorted pairs in contact
+  std::vector<PartPair> began;     ///< in contact now, not at the last step
+  std::vector<PartPair> ended;     ///< in contact at the last step, not now
+  StepStats stats;
+};
+
+/// A set of parts and the pipeline that finds their contacts.
+class CollisionWorld {
+ public:
+  explicit CollisionWorld(const WorldSettings& settings = {});
+  ~CollisionWorld();
+  CollisionWorld(const CollisionWorld&) = delete;
+  CollisionWorld& operator=(const CollisionWorld&) = delete;
+
+  /// Adds a part; throws std::invalid_argument without a mesh.
+  PartId add_part(const PartDef& def);
+  /// Removes a part; its pairs end (reported by the next step).
+  void remove_part(PartId id);
+  /// Sets a part's pose for the next step.
+  void set_pose(PartId id, const Transform& X_WP);
+  const Transform& pose(PartId id) const;
+  const std::string& name(PartId id) const;
+  std::size_t part_count() const;
+
+  /// Whether the pair is tested at all (default: yes unless both are fixed).
+  void set_interest(PartId a, PartId b, bool interested);
+  /// Level of detail for one pair, overriding the parts' levels.
+  void set_pair_level(PartId a, PartId b, LevelOfDetail level);
+
+  /// Runs the pipeline on the current poses.
+  const StepResult& step();
+  const StepResult& last_step() const;
+
+  /// Bytes of the hierarchies and hulls built so far (shared ones counted once).
+  std::size_t model_bytes() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dovetail::collision

@@ -1,0 +1,370 @@
+#include "dovetail/collision/collision_world.h"
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <stdexcept>
+#include <unordered_map>
+#include <utility>
+
+#include "dovetail/collision/convex.h"
+#include "dovetail/collision/task_system.h"
+#include "hierarchy_common.h"
+
+namespace dovetail::collision {
+
+namespace {
+
+/// What parts with the same mesh share: built once, on first need.
+struct Shape {
+  std::shared_ptr<const Mesh> mesh;
+  std::shared_ptr<const CollisionModel> model;  ///< polygon level, built for the first exact pair
+  std::shared_ptr<const ConvexHull> hull;       ///< convex level and tight world boxes
+  bool hull_failed = false;                     ///< flat part: no hull, conservative boxes
+  Vec3 local_min, local_max;                    ///< bounds in the part's frame
+  Real max_abs = 0;
+};
+
+struct Part {
+  PartId id;
+  std::shared_ptr<Shape> shape;
+  Transform X_WP;
+  bool movable = true;
+  bool alive = false;
+  bool in_broadphase = false;
+  bool dirty = true;
+  LevelOfDetail level = LevelOfDetail::kExact;
+  std::string name;
+  std::array<std::uint32_t, 6> extremal{};  ///< hull vertices extremal along +-x, +-y, +-z last step
+};
+
+/// Per-pair state kept across steps (temporal coherence of the convex level).
+struct PairState {
+  SeparatingPlaneCache plane;
+  GjkCache gjk;
+};
+
+std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<std::uint64_t>(a) << 32) | b;
+}
+
+/// X_AB = X_WA^-1 X_WB.
+Transform relative(const Transform& X_WA, const Transform& X_WB) {
+  Transform X;
+  X.R = X_WA.R.transpose() * X_WB.R;
+  X.t = X_WA.R.transpose() * (X_WB.t - X_WA.t);
+  return X;
+}
+
+/// The work of one candidate pair, filled in by whichever thread evaluates it.
+struct PairWork {
+  std::uint32_t a = 0, b = 0;
+  LevelOfDetail level = LevelOfDetail::kExact;
+  PairState* state = nullptr;
+  // Outputs.
+  bool colliding = false;
+  bool convex_tested = false;
+  bool convex_separated = false;
+  bool cached_plane = false;
+  bool polygon = false;
+  CollideResult result;
+};
+
+}  // namespace
+
+struct CollisionWorld::Impl {
+  WorldSettings settings;
+  std::unique_ptr<TaskSystem> tasks;
+  std::unique_ptr<Broadphase> broadphase;
+  std::vector<Part> parts;
+  std::vector<std::uint32_t> free_slots;  ///< removed slots, reused smallest first
+  std::map<const Mesh*, std::shared_ptr<Shape>> shapes;
+  std::unordered_map<std::uint64_t, bool> interest;
+  std::unordered_map<std::uint64_t, LevelOfDetail> levels;
+  std::unordered_map<std::uint64_t, PairState> pair_states;
+  std::vector<ProxyPair> candidates;
+  std::vector<PairWork> work;
+  StepResult result;
+
+  Part& part(PartId id) {
+    if (id.index >= parts.size() || !parts[id.index].alive || parts[id.index].id != id) {
+      throw std::invalid_argument("collision world: unknown or removed part");
+    }
+    return parts[id.index];
+  }
+
+  std::shared_ptr<Shape> shape_for(const std::shared_ptr<const Mesh>& mesh) {
+    std::shared_ptr<Shape>& shape = shapes[mesh.get()];
+    if (!shape) {
+      shape = std::make_shared<Shape>();
+      shape->mesh = mesh;
+      const Bounds bounds = mesh_bounds(*mesh);
+      shape->local_min = bounds.min;
+      shape->local_max = bounds.max;
+      shape->max_abs = detail::max_abs_coordinate(*mesh);
+    }
+    return shape;
+  }
+
+  void ensure_hull(Shape& shape) {
+    if (shape.hull || shape.hull_failed) return;
+    try {
+      shape.hull = std::make_shared<const ConvexHull>(compute_convex_hull(shape.mesh->vertices, shape.mesh->source));
+    } catch (const std::invalid_argument&) {
+      shape.hull_failed = true;  // a flat part: conservative boxes, no convex level
+    }
+  }
+
+  void ensure_model(Shape& shape) {
+    if (!shape.model) shape.model = build_model(settings.method, shape.mesh);
+  }
+
+  /// The part's world box: extremal hull vertices found by walking from last
+  /// step's, or the transformed local box for a part without a hull; widened
+  /// by a margin far above rounding so the box holds the part as every later
+  /// stage computes it.
+  Aabb world_box(Part& p) {
+    const Shape& shape = *p.shape;
+    const Transform& X = p.X_WP;
+    Aabb box;
+    if (shape.hull) {
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 d_P = X.R.row(k).transpose();  // world axis k in the part's frame
+        p.extremal[2 * k] = shape.hull->support(d_P, p.extremal[2 * k]);
+        p.extremal[2 * k + 1] = shape.hull->support(-d_P, p.extremal[2 * k + 1]);
+        box.max[k] = X.apply(shape.hull->vertices[p.extremal[2 * k]])[k];
+        box.min[k] = X.apply(shape.hull->vertices[p.extremal[2 * k + 1]])[k];
+      }
+    } else {
+      const Vec3 centre = X.apply((shape.local_min + shape.local_max) * 0.5);
+      const Vec3 half = X.R.cwiseAbs() * ((shape.local_max - shape.local_min) * 0.5);
+      box.min = centre - half;
+      box.max = centre + half;
+    }
+    const Real margin = 0x1.0p-36 * (X.t.cwiseAbs().sum() + 3 * shape.max_abs);
+    box.min.array() -= margin;
+    box.max.array() += margin;
+    return box;
+  }
+
+  bool interested(const Part& a, const Part& b) const {
+    const auto it = interest.find(pair_key(a.id.index, b.id.index));
+    if (it != interest.end()) return it->second;
+    return a.movable || b.movable;
+  }
+
+  LevelOfDetail level_of(const Part& a, const Part& b) const {
+    const auto it = levels.find(pair_key(a.id.index, b.id.index));
+    if (it != levels.end()) return it->second;
+    return std::min(a.level, b.level);
+  }
+
+  /// Decides one pair (`fine`: split its polygon-level query over the tasks).
+  void evaluate(PairWork& w, bool fine) {
+    const Part& a = parts[w.a];
+    const Part& b = parts[w.b];
+    if (w.level == LevelOfDetail::kBox) {
+      w.colliding = true;
+      return;
+    }
+    const Transform X_AB = relative(a.X_WP, b.X_WP);
+    const bool have_hulls = a.shape->hull && b.shape->hull;
+    if (have_hulls && (settings.convex_level || w.level == LevelOfDetail::kHull)) {
+      const SeparatingPlaneResult plane =
+          separating_plane_test(*a.shape->hull, *b.shape->hull, X_AB, w.state->plane);
+      w.convex_tested = true;
+      w.cached_plane = plane.cache_hit;
+      if (plane.separated) {
+        w.convex_separated = true;
+        return;
+      }
+      if (w.level == LevelOfDetail::kHull) {
+        w.colliding = gjk(*a.shape->hull, *b.shape->hull, X_AB, &w.state->gjk).intersecting;
+        return;
+      }
+    } else if (w.level == LevelOfDetail::kHull) {
+      w.level = LevelOfDetail::kExact;  // a flat part has no hull: decide exactly
+    }
+    w.polygon = true;
+    const CollideRequest request{.all_pairs = true};
+    w.result = fine ? a.shape->model->collide_parallel(*b.shape->model, X_AB, request, *tasks)
+                    : a.shape->model->collide(*b.shape->model, X_AB, request);
+    w.colliding = w.result.colliding;
+  }
+
+  const StepResult& step() {
+    StepResult next;
+    // 1. World boxes of new and moved parts; broad phase.
+    for (Part& p : parts) {
+      if (!p.alive) continue;
+      if (p.dirty || !p.in_broadphase) {
+        ensure_hull(*p.shape);
+        const Aabb box = world_box(p);
+        if (p.in_broadphase) broadphase->move(p.id.index, box);
+        else broadphase->add(p.id.index, box);
+        p.in_broadphase = true;
+        p.dirty = false;
+      }
+      ++next.stats.parts;
+    }
+    broadphase->pairs(candidates);
+    next.stats.box_pairs = candidates.size();
+
+    // 2. Pairs of interest, their levels, and what they need built (serially).
+    work.clear();
+    std::size_t exact_pairs = 0;
+    for (const ProxyPair& c : candidates) {
+      const Part& a = parts[c.a];
+      const Part& b = parts[c.b];
+      if (!interested(a, b)) continue;
+      PairWork w;
+      w.a = c.a;
+      w.b = c.b;
+      w.level = level_of(a, b);
+      if (w.level != LevelOfDetail::kBox) {
+        w.state = &pair_states[pair_key(c.a, c.b)];
+        if (w.level == LevelOfDetail::kExact || a.shape->hull_failed || b.shape->hull_failed) {
+          ensure_model(*a.shape);
+          ensure_model(*b.shape);
+          ++exact_pairs;
+        }
+      }
+      work.push_back(std::move(w));
+    }
+    next.stats.tested_pairs = work.size();
+
+    // 3. Decide the pairs: over pairs when there are enough of them, else
+    //    within each heavy pair. Either way each pair's result is the same.
+    const int threads = tasks->thread_count();
+    if (threads > 1 && exact_pairs < static_cast<std::size_t>(2 * threads)) {
+      for (PairWork& w : work) evaluate(w, true);
+    } else {
+      tasks->parallel_for(work.size(), 1, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) evaluate(work[i], false);
+      });
+    }
+
+    // 4. Gather in pair order: contacts sorted by (a, b, triangle_a, triangle_b).
+    for (const PairWork& w : work) {
+      StepStats& s = next.stats;
+      s.convex_tests += w.convex_tested;
+      s.convex_separated += w.convex_separated;
+      s.cached_planes += w.cached_plane;
+      s.polygon_pairs += w.polygon;
+      s.polygon.volume_tests += w.result.stats.volume_tests;
+      s.polygon.triangle_tests += w.result.stats.triangle_tests;
+      if (!w.colliding) continue;
+      const PartPair pair{parts[w.a].id, parts[w.b].id};
+      next.colliding.push_back(pair);
+      if (w.polygon) {
+        for (const TrianglePair& t : w.result.pairs) next.contacts.push_back({pair.a, pair.b, t.a, t.b});
+      } else {
+        next.contacts.push_back({pair.a, pair.b, kNoTriangle, kNoTriangle});
+      }
+    }
+    next.stats.colliding_pairs = next.colliding.size();
+
+    // 5. Changes since the last step.
+    std::set_difference(next.colliding.begin(), next.colliding.end(), result.colliding.begin(),
+                        result.colliding.end(), std::back_inserter(next.began));
+    std::set_difference(result.colliding.begin(), result.colliding.end(), next.colliding.begin(),
+                        next.colliding.end(), std::back_inserter(next.ended));
+    result = std::move(next);
+    return result;
+  }
+};
+
+CollisionWorld::CollisionWorld(const WorldSettings& settings) : impl_(std::make_unique<Impl>()) {
+  impl_->settings = settings;
+  impl_->tasks = make_task_system(settings.threads);
+  impl_->broadphase = make_broadphase(settings.broadphase);
+}
+
+CollisionWorld::~CollisionWorld() = default;
+
+PartId CollisionWorld::add_part(const PartDef& def) {
+  if (!def.mesh) throw std::invalid_argument("collision world: part '" + def.name + "' has no mesh");
+  Impl& w = *impl_;
+  std::uint32_t index;
+  if (!w.free_slots.empty()) {
+    const auto smallest = std::min_element(w.free_slots.begin(), w.free_slots.end());
+    index = *smallest;
+    w.free_slots.erase(smallest);
+  } else {
+    index = static_cast<std::uint32_t>(w.parts.size());
+    w.parts.emplace_back();
+  }
+  Part& p = w.parts[index];
+  const std::uint32_t generation = p.id.generation + (p.id.valid() ? 1 : 0);
+  p = Part{};
+  p.id = {index, generation};
+  p.shape = w.shape_for(def.mesh);
+  p.X_WP = def.X_WP;
+  p.movable = def.movable;
+  p.level = def.level;
+  p.name = def.name;
+  p.alive = true;
+  return p.id;
+}
+
+void CollisionWorld::remove_part(PartId id) {
+  Impl& w = *impl_;
+  Part& p = w.part(id);
+  if (p.in_broadphase) w.broadphase->remove(id.index);
+  p.alive = false;
+  p.in_broadphase = false;
+  p.shape.reset();
+  w.free_slots.push_back(id.index);
+  // Forget every per-pair setting and cache of the slot (order does not matter).
+  auto involves = [&](std::uint64_t key) {
+    return (key >> 32) == id.index || (key & 0xffffffffu) == id.index;
+  };
+  std::erase_if(w.pair_states, [&](const auto& kv) { return involves(kv.first); });
+  std::erase_if(w.interest, [&](const auto& kv) { return involves(kv.first); });
+  std::erase_if(w.levels, [&](const auto& kv) { return involves(kv.first); });
+}
+
+void CollisionWorld::set_pose(PartId id, const Transform& X_WP) {
+  Part& p = impl_->part(id);
+  p.X_WP = X_WP;
+  p.dirty = true;
+}
+
+const Transform& CollisionWorld::pose(PartId id) const { return impl_->part(id).X_WP; }
+const std::string& CollisionWorld::name(PartId id) const { return impl_->part(id).name; }
+
+std::size_t CollisionWorld::part_count() const {
+  return static_cast<std::size_t>(
+      std::count_if(impl_->parts.begin(), impl_->parts.end(), [](const Part& p) { return p.alive; }));
+}
+
+void CollisionWorld::set_interest(PartId a, PartId b, bool interested) {
+  impl_->part(a);
+  impl_->part(b);
+  impl_->interest[pair_key(a.index, b.index)] = interested;
+}
+
+void CollisionWorld::set_pair_level(PartId a, PartId b, LevelOfDetail level) {
+  impl_->part(a);
+  impl_->part(b);
+  impl_->levels[pair_key(a.index, b.index)] = level;
+}
+
+const StepResult& CollisionWorld::step() { return impl_->step(); }
+const StepResult& CollisionWorld::last_step() const { return impl_->result; }
+
+std::size_t CollisionWorld::model_bytes() const {
+  std::size_t bytes = 0;
+  for (const auto& [mesh, shape] : impl_->shapes) {
+    if (shape->model) bytes += shape->model->info().bytes;
+    if (shape->hull) {
+      bytes += shape->hull->vertices.size() * sizeof(Vec3) +
+               shape->hull->faces.size() * sizeof(TriangleIndices) +
+               (shape->hull->neighbors.size() + shape->hull->neighbor_offsets.size()) * sizeof(std::uint32_t);
+    }
+  }
+  return bytes;
+}
+
+}  // namespace dovetail::collision
