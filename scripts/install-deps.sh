@@ -8,7 +8,7 @@ packages="g++ cmake make pkg-config ccache libeigen3-dev libassimp-dev libtbb-de
 # Test-only: exact oracle for the triangle test, and the model files of the import tests.
 packages="$packages libcgal-dev assimp-testmodels"
 # Bench-only peers (optional for the library, used by bench/).
-packages="$packages libfcl-dev"
+packages="$packages libfcl-dev libbullet-dev"
 
 missing=""
 for p in $packages; do
