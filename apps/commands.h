@@ -17,5 +17,7 @@ int inspect_command(std::span<const std::string> args);
 int poses_command(std::span<const std::string> args);
 /// `dovetail run`: the built-in default job (every method against brute force).
 int run_command(std::span<const std::string> args);
+/// `dovetail broadphase --boxes FILE ...`: overlapping box pairs, frame by frame.
+int broadphase_command(std::span<const std::string> args);
 
 }  // namespace dovetail::cli

@@ -30,6 +30,7 @@ commands:
   inspect   mesh statistics and the size of every method's hierarchy
   poses     write a contact-distance pose list for two meshes
   run       the built-in job: every method against brute force
+  broadphase  overlapping pairs of moving boxes, frame by frame
   version   print the version
 
 'dovetail <command> --help' describes a command.
@@ -57,6 +58,7 @@ constexpr Command kCommands[] = {
     {"inspect", dovetail::cli::inspect_command},
     {"poses", dovetail::cli::poses_command},
     {"run", dovetail::cli::run_command},
+    {"broadphase", dovetail::cli::broadphase_command},
     {"version", version_command},
 };
 
