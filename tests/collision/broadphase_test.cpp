@@ -57,6 +57,9 @@ struct SceneSpec {
   bool snapped = false;  ///< coordinates rounded to 1/8: many exact ties
   double churn = 0.05;   ///< chance per frame of adding and removing objects
   std::uint64_t seed = 1;
+  int burst_frame = -1;  ///< at this frame, half of the objects appear or vanish at once
+  double drift = 0;      ///< every box also moves by this per frame along (1, 0.5, 0.25)
+  double growth = 1;     ///< every box's size is multiplied by this per frame
 };
 
 /// One object's motion: a box centre bouncing in the scene cube, half extents
@@ -90,6 +93,19 @@ class Scene {
   void step() {
     ++frame_;
     for (Mover& m : movers_) advance(m);
+    if (frame_ == spec_.burst_frame) {
+      // Half of the objects vanish (or come back), and as many new ones arrive.
+      const std::size_t n = movers_.size();
+      for (std::size_t id = 0; id < n; ++id) {
+        if (rng_.uniform() < 0.5) continue;
+        present_[id] = present_[id] != 0 ? 0 : 1;
+        if (present_[id] != 0) movers_[id] = make_mover(static_cast<std::uint32_t>(id));
+      }
+      for (std::size_t i = 0; i < n / 2; ++i) {
+        movers_.push_back(make_mover(static_cast<std::uint32_t>(movers_.size())));
+        present_.push_back(1);
+      }
+    }
     if (rng_.uniform() < spec_.churn) {
       const int changes = 1 + static_cast<int>(rng_.below(1 + movers_.size() / 50));
       for (int c = 0; c < changes; ++c) {
@@ -154,6 +170,7 @@ class Scene {
 
   void advance(Mover& m) const {
     m.center += m.velocity;
+    m.half *= spec_.growth;
     if (m.kind == Kind::kOutlier) return;
     for (int k = 0; k < 3; ++k) {
       if (m.center[k] < 0 || m.center[k] > world_) {
@@ -183,7 +200,8 @@ class Scene {
     for (int k = 0; k < 3; ++k) half[k] *= 1 + 0.4 * std::sin(m.rate * frame_ + m.phase[k]);
     if (m.kind == Kind::kPoint) half.setZero();
     if (m.kind == Kind::kFlat) half[m.axis] = 0;
-    Aabb b{m.center - half, m.center + half};
+    const Vec3 drift = spec_.drift * frame_ * Vec3(1, 0.5, 0.25);
+    Aabb b{m.center + drift - half, m.center + drift + half};
     if (spec_.snapped) {
       for (int k = 0; k < 3; ++k) {
         b.min[k] = std::floor(b.min[k] * 8) / 8;
@@ -456,19 +474,42 @@ TEST(BroadphaseAgreement, Snapped100) {
   }
 }
 
+TEST(BroadphaseAgreement, DriftingGrowingBursts100) {
+  // The whole scene drifts away from where it started (the octree's root must
+  // be rebuilt) and grows by 4x (the grid's cell must be re-chosen); half of
+  // the objects appear or vanish at once (sweep and prune re-sorts from scratch).
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    expect_agreement({.name = "drifting growing 100 seed " + std::to_string(seed),
+                      .objects = 100,
+                      .frames = 300,
+                      .clustered = seed == 2,
+                      .snapped = seed == 3,
+                      .seed = seed,
+                      .burst_frame = 150,
+                      .drift = 0.5,
+                      .growth = 1.005});
+  }
+}
+
 TEST(BroadphaseAgreement, Uniform10000) {
-  expect_agreement(
-      {.name = "uniform 10000", .objects = 10000, .frames = 8, .churn = 0.5, .seed = 11});
+  expect_agreement({.name = "uniform 10000",
+                    .objects = 10000,
+                    .frames = 10,
+                    .churn = 0.5,
+                    .seed = 11,
+                    .burst_frame = 6});
 }
 
 TEST(BroadphaseAgreement, Clustered10000) {
-  expect_agreement({.name = "clustered snapped 10000",
+  expect_agreement({.name = "clustered snapped drifting 10000",
                     .objects = 10000,
-                    .frames = 8,
+                    .frames = 10,
                     .clustered = true,
                     .snapped = true,
                     .churn = 0.5,
-                    .seed = 12});
+                    .seed = 12,
+                    .drift = 2,
+                    .growth = 1.02});
 }
 
 }  // namespace
