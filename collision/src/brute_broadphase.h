@@ -1,6 +1,7 @@
 #pragma once
 // The reference broad phase: every pair of present boxes, n^2/2 box tests.
 
+#include <array>
 #include <vector>
 
 #include "dovetail/collision/broadphase.h"
@@ -8,8 +9,9 @@
 namespace dovetail::collision {
 
 /// Exhaustive reference. Keeps the boxes by id and, on `pairs()`, runs the
-/// closed-box test `Aabb::overlaps` on every pair of present boxes in id order,
-/// so its output is sorted without a sort and depends on nothing but the boxes.
+/// closed-box test (the comparisons of `Aabb::overlaps`, x first) on every pair
+/// of present boxes in id order, so its output is sorted without a sort and
+/// depends on nothing but the boxes.
 class BruteBroadphase final : public Broadphase {
  public:
   void add(ProxyId id, const Aabb& box) override;
@@ -24,8 +26,8 @@ class BruteBroadphase final : public Broadphase {
   std::vector<Aabb> boxes_;    ///< by id
   std::vector<char> present_;  ///< by id
   std::size_t count_ = 0;
-  std::vector<ProxyId> ids_;  ///< scratch: present ids in order
-  std::vector<Aabb> packed_;  ///< scratch: their boxes, contiguous
+  std::vector<ProxyId> ids_;                 ///< scratch: present ids in order
+  std::array<std::vector<Real>, 6> packed_;  ///< scratch: min x, y, z, max x, y, z
   BroadphaseStats last_stats_;
 };
 
