@@ -8,6 +8,7 @@
 /// with coherent motion the plane that separated a pair last frame usually
 /// still does, so most frames re-check one plane.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -19,29 +20,57 @@ namespace dovetail::collision {
 
 /// Convex hull of a point set, in the part's own frame. Immutable after
 /// construction; shared by every instance of a part.
+///
+/// Why exact: a "separated" verdict of the convex level is a proof, so the
+/// hull must contain every input point exactly and be exactly convex; then a
+/// vertex no neighbour beats in a direction is the maximum over the whole hull.
+/// compute_convex_hull checks both with exact orient3d (docs/convex.md).
 struct ConvexHull {
-  std::vector<Vec3> vertices;            ///< hull vertices only
-  std::vector<TriangleIndices> faces;    ///< outward, counter-clockwise
+  std::vector<Vec3> vertices;          ///< hull vertices only (input points)
+  std::vector<TriangleIndices> faces;  ///< outward, counter-clockwise
   /// Vertex adjacency along hull edges, compressed: the neighbours of vertex
   /// i are neighbors[neighbor_offsets[i] .. neighbor_offsets[i + 1]).
   std::vector<std::uint32_t> neighbor_offsets;
   std::vector<std::uint32_t> neighbors;
+  Vec3 center = Vec3::Zero();  ///< mean of the vertices (inside the hull)
+  Real radius = 0;             ///< largest distance from `center` to a vertex
+  /// Largest |coordinate| of a vertex: bounds the rounding error of d . v for
+  /// every point of the hull. The exactness arguments of support() and of the
+  /// separating-plane test rely on it; compute_convex_hull sets it.
+  Real extent = 0;
 
   /// Index of a vertex maximising d . v, by hill climbing along edges from
-  /// `start` (exact maximum: the hull is convex).
+  /// `start` (an out-of-range start means 0). Exact maximum of d . v for the
+  /// given doubles: comparisons the rounding could decide wrongly are redone
+  /// exactly, and on an exactly convex hull a vertex no neighbour strictly
+  /// beats is a global maximum. Moves only on strict improvement, so on a
+  /// plateau (a face or edge perpendicular to d) it stops at the first
+  /// maximising vertex reached from `start`: deterministic.
   std::uint32_t support(const Vec3& d, std::uint32_t start = 0) const;
 };
 
-/// Hull of `points` through reentrant qhull. Throws std::invalid_argument
-/// naming `source` when fewer than 4 affinely independent points exist (a
-/// flat or degenerate part); see docs for how the pipeline treats such parts.
+/// Hull of `points` through reentrant qhull (triangulated output, option
+/// `Qt`), checked exactly and rebuilt exactly from qhull's vertices when the
+/// check fails (docs/convex.md). Throws std::invalid_argument naming `source`
+/// for an empty input, a non-finite coordinate, more than 2^31 - 1 points,
+/// fewer than 4 affinely independent points (a flat or degenerate part: the
+/// pipeline then skips the convex level for it) or a qhull error.
 ConvexHull compute_convex_hull(std::span<const Vec3> points, const std::string& source);
 
 /// Per-pair state of the separating-plane test, kept by the caller across frames.
 struct SeparatingPlaneCache {
   Vec3 normal = Vec3::UnitX();  ///< plane normal in A's frame, pointing from A to B
   Real offset = 0;              ///< plane: normal . x = offset
-  bool valid = false;           ///< false until a plane has been found once
+  /// False until the first test. Afterwards normal/offset hold the last
+  /// separating plane, or, when the last test gave up, its last candidate.
+  bool valid = false;
+  std::uint32_t support_a = 0;  ///< last support vertex of A (warm start of its hill climb)
+  std::uint32_t support_b = 0;  ///< last support vertex of B
+  /// Vertex pairs (A index, B index) of the search's last simplex; four pairs
+  /// after an overlap: the witness re-checked first by the next test.
+  std::array<std::uint32_t, 4> simplex_a{};
+  std::array<std::uint32_t, 4> simplex_b{};
+  int simplex_size = 0;
 };
 
 /// Settings of the separating-plane search.
@@ -51,38 +80,73 @@ struct SeparatingPlaneSettings {
 
 /// Outcome of one separating-plane test.
 struct SeparatingPlaneResult {
-  bool separated = false;   ///< true: a plane strictly separates the hulls (proof)
-  bool cache_hit = false;   ///< the cached plane still separated them
-  int iterations = 0;
+  bool separated = false;  ///< true: a plane strictly separates the hulls (proof)
+  bool cache_hit = false;  ///< the cached plane still separated them
+  /// Not separated because the search stopped without a plane: it reached
+  /// max_iterations; or its normal, a point of the Minkowski difference
+  /// B - A, became shorter than kSeparatingPlaneContact * (a.radius +
+  /// b.radius), so the hulls are at most that far apart; or that point
+  /// could not be shortened any more; or `overlap`. Every "not separated"
+  /// answer is a give-up: "maybe colliding", never a proof.
+  bool gave_up = false;
+  /// Gave up because the origin lies inside a tetrahedron of four support
+  /// pairs (points of B - A): the hulls overlap, up to rounding.
+  bool overlap = false;
+  bool witness_hit = false;  ///< the cached overlap witness still held (no support query)
+  int iterations = 0;        ///< support-query pairs evaluated (1 on a cache hit)
 };
 
+/// Relative length below which the separating-plane search stops (see
+/// SeparatingPlaneResult::gave_up).
+inline constexpr Real kSeparatingPlaneContact = 1e-3;
+
 /// Searches for a plane separating hull A from hull B (B at pose X_AB in A's
-/// frame), starting from `cache` and leaving the found plane in it. Biased
-/// towards "collision": when the search gives up it reports not separated.
+/// frame), starting from `cache` and leaving the found plane in it: first the
+/// cached overlap witness or the cached normal (two warm-started support
+/// queries), then the perceptron rule with a fully corrective step
+/// (docs/convex.md). Biased towards "collision": when the search
+/// gives up it reports not separated. "Separated" is a proof for the meshes
+/// the hulls were built from, with B's vertices placed by X_AB.apply.
 SeparatingPlaneResult separating_plane_test(const ConvexHull& a, const ConvexHull& b,
                                             const Transform& X_AB, SeparatingPlaneCache& cache,
                                             const SeparatingPlaneSettings& settings = {});
 
 /// Per-pair warm-start state of GJK, kept by the caller across frames.
 struct GjkCache {
-  std::uint32_t support_a = 0;  ///< last support vertex of A
-  std::uint32_t support_b = 0;  ///< last support vertex of B
+  std::uint32_t support_a = 0;     ///< last support vertex of A
+  std::uint32_t support_b = 0;     ///< last support vertex of B
   Vec3 direction = Vec3::UnitX();  ///< last search direction, in A's frame
   bool valid = false;
+  /// Vertex pairs of the last final simplex (A index, B index); the next call
+  /// starts from these points at the new pose.
+  std::array<std::uint32_t, 4> simplex_a{};
+  std::array<std::uint32_t, 4> simplex_b{};
+  int simplex_size = 0;
 };
+
+/// GJK stops as converged when the gap between the distance's upper bound
+/// |v| and its lower bound (v . w) / |v| is at most this fraction of |v|.
+inline constexpr Real kGjkRelativeTolerance = 1e-10;
+/// GJK reports "intersecting" when the distance is at most this fraction of
+/// the pair's scale (|t_AB| + a.extent + b.extent): the touching band.
+inline constexpr Real kGjkContactTolerance = 1e-9;
+/// Cap on GJK iterations (support-query pairs); reached only on numerical
+/// trouble, reported in GjkResult::hit_iteration_cap.
+inline constexpr int kGjkMaxIterations = 128;
 
 /// Outcome of GJK on two hulls.
 struct GjkResult {
-  bool intersecting = false;
-  Real distance = 0;         ///< 0 when intersecting
-  Vec3 closest_a = Vec3::Zero();  ///< on A, in A's frame
+  bool intersecting = false;      ///< distance within the touching band (see kGjkContactTolerance)
+  Real distance = 0;              ///< 0 when intersecting
+  Vec3 closest_a = Vec3::Zero();  ///< on A, in A's frame (when intersecting: a point of A near B)
   Vec3 closest_b = Vec3::Zero();  ///< on B, in A's frame
-  int iterations = 0;
+  int iterations = 0;             ///< support-query pairs evaluated
   bool hit_iteration_cap = false;
 };
 
 /// GJK distance/intersection of hull A and hull B (B at X_AB in A's frame),
-/// warm-started from `cache` when given (and updated).
+/// warm-started from `cache` when given (and updated). Signed-volume
+/// sub-distance; always returns finite values for finite input.
 GjkResult gjk(const ConvexHull& a, const ConvexHull& b, const Transform& X_AB,
               GjkCache* cache = nullptr);
 
