@@ -1,6 +1,7 @@
 #include "dovetail/collision/task_system.h"
 
 #include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/info.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
@@ -22,10 +23,15 @@ class SerialTaskSystem final : public TaskSystem {
   }
 };
 
-/// oneTBB in an arena of its own, so the thread count is exactly what was asked for.
+/// oneTBB in an arena of its own, so the thread count is exactly what was
+/// asked for; the global limit is raised while it lives, so that more threads
+/// than cores (oversubscription) are really used when asked for.
 class TbbTaskSystem final : public TaskSystem {
  public:
-  explicit TbbTaskSystem(int threads) : arena_(threads), threads_(threads) {}
+  explicit TbbTaskSystem(int threads)
+      : limit_(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads)),
+        arena_(threads),
+        threads_(threads) {}
   int thread_count() const override { return threads_; }
   void parallel_for(std::size_t count, std::size_t grain,
                     const std::function<void(std::size_t, std::size_t)>& body) override {
@@ -39,6 +45,7 @@ class TbbTaskSystem final : public TaskSystem {
   }
 
  private:
+  tbb::global_control limit_;
   tbb::task_arena arena_;
   int threads_;
 };

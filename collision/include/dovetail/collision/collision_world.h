@@ -50,7 +50,7 @@ struct PartDef {
   /// The level this part needs; a pair uses the coarser of its two parts'
   /// levels unless set_pair_level overrides it.
   LevelOfDetail level = LevelOfDetail::kExact;
-  std::string name;
+  std::string name{};
 };
 
 /// Pipeline settings.
