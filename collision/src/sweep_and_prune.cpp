@@ -21,6 +21,8 @@ void SweepAndPrune::PairSet::clear() {
     std::size_t i = home(key);
     while (slots_[i].key != key) i = (i + 1) & mask_;
     slots_[i].key = kEmpty;
+    degree_[key >> 32] = 0;
+    degree_[static_cast<std::uint32_t>(key)] = 0;
   }
   dense_.clear();
 }
@@ -47,16 +49,22 @@ void SweepAndPrune::PairSet::insert(std::uint32_t a, std::uint32_t b) {
   }
   slots_[i] = {key, static_cast<std::uint32_t>(dense_.size())};
   dense_.push_back(key);
+  if (std::max(a, b) >= degree_.size()) degree_.resize(std::size_t{std::max(a, b)} + 1, 0);
+  ++degree_[a];
+  ++degree_[b];
 }
 
 void SweepAndPrune::PairSet::erase(std::uint32_t a, std::uint32_t b) {
-  if (dense_.empty()) return;
+  // Most boxes overlap nothing: then there is nothing to look up.
+  if (a >= degree_.size() || b >= degree_.size() || degree_[a] == 0 || degree_[b] == 0) return;
   const std::uint64_t key = pair_key(a, b);
   std::size_t i = home(key);
   while (slots_[i].key != key) {
     if (slots_[i].key == kEmpty) return;
     i = (i + 1) & mask_;
   }
+  --degree_[a];
+  --degree_[b];
   // Swap-remove the key from the dense list and re-point the slot of the key moved.
   const std::uint32_t index = slots_[i].index;
   const std::uint64_t last = dense_.back();

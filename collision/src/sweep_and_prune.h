@@ -47,7 +47,9 @@ class SweepAndPrune final : public Broadphase {
   };
 
   /// The overlapping pairs of handles: open addressing, linear probing,
-  /// backward-shift deletion, plus a dense list of the keys for output.
+  /// backward-shift deletion, plus a dense list of the keys for output and
+  /// each handle's number of pairs (an erase of a pair with a handle in no
+  /// pair, the common case, costs no lookup).
   class PairSet {
    public:
     void clear();
@@ -73,6 +75,7 @@ class SweepAndPrune final : public Broadphase {
     std::size_t mask_ = 0;
     int shift_ = 64;
     std::vector<std::uint64_t> dense_;
+    std::vector<std::uint32_t> degree_;  ///< per handle: pairs in the set that hold it
   };
 
   std::uint32_t new_handle();

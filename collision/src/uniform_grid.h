@@ -75,6 +75,10 @@ class UniformGrid final : public Broadphase {
   Range range_of(const Aabb& box) const;
   static std::uint64_t cell_key(const CellIndex& c);
   std::size_t home(std::uint64_t key) const {
+    // Neighbouring cells differ in few bits: mix them all before taking the top bits.
+    key ^= key >> 31;
+    key *= 0xBF58476D1CE4E5B9ull;
+    key ^= key >> 29;
     return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift_);
   }
 
