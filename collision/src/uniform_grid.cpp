@@ -271,6 +271,9 @@ void UniformGrid::choose_cell() {
   if (cell == 0) cell = 1;
   cell_ = cell;
   inverse_cell_ = 1 / cell;
+  // The running sum of sizes, recomputed exactly (it drifts by rounding).
+  size_sum_ = 0;
+  for (ProxyId id : present_) size_sum_ += box_size(boxes_[id]);
   chosen_mean_size_ = n > 0 ? size_sum_ / static_cast<Real>(n) : 0;
 }
 
@@ -301,8 +304,11 @@ void UniformGrid::pairs(std::vector<ProxyPair>& out) {
     ready_ = true;
     register_all();
   } else if (fixed_cell_ == 0 && n > 0) {
+    // (The slack of 1e-9 cells absorbs the rounding of the running sum, so a
+    // scene of points does not re-choose on noise.)
     const Real mean = size_sum_ / static_cast<Real>(n);
-    if (mean > 2 * chosen_mean_size_ || mean < chosen_mean_size_ / 2) {
+    const Real slack = cell_ * Real(1e-9);
+    if (mean > 2 * chosen_mean_size_ + slack || mean < chosen_mean_size_ / 2 - slack) {
       choose_cell();
       register_all();
     }
