@@ -414,6 +414,10 @@ int main(int argc, char** argv) {
               o.objects, o.frames, o.size, o.speed, static_cast<unsigned long long>(o.seed));
   std::printf("overlap: %.2f%% of objects in at least one pair, %.1f pairs per frame\n",
               100 * overlapping_fraction, pairs_per_frame);
+#ifdef DOVETAIL_HAVE_BULLET
+  std::printf("bullet: btDbvtBroadphase margin %g, boxes rounded outwards to float\n",
+              static_cast<double>(gDbvtMargin));
+#endif
   std::printf("times: median over %d runs of the median ms per frame (frames 2..%d)\n\n", o.runs,
               o.frames);
   std::printf("| %-26s | %10s | %11s | %-34s | %30s |\n", "broad phase", "ms/frame", "vs Bullet",
