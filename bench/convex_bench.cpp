@@ -6,7 +6,11 @@
 //   (c) GJK from a cold start,
 //   (d) libccd's GJK intersection test (when libccd is installed).
 //
-//   convex_bench [--pairs N] [--frames F] [--vertices V] [--runs R] [--seed S]
+//   convex_bench [--pairs N] [--frames F] [--vertices V] [--speed K] [--runs R] [--seed S]
+//                [--hull-build]
+//
+// --speed multiplies every angular and swing velocity (less coherence).
+// --hull-build instead times compute_convex_hull on generated point sets.
 //
 // Prints, per contender, the median over runs of the mean time per query,
 // the fastest and slowest run, mean iterations, and the verdicts against
@@ -23,6 +27,7 @@
 #include <vector>
 
 #include "dovetail/collision/convex.h"
+#include "dovetail/collision/primitives.h"
 
 #ifdef DOVETAIL_HAVE_CCD
 #include <ccd/ccd.h>
@@ -45,6 +50,7 @@ struct Options {
   int pairs = 64;
   int frames = 1000;
   int vertices = 48;
+  double speed = 1;
   int runs = 7;
   std::uint64_t seed = 1;
 };
@@ -101,8 +107,8 @@ std::vector<Pair> make_scene(const Options& o) {
     pair.b = random_polytope(r, o.vertices);
     const Vec3 axis = r.direction(), spin = r.direction();
     const Mat3 R0 = r.rotation();
-    const double omega = r.uniform(0.5, 2.0);  // rad/s
-    const double swing = r.uniform(0.2, 0.5);  // rad/s of the approach cycle
+    const double omega = o.speed * r.uniform(0.5, 2.0);  // rad/s
+    const double swing = o.speed * r.uniform(0.2, 0.5);  // rad/s of the approach cycle
     const double phase = r.uniform(0, 2 * kPi);
     const double reach = pair.a.radius + pair.b.radius;
     for (int f = 0; f < o.frames; ++f) {
@@ -140,6 +146,54 @@ void ccd_first_direction(const void* a, const void* b, ccd_vec3_t* dir) {
   ccdVec3Set(dir, d.x(), d.y(), d.z());
 }
 #endif
+
+/// Times compute_convex_hull (median of runs) on generated point sets:
+/// smooth (every point a hull vertex), rounded coplanar, and interior-heavy.
+void hull_build_times(int runs) {
+  const Mat3 R = Eigen::Quaternion<double>(0.9, 0.2, 0.3, 0.1).normalized().toRotationMatrix();
+  auto turned = [&](std::vector<Vec3> p) {
+    for (Vec3& v : p) v = R * v;
+    return p;
+  };
+  std::vector<std::pair<std::string, std::vector<Vec3>>> sets;
+  sets.emplace_back("sphere, 4 subdivisions", turned(make_sphere(1, 4).vertices));
+  sets.emplace_back("sphere, 6 subdivisions", turned(make_sphere(1, 6).vertices));
+  sets.emplace_back("torus 64 x 32", turned(make_torus(1, 0.3, 64, 32).vertices));
+  sets.emplace_back("cylinder, 1024 sides", turned(make_cylinder(1, 2, 1024).vertices));
+  sets.emplace_back("box, 60 x 60 grid per face", [&] {
+    std::vector<Vec3> p;
+    for (int i = 0; i <= 60; ++i) {
+      for (int j = 0; j <= 60; ++j) {
+        const double u = -1 + i / 30.0, v = -1 + j / 30.0;
+        for (double s : {-1.0, 1.0}) {
+          p.push_back(R * Vec3(u, v, s));
+          p.push_back(R * Vec3(u, s, v));
+          p.push_back(R * Vec3(s, u, v));
+        }
+      }
+    }
+    return p;
+  }());
+  sets.emplace_back("cloud, 200,000 points in a cube", [] {
+    Random r(7);
+    std::vector<Vec3> p;
+    for (int i = 0; i < 200000; ++i) p.emplace_back(r.unit(), r.unit(), r.unit());
+    return p;
+  }());
+  std::printf("| point set | points | hull vertices | hull faces | build ms (median) |\n");
+  std::printf("|---|---:|---:|---:|---:|\n");
+  for (const auto& [name, points] : sets) {
+    std::vector<double> ms;
+    ConvexHull hull;
+    for (int k = 0; k < runs; ++k) {
+      const auto start = Clock::now();
+      hull = compute_convex_hull(points, name);
+      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+    }
+    std::printf("| %s | %zu | %zu | %zu | %.1f |\n", name.c_str(), points.size(),
+                hull.vertices.size(), hull.faces.size(), median(ms));
+  }
+}
 
 /// What one contender answered on every query of one run.
 struct Pass {
@@ -207,7 +261,12 @@ Pass run(Contender c, const std::vector<Pair>& pairs) {
 
 int main(int argc, char** argv) {
   Options o;
+  bool hull_build = false;
   for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--hull-build") == 0) {
+      hull_build = true;
+      continue;
+    }
     auto value = [&](const char* name) -> const char* {
       if (std::strcmp(argv[i], name) != 0 || i + 1 >= argc) return nullptr;
       return argv[++i];
@@ -218,20 +277,28 @@ int main(int argc, char** argv) {
       o.frames = std::atoi(v2);
     } else if (const char* v3 = value("--vertices")) {
       o.vertices = std::atoi(v3);
+    } else if (const char* v6 = value("--speed")) {
+      o.speed = std::atof(v6);
     } else if (const char* v4 = value("--runs")) {
       o.runs = std::atoi(v4);
     } else if (const char* v5 = value("--seed")) {
       o.seed = std::strtoull(v5, nullptr, 10);
     } else {
       std::fprintf(stderr,
-                   "usage: convex_bench [--pairs N] [--frames F] [--vertices V] [--runs R] "
-                   "[--seed S]\n");
+                   "usage: convex_bench [--pairs N] [--frames F] [--vertices V] [--speed K] "
+                   "[--runs R] [--seed S] [--hull-build]\n");
       return 2;
     }
   }
-  if (o.pairs < 1 || o.frames < 1 || o.vertices < 4 || o.runs < 1) {
-    std::fprintf(stderr, "convex_bench: pairs, frames, runs must be positive, vertices >= 4\n");
+  if (o.pairs < 1 || o.frames < 1 || o.vertices < 4 || o.runs < 1 || !(o.speed > 0)) {
+    std::fprintf(stderr,
+                 "convex_bench: pairs, frames, runs, speed must be positive, vertices >= 4\n");
     return 2;
+  }
+
+  if (hull_build) {
+    hull_build_times(o.runs);
+    return 0;
   }
 
   const std::vector<Pair> pairs = make_scene(o);
@@ -265,8 +332,8 @@ int main(int argc, char** argv) {
   for (char v : reference) colliding += v;
   std::printf(
       "convex_bench: %d pairs x %d frames = %zu queries, %d points per polytope (mean %.1f hull "
-      "faces), %ld colliding (%.1f%%) by warm GJK, %d runs\n\n",
-      o.pairs, o.frames, queries, o.vertices, faces, colliding,
+      "faces), speed x%g, %ld colliding (%.1f%%) by warm GJK, %d runs\n\n",
+      o.pairs, o.frames, queries, o.vertices, faces, o.speed, colliding,
       100.0 * static_cast<double>(colliding) / static_cast<double>(queries), o.runs);
   std::printf(
       "| method | ns/query (median) | fastest run | slowest run | iterations/query | "

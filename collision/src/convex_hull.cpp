@@ -81,6 +81,11 @@ namespace {
 
 using Triangles = std::vector<TriangleIndices>;
 
+/// An inconsistency inside the exact hull (a bug, never expected).
+struct HullInternalError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 [[noreturn]] void fail(const std::string& source, const std::string& what) {
   throw std::invalid_argument(source + ": convex hull: " + what);
 }
@@ -231,12 +236,17 @@ bool closed_surface(std::span<const Vec3> points, const Triangles& triangles,
 }
 
 /// Solid angle of triangle (a, b, c) seen from the origin (Van Oosterom and
-/// Strackee), positive for a counter-clockwise triangle facing away.
-Real solid_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
+/// Strackee), for a triangle known to face away from the origin (its exact
+/// determinant is positive, so a rounded numerator below zero is read as
+/// zero). False when the triangle is so nearly edge-on that the rounded
+/// formula cannot be trusted to a small fraction of pi.
+bool solid_angle(const Vec3& a, const Vec3& b, const Vec3& c, Real& angle) {
   const Real la = a.norm(), lb = b.norm(), lc = c.norm();
   const Real numerator = a.dot(b.cross(c));
   const Real denominator = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-  return 2 * std::atan2(numerator, denominator);
+  if (!(std::hypot(numerator, denominator) >= 1e-3 * la * lb * lc)) return false;
+  angle = 2 * std::atan2(numerator > 0 ? numerator : 0.0, denominator);
+  return true;
 }
 
 /// Proves that a closed surface of genus 0 bounds a convex polytope, with `c`
@@ -244,7 +254,9 @@ Real solid_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
 /// edge is convex: the far vertex of the face across it is not above the
 /// face's plane (exact); (3) the faces, projected centrally from c, cover the
 /// sphere once (their solid angles, all positive by (1), sum to 4 pi times
-/// an integer degree, which floating point tells apart). By (1) and (3) the
+/// an integer degree, which floating point tells apart: each rounded angle
+/// is accurate to about 1e-12 once the face is not nearly edge-on, and
+/// nearly edge-on faces make the proof fail, not pass). By (1) and (3) the
 /// projection is one-to-one, so the surface is embedded and star-shaped
 /// about c; a closed embedded surface that is convex at every edge is
 /// locally convex everywhere (a simple cone with convex edges is convex) and
@@ -270,7 +282,9 @@ bool proves_convex(std::span<const Vec3> points, const Triangles& triangles,
           g[0] != u && g[0] != v ? g[0] : (g[1] != u && g[1] != v ? g[1] : g[2]);
       if (orient3d(a, b, d, points[far]) > 0) return false;
     }
-    angles += solid_angle(a - c, b - c, d - c);
+    Real angle = 0;
+    if (!solid_angle(a - c, b - c, d - c, angle)) return false;
+    angles += angle;
   }
   constexpr Real kFourPi = 12.566370614359172;
   return std::abs(angles - kFourPi) < 0.5 * kFourPi;
@@ -457,8 +471,7 @@ class ExactHull {
         for (std::uint32_t& back : faces_[g].nb) {
           if (back == f) back = nf;
         }
-        if (stamp_of_[u] == horizon_stamp_)
-          throw std::logic_error("convex hull: horizon not simple");
+        if (stamp_of_[u] == horizon_stamp_) throw HullInternalError("horizon not simple");
         stamp_of_[u] = horizon_stamp_;
         start_of_[u] = nf;
         created_.push_back(nf);
@@ -467,7 +480,7 @@ class ExactHull {
     // Join the new faces around the new vertex: (u, w, i) meets (w, x, i) along (w, i).
     for (std::uint32_t nf : created_) {
       const std::uint32_t w = faces_[nf].v[1];
-      if (stamp_of_[w] != horizon_stamp_) throw std::logic_error("convex hull: horizon not closed");
+      if (stamp_of_[w] != horizon_stamp_) throw HullInternalError("horizon not closed");
       const std::uint32_t next = start_of_[w];
       faces_[nf].nb[1] = next;
       faces_[next].nb[2] = nf;
@@ -639,7 +652,11 @@ ConvexHull build_convex_hull(std::span<const Vec3> points, const std::string& so
   }
   if (exact) return finish(points, candidate);
   // Otherwise the exact rebuild from qhull's vertices.
-  return finish(points, exact_hull(points, candidate, simplex));
+  try {
+    return finish(points, exact_hull(points, candidate, simplex));
+  } catch (const HullInternalError& e) {
+    fail(source, std::string("internal error: ") + e.what());
+  }
 }
 
 bool is_exact_hull(std::span<const Vec3> points, const std::vector<TriangleIndices>& triangles) {

@@ -539,6 +539,7 @@ struct Tally {
   long gjk_cap = 0, gjk_nonfinite = 0;
   int sp_max_iterations = 0;
   long sp_iterations = 0;
+  Real sp_gave_up_farthest = 0;  ///< largest GJK distance / (radius A + radius B) of those
 };
 
 constexpr Real kClearMargin = 0.01;  // times (radius A + radius B)
@@ -560,7 +561,11 @@ void check(const ConvexHull& a, const ConvexHull& b, const Transform& X, Tally& 
   if (!ref && !sp.separated) {
     EXPECT_TRUE(sp.gave_up);
     ++t.sp_gave_up_separated;
-    if (!g.intersecting && g.distance > kClearMargin * (a.radius + b.radius)) ++t.sp_gave_up_clear;
+    if (!g.intersecting) {
+      const Real relative = g.distance / (a.radius + b.radius);
+      t.sp_gave_up_farthest = std::max(t.sp_gave_up_farthest, relative);
+      if (relative > kClearMargin) ++t.sp_gave_up_clear;
+    }
   }
   if (ref && !g.intersecting) {
     ++t.gjk_false_separated;
@@ -580,12 +585,12 @@ void check(const ConvexHull& a, const ConvexHull& b, const Transform& X, Tally& 
 void report(const char* name, const Tally& t) {
   std::printf(
       "[ convex  ] %-28s %7ld configs %7ld intersecting | SP: false separated %ld, gave up on "
-      "separated %ld (clear margin %ld), mean iterations %.2f, max %d | GJK: false separated "
-      "%ld, band %ld (outside band %ld), cap %ld, non-finite %ld\n",
+      "separated %ld (farthest %.2g, clear margin %ld), mean iterations %.2f, max %d | GJK: false "
+      "separated %ld, band %ld (outside band %ld), cap %ld, non-finite %ld\n",
       name, t.configurations, t.intersecting, t.sp_false_separated, t.sp_gave_up_separated,
-      t.sp_gave_up_clear, static_cast<double>(t.sp_iterations) / std::max(1L, t.configurations),
-      t.sp_max_iterations, t.gjk_false_separated, t.gjk_band, t.gjk_band_outside, t.gjk_cap,
-      t.gjk_nonfinite);
+      t.sp_gave_up_farthest, t.sp_gave_up_clear,
+      static_cast<double>(t.sp_iterations) / std::max(1L, t.configurations), t.sp_max_iterations,
+      t.gjk_false_separated, t.gjk_band, t.gjk_band_outside, t.gjk_cap, t.gjk_nonfinite);
 }
 
 void expect_clean(const Tally& t) {
