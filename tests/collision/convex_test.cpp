@@ -517,6 +517,20 @@ Pool make_pool(Random& r) {
   return pool;
 }
 
+/// A rotation taking unit vector `from` to unit vector `to` (Rodrigues).
+Mat3 rotation_between(const Vec3& from, const Vec3& to) {
+  const Vec3 axis = from.cross(to);
+  const Real s = axis.norm(), c = from.dot(to);
+  if (s < 1e-12) {
+    if (c > 0) return Mat3::Identity();
+    // Opposite: a half turn about any axis perpendicular to `from`.
+    const Vec3 p = std::abs(from.x()) < 0.9 ? Vec3(Vec3::UnitX()) : Vec3(Vec3::UnitY());
+    const Vec3 k = from.cross(p).normalized();
+    return 2 * k * k.transpose() - Mat3::Identity();
+  }
+  return Eigen::AngleAxis<Real>(std::atan2(s, c), axis / s).toRotationMatrix();
+}
+
 /// The 24 rotations that permute and negate axes (exact transforms).
 Mat3 axis_rotation(Random& r) {
   for (;;) {
@@ -646,7 +660,7 @@ TEST(ConvexAgreement, TouchingAndNearlyTouching) {
       const Vec3 nb = (b.vertices[fb[1]] - b.vertices[fb[0]])
                           .cross(b.vertices[fb[2]] - b.vertices[fb[0]])
                           .normalized();
-      const Mat3 turn = Eigen::Quaternion<Real>::FromTwoVectors(nb, -na).toRotationMatrix();
+      const Mat3 turn = rotation_between(nb, -na);
       const Mat3 spin = Eigen::AngleAxis<Real>(r.uniform(0, 2 * kPi), na).toRotationMatrix();
       X.R = spin * turn;
       u = na;
