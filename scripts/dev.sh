@@ -4,6 +4,8 @@
 #   scripts/dev.sh test    install what is missing, build Release, run every test
 #   scripts/dev.sh build   install what is missing, build Release
 #   scripts/dev.sh bench   build, then run the polygon-level benchmark on built-in meshes
+#   scripts/dev.sh tsan    build the collision tests with ThreadSanitizer (build-tsan/) and
+#                          run the parallel ones
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores),
 # DOVETAIL_WERROR=ON to treat warnings as errors (CI does).
 set -eu
@@ -15,6 +17,15 @@ command=${1:-run}
 
 sh scripts/install-deps.sh
 
+if [ "$command" = tsan ]; then
+  cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDOVETAIL_SANITIZE=thread \
+    -DDOVETAIL_BUILD_BENCH=OFF -DDOVETAIL_WERROR="${DOVETAIL_WERROR:-OFF}" >/dev/null
+  cmake --build build-tsan -j "$jobs" --target collision_tests
+  TSAN_OPTIONS="halt_on_error=1 ${TSAN_OPTIONS:-}" build-tsan/tests/collision_tests \
+    --gtest_filter='CollisionWorld.*:Hierarchies.ParallelQueries*:TaskSystem.*'
+  exit 0
+fi
+
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DDOVETAIL_WERROR="${DOVETAIL_WERROR:-OFF}" >/dev/null
 cmake --build "$build_dir" -j "$jobs"
 
@@ -23,5 +34,5 @@ case "$command" in
   run) "$build_dir/apps/dovetail" run ;;
   test) ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" ;;
   bench) "$build_dir/bench/polygon_bench" ;;
-  *) echo "dev.sh: unknown command '$command' (run, test, build, bench)" >&2; exit 2 ;;
+  *) echo "dev.sh: unknown command '$command' (run, test, build, bench, tsan)" >&2; exit 2 ;;
 esac

@@ -28,8 +28,9 @@ class TaskSystem {
                             const std::function<void(std::size_t, std::size_t)>& body) = 0;
 };
 
-/// A task system with `threads` threads: serial for 1, oneTBB otherwise;
-/// 0 means one per hardware thread.
+/// A task system with `threads` threads: serial for 1, oneTBB otherwise
+/// (a plain std::thread pool in ThreadSanitizer builds, which cannot see
+/// inside the packaged oneTBB); 0 means one per hardware thread.
 std::unique_ptr<TaskSystem> make_task_system(int threads);
 
 }  // namespace dovetail::collision
