@@ -100,13 +100,10 @@ CollideResult AabbTree::collide(const Mesh& mesh_a, const AabbTree& b, const Mes
   return result;
 }
 
-CollideResult AabbTree::collide_parallel(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
-                                   const Transform& X_AB, const CollideRequest& request,
-                                   TaskSystem& tasks) const {
-  const AabbPolicy policy(*this, b, X_AB);
-  return detail::collide_in_parallel(mesh_a, mesh_b, X_AB, request, tasks, [&](detail::LeafTester& t) {
-    return detail::PairTraversal<AabbPolicy>(policy, t);
-  });
+std::unique_ptr<SplitQuery> AabbTree::split(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
+                                   const Transform& X_AB, const CollideRequest& request) const {
+  return std::make_unique<detail::SplitTraversal<detail::PolicyContext<AabbPolicy>>>(mesh_a, mesh_b, X_AB,
+                                                                              request, *this, b);
 }
 
 // ----------------------------------------------------------------- OBB tree
@@ -269,13 +266,10 @@ CollideResult ObbTree::collide(const Mesh& mesh_a, const ObbTree& b, const Mesh&
   return result;
 }
 
-CollideResult ObbTree::collide_parallel(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
-                                   const Transform& X_AB, const CollideRequest& request,
-                                   TaskSystem& tasks) const {
-  const ObbPolicy policy(*this, b, X_AB);
-  return detail::collide_in_parallel(mesh_a, mesh_b, X_AB, request, tasks, [&](detail::LeafTester& t) {
-    return detail::PairTraversal<ObbPolicy>(policy, t);
-  });
+std::unique_ptr<SplitQuery> ObbTree::split(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
+                                   const Transform& X_AB, const CollideRequest& request) const {
+  return std::make_unique<detail::SplitTraversal<detail::PolicyContext<ObbPolicy>>>(mesh_a, mesh_b, X_AB,
+                                                                              request, *this, b);
 }
 
 }  // namespace dovetail::collision

@@ -10,7 +10,7 @@
 #include "binary_layout.h"
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/mesh.h"
-#include "dovetail/collision/task_system.h"
+#include "dovetail/collision/model.h"
 
 namespace dovetail::collision {
 
@@ -21,9 +21,9 @@ class AabbTree {
 
   CollideResult collide(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
                         const Transform& X_AB, const CollideRequest& request) const;
-  CollideResult collide_parallel(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
-                                 const Transform& X_AB, const CollideRequest& request,
-                                 TaskSystem& tasks) const;
+  /// The same query divided into independent parts (see SplitQuery).
+  std::unique_ptr<SplitQuery> split(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
+                                    const Transform& X_AB, const CollideRequest& request) const;
 
   std::size_t node_count() const { return nodes_.size(); }
   std::size_t leaf_count() const { return leaves_; }
@@ -51,9 +51,9 @@ class ObbTree {
 
   CollideResult collide(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
                         const Transform& X_AB, const CollideRequest& request) const;
-  CollideResult collide_parallel(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
-                                 const Transform& X_AB, const CollideRequest& request,
-                                 TaskSystem& tasks) const;
+  /// The same query divided into independent parts (see SplitQuery).
+  std::unique_ptr<SplitQuery> split(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
+                                    const Transform& X_AB, const CollideRequest& request) const;
 
   std::size_t node_count() const { return nodes_.size(); }
   std::size_t leaf_count() const { return leaves_; }

@@ -433,12 +433,23 @@ class BoxtreeTraversal {
   detail::LeafTester& tester_;
 };
 
-CollideResult Boxtree::collide_parallel(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,
-                                        const Transform& X_AB, const CollideRequest& request,
-                                        TaskSystem& tasks) const {
-  return detail::collide_in_parallel(mesh_a, mesh_b, X_AB, request, tasks, [&](detail::LeafTester& t) {
-    return BoxtreeTraversal(*this, b, X_AB, t);
-  });
+namespace {
+
+/// Per-query state of a split boxtree query (see SplitTraversal).
+struct BoxtreeContext {
+  using Entry = BoxtreeTraversal::Entry;
+  BoxtreeContext(const Transform& X_AB, const Boxtree& a, const Boxtree& b) : X(X_AB), tree_a(a), tree_b(b) {}
+  BoxtreeTraversal make(detail::LeafTester& tester) const { return BoxtreeTraversal(tree_a, tree_b, X, tester); }
+  const Transform& X;
+  const Boxtree& tree_a;
+  const Boxtree& tree_b;
+};
+
+}  // namespace
+
+std::unique_ptr<SplitQuery> Boxtree::split(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,
+                                           const Transform& X_AB, const CollideRequest& request) const {
+  return std::make_unique<detail::SplitTraversal<BoxtreeContext>>(mesh_a, mesh_b, X_AB, request, *this, b);
 }
 
 CollideResult Boxtree::collide(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,

@@ -14,7 +14,7 @@
 
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/mesh.h"
-#include "dovetail/collision/task_system.h"
+#include "dovetail/collision/model.h"
 
 namespace dovetail::collision {
 
@@ -57,11 +57,9 @@ class Boxtree {
   CollideResult collide(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,
                         const Transform& X_AB, const CollideRequest& request) const;
 
-  /// The same query split into independent parts run on `tasks` (see
-  /// detail::collide_in_parallel for what is identical to collide()).
-  CollideResult collide_parallel(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,
-                                 const Transform& X_AB, const CollideRequest& request,
-                                 TaskSystem& tasks) const;
+  /// The same query divided into independent parts (see SplitQuery).
+  std::unique_ptr<SplitQuery> split(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,
+                                    const Transform& X_AB, const CollideRequest& request) const;
 
   std::size_t node_count() const { return nodes_.size(); }
   std::size_t leaf_count() const { return leaves_; }

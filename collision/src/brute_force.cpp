@@ -60,25 +60,46 @@ CollideResult BruteForce::collide(const Mesh& mesh_a, const BruteForce& /*b*/, c
   return result;
 }
 
-CollideResult BruteForce::collide_parallel(const Mesh& mesh_a, const BruteForce& /*b*/,
-                                           const Mesh& mesh_b, const Transform& X_AB,
-                                           const CollideRequest& request, TaskSystem& tasks) const {
-  const TransformedB transformed(mesh_b, X_AB);
-  // Rows of A in a fixed number of chunks, independent of the thread count.
-  const std::size_t rows = lo_.size();
-  const std::size_t chunk = (rows + detail::kFrontierTarget - 1) / detail::kFrontierTarget;
-  const std::size_t chunks = (rows + chunk - 1) / chunk;
-  std::vector<CollideResult> parts(chunks);
-  tasks.parallel_for(chunks, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t c = begin; c < end; ++c) {
-      detail::LeafTester tester(mesh_a, mesh_b, X_AB, request.all_pairs, parts[c]);
-      test_rows(static_cast<std::uint32_t>(c * chunk), static_cast<std::uint32_t>(std::min(rows, (c + 1) * chunk)),
-                mesh_b, &transformed, tester);
-    }
-  });
-  CollideResult result;
-  detail::merge_parts(result, parts, request);
-  return result;
+/// Brute force divided into a fixed number of chunks of A's rows.
+class BruteForceSplit final : public SplitQuery {
+ public:
+  BruteForceSplit(const BruteForce& brute, const Mesh& mesh_a, const Mesh& mesh_b,
+                  const Transform& X_AB, const CollideRequest& request)
+      : brute_(brute), a_(mesh_a), b_(mesh_b), X_AB_(X_AB), request_(request), transformed_(mesh_b, X_AB_) {
+    rows_ = mesh_a.triangles.size();
+    chunk_ = (rows_ + detail::kFrontierTarget - 1) / detail::kFrontierTarget;
+    parts_.resize((rows_ + chunk_ - 1) / chunk_);
+  }
+
+  std::size_t parts() const override { return parts_.size(); }
+
+  void run(std::size_t i) override {
+    detail::LeafTester tester(a_, b_, X_AB_, request_.all_pairs, parts_[i]);
+    brute_.test_rows(static_cast<std::uint32_t>(i * chunk_),
+                     static_cast<std::uint32_t>(std::min(rows_, (i + 1) * chunk_)), b_, &transformed_, tester);
+  }
+
+  CollideResult result() override {
+    CollideResult merged;
+    detail::merge_parts(merged, parts_, request_);
+    return merged;
+  }
+
+ private:
+  const BruteForce& brute_;
+  const Mesh& a_;
+  const Mesh& b_;
+  const Transform X_AB_;
+  const CollideRequest request_;
+  const TransformedB transformed_;
+  std::size_t rows_ = 0, chunk_ = 1;
+  std::vector<CollideResult> parts_;
+};
+
+std::unique_ptr<SplitQuery> BruteForce::split(const Mesh& mesh_a, const BruteForce& /*b*/,
+                                              const Mesh& mesh_b, const Transform& X_AB,
+                                              const CollideRequest& request) const {
+  return std::make_unique<BruteForceSplit>(*this, mesh_a, mesh_b, X_AB, request);
 }
 
 }  // namespace dovetail::collision

@@ -5,7 +5,7 @@
 
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/mesh.h"
-#include "dovetail/collision/task_system.h"
+#include "dovetail/collision/model.h"
 
 namespace dovetail::collision {
 
@@ -24,15 +24,15 @@ class BruteForce {
   CollideResult collide(const Mesh& mesh_a, const BruteForce& b, const Mesh& mesh_b,
                         const Transform& X_AB, const CollideRequest& request) const;
 
-  /// The same query split into independent parts run on `tasks` (see
-  /// detail::collide_in_parallel for what is identical to collide()).
-  CollideResult collide_parallel(const Mesh& mesh_a, const BruteForce& b, const Mesh& mesh_b,
-                                 const Transform& X_AB, const CollideRequest& request,
-                                 TaskSystem& tasks) const;
+  /// The same query divided into independent parts (see SplitQuery).
+  std::unique_ptr<SplitQuery> split(const Mesh& mesh_a, const BruteForce& b, const Mesh& mesh_b,
+                                    const Transform& X_AB, const CollideRequest& request) const;
 
   std::size_t bytes() const;
 
  private:
+  friend class BruteForceSplit;
+
   /// Rows [begin, end) of A against every triangle of B (`transformed`: B in A's frame).
   void test_rows(std::uint32_t begin, std::uint32_t end, const Mesh& mesh_b, const void* transformed,
                  detail::LeafTester& tester) const;

@@ -160,13 +160,14 @@ struct CollisionWorld::Impl {
     return std::min(a.level, b.level);
   }
 
-  /// Decides one pair (`fine`: split its polygon-level query over the tasks).
-  void evaluate(PairWork& w, bool fine) {
+  /// Decides one pair up to the polygon level; returns whether the polygon
+  /// level must still decide it.
+  bool evaluate_coarse(PairWork& w) {
     const Part& a = parts[w.a];
     const Part& b = parts[w.b];
     if (w.level == LevelOfDetail::kBox) {
       w.colliding = true;
-      return;
+      return false;
     }
     const Transform X_AB = relative(a.X_WP, b.X_WP);
     const bool have_hulls = a.shape->hull && b.shape->hull;
@@ -177,20 +178,60 @@ struct CollisionWorld::Impl {
       w.cached_plane = plane.cache_hit;
       if (plane.separated) {
         w.convex_separated = true;
-        return;
+        return false;
       }
       if (w.level == LevelOfDetail::kHull) {
         w.colliding = gjk(*a.shape->hull, *b.shape->hull, X_AB, &w.state->gjk).intersecting;
-        return;
+        return false;
       }
     } else if (w.level == LevelOfDetail::kHull) {
       w.level = LevelOfDetail::kExact;  // a flat part has no hull: decide exactly
     }
     w.polygon = true;
-    const CollideRequest request{.all_pairs = true};
-    w.result = fine ? a.shape->model->collide_parallel(*b.shape->model, X_AB, request, *tasks)
-                    : a.shape->model->collide(*b.shape->model, X_AB, request);
+    return true;
+  }
+
+  /// The polygon level of one pair, in one piece.
+  void evaluate_polygon(PairWork& w) {
+    const Part& a = parts[w.a];
+    const Part& b = parts[w.b];
+    w.result = a.shape->model->collide(*b.shape->model, relative(a.X_WP, b.X_WP), {.all_pairs = true});
     w.colliding = w.result.colliding;
+  }
+
+  /// The polygon level of heavy pairs, each divided into parts, all parts of
+  /// all pairs in one parallel loop (fine grain, balanced across pairs).
+  void evaluate_split(const std::vector<std::size_t>& heavy_pairs) {
+    std::vector<std::unique_ptr<SplitQuery>> queries(heavy_pairs.size());
+    tasks->parallel_for(heavy_pairs.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t q = begin; q < end; ++q) {
+        const PairWork& w = work[heavy_pairs[q]];
+        queries[q] = parts[w.a].shape->model->split(*parts[w.b].shape->model,
+                                                     relative(parts[w.a].X_WP, parts[w.b].X_WP),
+                                                     {.all_pairs = true});
+      }
+    });
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> jobs;  // (query, part)
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+      for (std::size_t i = 0; i < queries[q]->parts(); ++i) {
+        jobs.emplace_back(static_cast<std::uint32_t>(q), static_cast<std::uint32_t>(i));
+      }
+    }
+    tasks->parallel_for(jobs.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t j = begin; j < end; ++j) queries[jobs[j].first]->run(jobs[j].second);
+    });
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+      PairWork& w = work[heavy_pairs[q]];
+      w.result = queries[q]->result();
+      w.colliding = w.result.colliding;
+    }
+  }
+
+  /// A pair worth splitting over the threads: both parts large.
+  bool heavy(const PairWork& w) const {
+    constexpr std::size_t kHeavyProduct = std::size_t{1} << 20;
+    return parts[w.a].shape->mesh->triangle_count() * parts[w.b].shape->mesh->triangle_count() >=
+           kHeavyProduct;
   }
 
   const StepResult& step() {
@@ -213,7 +254,6 @@ struct CollisionWorld::Impl {
 
     // 2. Pairs of interest, their levels, and what they need built (serially).
     work.clear();
-    std::size_t exact_pairs = 0;
     for (const ProxyPair& c : candidates) {
       const Part& a = parts[c.a];
       const Part& b = parts[c.b];
@@ -227,23 +267,29 @@ struct CollisionWorld::Impl {
         if (w.level == LevelOfDetail::kExact || a.shape->hull_failed || b.shape->hull_failed) {
           ensure_model(*a.shape);
           ensure_model(*b.shape);
-          ++exact_pairs;
         }
       }
       work.push_back(std::move(w));
     }
     next.stats.tested_pairs = work.size();
 
-    // 3. Decide the pairs: over pairs when there are enough of them, else
-    //    within each heavy pair. Either way each pair's result is the same.
-    const int threads = tasks->thread_count();
-    if (threads > 1 && exact_pairs < static_cast<std::size_t>(2 * threads)) {
-      for (PairWork& w : work) evaluate(w, true);
-    } else {
-      tasks->parallel_for(work.size(), 1, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) evaluate(work[i], false);
-      });
+    // 3. Decide the pairs in parallel over pairs (coarse grain); the polygon
+    //    level of heavy pairs is deferred and then split over the threads one
+    //    pair at a time (fine grain). Either way each pair's result is the same.
+    const bool split_heavy = tasks->thread_count() > 1;
+    std::vector<char> deferred(work.size(), 0);
+    tasks->parallel_for(work.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        if (!evaluate_coarse(work[i])) continue;
+        if (split_heavy && heavy(work[i])) deferred[i] = 1;
+        else evaluate_polygon(work[i]);
+      }
+    });
+    std::vector<std::size_t> heavy_pairs;
+    for (std::size_t i = 0; i < work.size(); ++i) {
+      if (deferred[i]) heavy_pairs.push_back(i);
     }
+    if (!heavy_pairs.empty()) evaluate_split(heavy_pairs);
 
     // 4. Gather in pair order: contacts sorted by (a, b, triangle_a, triangle_b).
     for (const PairWork& w : work) {

@@ -235,14 +235,11 @@ CollideResult DopTree::collide(const Mesh& mesh_a, const DopTree& b, const Mesh&
 
 namespace dovetail::collision {
 
-CollideResult DopTree::collide_parallel(const Mesh& mesh_a, const DopTree& b, const Mesh& mesh_b,
-                                        const Transform& X_AB, const CollideRequest& request,
-                                        TaskSystem& tasks) const {
+std::unique_ptr<SplitQuery> DopTree::split(const Mesh& mesh_a, const DopTree& b, const Mesh& mesh_b,
+                                   const Transform& X_AB, const CollideRequest& request) const {
   if (b.k() != k()) throw std::invalid_argument("DOP-tree: both trees need the same k");
-  const DopPolicy policy(*this, b, X_AB);
-  return detail::collide_in_parallel(mesh_a, mesh_b, X_AB, request, tasks, [&](detail::LeafTester& t) {
-    return detail::PairTraversal<DopPolicy>(policy, t);
-  });
+  return std::make_unique<detail::SplitTraversal<detail::PolicyContext<DopPolicy>>>(mesh_a, mesh_b, X_AB,
+                                                                              request, *this, b);
 }
 
 }  // namespace dovetail::collision

@@ -15,7 +15,7 @@
 #include "binary_layout.h"
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/mesh.h"
-#include "dovetail/collision/task_system.h"
+#include "dovetail/collision/model.h"
 
 namespace dovetail::collision {
 
@@ -46,11 +46,9 @@ class DopTree {
   CollideResult collide(const Mesh& mesh_a, const DopTree& b, const Mesh& mesh_b,
                         const Transform& X_AB, const CollideRequest& request) const;
 
-  /// The same query split into independent parts run on `tasks` (see
-  /// detail::collide_in_parallel for what is identical to collide()).
-  CollideResult collide_parallel(const Mesh& mesh_a, const DopTree& b, const Mesh& mesh_b,
-                                 const Transform& X_AB, const CollideRequest& request,
-                                 TaskSystem& tasks) const;
+  /// The same query divided into independent parts (see SplitQuery).
+  std::unique_ptr<SplitQuery> split(const Mesh& mesh_a, const DopTree& b, const Mesh& mesh_b,
+                                    const Transform& X_AB, const CollideRequest& request) const;
 
   int k() const { return 2 * basis_.axes; }
   std::size_t node_count() const { return links_.size(); }

@@ -11,6 +11,7 @@
 
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/mesh.h"
+#include "dovetail/collision/model.h"
 #include "dovetail/collision/task_system.h"
 #include "dovetail/collision/tri_tri.h"
 
@@ -158,29 +159,46 @@ inline void merge_parts(CollideResult& result, const std::vector<CollideResult>&
 /// to the thread count, so the result is the same for any number of threads.
 inline constexpr std::size_t kFrontierTarget = 64;
 
-/// Runs one query as independent sub-traversals. `make(tester)` gives a
-/// traversal over the pair that reports to `tester`, with
-/// `frontier(target)`, a breadth-first expansion of the overlapping node
-/// pairs near the roots, and `run_from(entry)`. For all-pairs queries the
-/// result equals the serial one (the set of node pairs visited does not
-/// depend on the order); for first-hit queries the reported pair is the
-/// smallest of the sub-traversals' first hits.
-template <typename MakeTraversal>
-CollideResult collide_in_parallel(const Mesh& a, const Mesh& b, const Transform& X_AB,
-                                  const CollideRequest& request, TaskSystem& tasks,
-                                  MakeTraversal&& make) {
-  CollideResult result;
-  LeafTester head(a, b, X_AB, request.all_pairs, result);
-  const auto entries = make(head).frontier(kFrontierTarget);
-  std::vector<CollideResult> parts(entries.size());
-  tasks.parallel_for(entries.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      LeafTester tester(a, b, X_AB, request.all_pairs, parts[i]);
-      make(tester).run_from(entries[i]);
-    }
-  });
-  merge_parts(result, parts, request);
-  return result;
-}
+/// A query divided into sub-traversals: `Context` holds the per-query state
+/// (constructed from the pose, stored here, and the extra arguments) and
+/// makes a traversal reporting to a given tester, with `frontier(target)`
+/// (overlapping node pairs breadth-first from the roots) and `run_from(entry)`.
+/// All-pairs results equal the serial query's exactly: the set of node pairs
+/// visited does not depend on the order.
+template <typename Context>
+class SplitTraversal final : public SplitQuery {
+ public:
+  template <typename... Args>
+  SplitTraversal(const Mesh& a, const Mesh& b, const Transform& X_AB, const CollideRequest& request,
+                 Args&&... args)
+      : a_(a), b_(b), X_AB_(X_AB), request_(request), context_(X_AB_, std::forward<Args>(args)...) {
+    LeafTester head(a_, b_, X_AB_, request_.all_pairs, head_);
+    entries_ = context_.make(head).frontier(kFrontierTarget);
+    parts_.resize(entries_.size());
+  }
+
+  std::size_t parts() const override { return entries_.size(); }
+
+  void run(std::size_t i) override {
+    LeafTester tester(a_, b_, X_AB_, request_.all_pairs, parts_[i]);
+    context_.make(tester).run_from(entries_[i]);
+  }
+
+  CollideResult result() override {
+    CollideResult merged = head_;
+    merge_parts(merged, parts_, request_);
+    return merged;
+  }
+
+ private:
+  const Mesh& a_;
+  const Mesh& b_;
+  const Transform X_AB_;
+  const CollideRequest request_;
+  const Context context_;
+  CollideResult head_;
+  std::vector<typename Context::Entry> entries_;
+  std::vector<CollideResult> parts_;
+};
 
 }  // namespace dovetail::collision::detail

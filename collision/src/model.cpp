@@ -55,10 +55,9 @@ class StructureModel final : public CollisionModel {
     return structure_.collide(mesh(), same_method(b).structure_, b.mesh(), X_AB, request);
   }
 
-  CollideResult collide_parallel(const CollisionModel& b, const Transform& X_AB,
-                                 const CollideRequest& request, TaskSystem& tasks) const override {
-    return structure_.collide_parallel(mesh(), same_method(b).structure_, b.mesh(), X_AB, request,
-                                       tasks);
+  std::unique_ptr<SplitQuery> split(const CollisionModel& b, const Transform& X_AB,
+                                    const CollideRequest& request) const override {
+    return structure_.split(mesh(), same_method(b).structure_, b.mesh(), X_AB, request);
   }
 
  private:
@@ -66,6 +65,16 @@ class StructureModel final : public CollisionModel {
 };
 
 }  // namespace
+
+CollideResult CollisionModel::collide_parallel(const CollisionModel& b, const Transform& X_AB,
+                                               const CollideRequest& request,
+                                               TaskSystem& tasks) const {
+  const std::unique_ptr<SplitQuery> query = split(b, X_AB, request);
+  tasks.parallel_for(query->parts(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) query->run(i);
+  });
+  return query->result();
+}
 
 std::string_view method_name(Method method) { return kNames[static_cast<std::size_t>(method)]; }
 

@@ -119,6 +119,16 @@ class PairTraversal {
   LeafTester& tester_;
 };
 
+/// Per-query state of a split PairTraversal query (see SplitTraversal).
+template <typename Policy>
+struct PolicyContext {
+  using Entry = typename PairTraversal<Policy>::Entry;
+  template <typename Tree>
+  PolicyContext(const Transform& X_AB, const Tree& a, const Tree& b) : policy(a, b, X_AB) {}
+  PairTraversal<Policy> make(LeafTester& tester) const { return PairTraversal<Policy>(policy, tester); }
+  Policy policy;
+};
+
 /// For policies whose test needs nothing cached on A's side.
 struct NoEnclosure {};
 

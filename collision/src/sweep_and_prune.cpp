@@ -247,12 +247,52 @@ void SweepAndPrune::sort_axis(int axis) {
   stats_.swaps += swaps;
 }
 
+void SweepAndPrune::merge_added() {
+  // Pairs of each new box: every box already in the arrays, and the new boxes before it.
+  std::uint64_t tests = 0;
+  const auto test = [&](std::uint32_t a, std::uint32_t b) {
+    ++tests;
+    if (overlap_on(0, a, b) && overlap_on(1, a, b) && overlap_on(2, a, b)) {
+      overlapping_.insert(a, b);
+    }
+  };
+  for (std::size_t i = 0; i < added_.size(); ++i) {
+    const std::uint32_t a = added_[i];
+    for (std::uint32_t h = 0; h < id_of_.size(); ++h) {
+      if (sorted_in_[h] != 0) test(a, h);
+    }
+    for (std::size_t j = 0; j < i; ++j) test(a, added_[j]);
+  }
+  stats_.box_tests += tests;
+  // Their endpoints merged in at their sorted places.
+  const auto by_key = [](const Endpoint& p, const Endpoint& q) {
+    return p.value < q.value || (p.value == q.value && (p.key & 1) < (q.key & 1));
+  };
+  for (int k = 0; k < 3; ++k) {
+    fresh_.clear();
+    for (std::uint32_t h : added_) {
+      fresh_.push_back({bounds_[k][2 * h], 2 * h});
+      fresh_.push_back({bounds_[k][2 * h + 1], 2 * h + 1});
+    }
+    std::sort(fresh_.begin(), fresh_.end(), [&](const Endpoint& p, const Endpoint& q) {
+      return by_key(p, q) || (!by_key(q, p) && p.key < q.key);
+    });
+    merged_.resize(axes_[k].size() + fresh_.size());
+    std::merge(axes_[k].begin(), axes_[k].end(), fresh_.begin(), fresh_.end(), merged_.begin(),
+               by_key);
+    axes_[k].swap(merged_);
+  }
+  for (std::uint32_t h : added_) sorted_in_[h] = 1;
+  added_.clear();
+}
+
 void SweepAndPrune::pairs(std::vector<ProxyPair>& out) {
   if (dead_in_arrays_ > 0) remove_dead();
-  // Many new boxes (or the first frame): sort from scratch; otherwise
-  // insertion sort carries the new endpoints in from the end of the arrays.
+  // Many new boxes (or the first frame): sort from scratch. Otherwise the
+  // boxes present are re-sorted by insertion sort, then the few new ones are
+  // tested against all and merged in.
   const std::size_t sorted_count = axes_[0].size() / 2;
-  if (!added_.empty() && 8 * added_.size() > sorted_count) {
+  if (!added_.empty() && 32 * added_.size() > sorted_count) {
     rebuild();
   } else {
     if (moved_) {
@@ -260,15 +300,8 @@ void SweepAndPrune::pairs(std::vector<ProxyPair>& out) {
         for (Endpoint& e : axes_[k]) e.value = bounds_[k][e.key];
       }
     }
-    for (std::uint32_t h : added_) {
-      for (int k = 0; k < 3; ++k) {
-        axes_[k].push_back({bounds_[k][2 * h], 2 * h});
-        axes_[k].push_back({bounds_[k][2 * h + 1], 2 * h + 1});
-      }
-      sorted_in_[h] = 1;
-    }
-    added_.clear();
     for (int k = 0; k < 3; ++k) sort_axis(k);
+    if (!added_.empty()) merge_added();
   }
   moved_ = false;
 

@@ -24,6 +24,10 @@ namespace dovetail::collision {
 /// set is exactly the overlapping pairs (see docs/broadphase.md). Memory is
 /// O(n + s), not O(pairs overlapping on one axis).
 ///
+/// New boxes are tested against all boxes and merged into the arrays (O(n)
+/// each, no swaps); more than n/32 at once, and the first frame, sort from
+/// scratch and rebuild the set by one sweep along x.
+///
 /// Ties: an endpoint is ordered by (value, begin before end), so boxes that
 /// only touch overlap, as `Aabb::overlaps` says.
 class SweepAndPrune final : public Broadphase {
@@ -81,6 +85,7 @@ class SweepAndPrune final : public Broadphase {
   std::uint32_t new_handle();
   void remove_dead();
   void rebuild();
+  void merge_added();
   void sort_axis(int axis);
   bool overlap_on(int axis, std::uint32_t a, std::uint32_t b) const {
     const std::vector<Real>& v = bounds_[axis];
@@ -103,7 +108,8 @@ class SweepAndPrune final : public Broadphase {
   bool moved_ = false;
   PairSet overlapping_;
 
-  std::vector<std::uint32_t> active_;  ///< scratch of rebuild()
+  std::vector<std::uint32_t> active_;     ///< scratch of rebuild()
+  std::vector<Endpoint> fresh_, merged_;  ///< scratch of merge_added()
   BroadphaseStats stats_, last_stats_;
 };
 

@@ -223,3 +223,27 @@ TEST(CollisionWorld, InstancesShareOneHierarchy) {
 
 }  // namespace
 }  // namespace dovetail::collision
+
+namespace dovetail::collision {
+namespace {
+
+TEST(CollisionWorld, HeavyPairsSplitOverThreadsGiveIdenticalResults) {
+  // Parts large enough that their pairs are split over the threads.
+  const auto sphere = share(make_sphere(0.5, 4));           // 5,120 triangles
+  const auto torus = share(make_torus(0.5, 0.2, 64, 32));   // 4,096
+  std::vector<std::vector<Contact>> runs;
+  for (int threads : {1, 2, 8}) {
+    CollisionWorld world({.threads = threads});
+    const std::vector<Transform> poses = random_poses(6, 0.4, 77);
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      world.add_part({.mesh = i % 2 ? torus : sphere, .X_WP = poses[i]});
+    }
+    runs.push_back(world.step().contacts);
+  }
+  EXPECT_GT(runs[0].size(), 100u);
+  EXPECT_EQ(runs[1], runs[0]);
+  EXPECT_EQ(runs[2], runs[0]);
+}
+
+}  // namespace
+}  // namespace dovetail::collision

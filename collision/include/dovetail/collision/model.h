@@ -39,6 +39,23 @@ struct ModelInfo {
   double bytes_per_triangle = 0.0;
 };
 
+/// One query divided into a fixed number of independent parts (node pairs
+/// near the top of the traversal, or rows of brute force). Parts may run on
+/// any threads, in any order, each exactly once; result() then merges them.
+/// Parts of several queries can share one parallel loop, which balances
+/// heavy pairs of different sizes better than one loop per pair.
+class SplitQuery {
+ public:
+  virtual ~SplitQuery() = default;
+  virtual std::size_t parts() const = 0;
+  /// Runs part `i`; distinct parts may run concurrently.
+  virtual void run(std::size_t i) = 0;
+  /// The merged result, once every part has run: the verdict of collide();
+  /// all-pairs results equal collide()'s exactly; a first-hit result reports
+  /// the smallest of the parts' first hits. Independent of the thread count.
+  virtual CollideResult result() = 0;
+};
+
 /// A mesh with its hierarchy for one Method. Immutable after build.
 class CollisionModel {
  public:
@@ -56,14 +73,15 @@ class CollisionModel {
   virtual CollideResult collide(const CollisionModel& b, const Transform& X_AB,
                                 const CollideRequest& request = {}) const = 0;
 
-  /// The same query split into a fixed number of independent sub-traversals
-  /// (node pairs near the top of the traversal) run on `tasks`: the fine-grain
-  /// parallelism for one heavy pair. The verdict is that of collide(); an
-  /// all-pairs result equals collide()'s exactly; a first-hit result reports
-  /// the smallest of the parts' first hits, which may differ from collide()'s
-  /// pair. Either way the result is the same for any thread count.
-  virtual CollideResult collide_parallel(const CollisionModel& b, const Transform& X_AB,
-                                         const CollideRequest& request, TaskSystem& tasks) const = 0;
+  /// The same query divided into independent parts (the fine-grain
+  /// parallelism for one heavy pair). `b`, the models' meshes and this model
+  /// must outlive the returned query.
+  virtual std::unique_ptr<SplitQuery> split(const CollisionModel& b, const Transform& X_AB,
+                                            const CollideRequest& request) const = 0;
+
+  /// split() run on `tasks`: see SplitQuery::result for what equals collide().
+  CollideResult collide_parallel(const CollisionModel& b, const Transform& X_AB,
+                                 const CollideRequest& request, TaskSystem& tasks) const;
 
  protected:
   CollisionModel(Method method, std::shared_ptr<const Mesh> mesh)
