@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "predicates_inline.h"
+#include "../support/random_geometry.h"
 
 namespace dovetail::collision {
 namespace {
@@ -166,40 +167,11 @@ int reference_orient2d(Real ax, Real ay, Real bx, Real by, Real cx, Real cy) {
   return ((v[2] - v[0]) * (v[5] - v[1]) - (v[3] - v[1]) * (v[4] - v[0])).sign();
 }
 
-/// Seeded generator from raw 64-bit draws (identical on every platform).
-class Random {
- public:
-  explicit Random(std::uint64_t seed) : engine_(seed) {}
-  Real unit() { return static_cast<Real>(engine_() >> 11) * 0x1p-53; }
-  Real uniform(Real lo, Real hi) { return lo + (hi - lo) * unit(); }
-  std::int64_t integer(std::int64_t lo, std::int64_t hi) {
-    return lo + static_cast<std::int64_t>(engine_() % static_cast<std::uint64_t>(hi - lo + 1));
-  }
-  Vec3 point(Real lo, Real hi) { return Vec3(uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)); }
-  Vec3 grid_point(std::int64_t range) {
-    return Vec3(Real(integer(-range, range)), Real(integer(-range, range)),
-                Real(integer(-range, range)));
-  }
+using test::Random;
 
- private:
-  std::mt19937_64 engine_;
-};
+using test::ulps;
 
-/// x moved by `steps` units in the last place.
-Real ulps(Real x, int steps) {
-  for (; steps > 0; --steps) x = std::nextafter(x, HUGE_VAL);
-  for (; steps < 0; ++steps) x = std::nextafter(x, -HUGE_VAL);
-  return x;
-}
-
-Vec3 nudge(Random& random, const Vec3& p, int max_ulps) {
-  Vec3 q;
-  for (int k = 0; k < 3; ++k) {
-    const int steps = static_cast<int>(random.integer(-max_ulps, max_ulps));
-    q[k] = std::abs(p[k]) < 0x1p-306 ? p[k] : ulps(p[k], steps);  // stay inside the range
-  }
-  return q;
-}
+using test::nudge;
 
 /// Checks the filtered, exact and plane-side paths of orient3d against the reference.
 void expect_orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {

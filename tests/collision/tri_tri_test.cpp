@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "dovetail/collision/predicates.h"
+#include "../support/random_geometry.h"
 
 namespace dovetail::collision {
 namespace {
@@ -206,23 +207,7 @@ struct ExactMap {
   }
 };
 
-class Random {
- public:
-  explicit Random(std::uint64_t seed) : engine_(seed) {}
-  Real unit() { return static_cast<Real>(engine_() >> 11) * 0x1p-53; }
-  Real uniform(Real lo, Real hi) { return lo + (hi - lo) * unit(); }
-  std::int64_t integer(std::int64_t lo, std::int64_t hi) {
-    return lo + static_cast<std::int64_t>(engine_() % static_cast<std::uint64_t>(hi - lo + 1));
-  }
-  Mat3 rotation() {
-    Eigen::Quaternion<Real> q(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
-    if (q.norm() < 1e-3) q = Eigen::Quaternion<Real>(1, 0, 0, 0);
-    return q.normalized().toRotationMatrix();
-  }
-
- private:
-  std::mt19937_64 engine_;
-};
+using test::Random;
 
 TEST(TrianglesIntersect, DesignedCasesInEveryVertexOrder) {
   for (const Case& c : designed_cases()) {
