@@ -5,6 +5,7 @@
 #include <assimp/scene.h>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <cerrno>
@@ -119,6 +120,25 @@ std::vector<Instance> collect_instances(const fs::path& path, const aiScene& sce
     }
   }
   return instances;
+}
+
+/// Splits X_RN into a rigid pose X_RP (the polar rotation of its 3x3 part,
+/// with determinant +1, and its translation) and returns what is left for the
+/// vertices, R_RP^T * A with no translation: identity when A is a rotation.
+Affine split_rigid(const Affine& X_RN, collision::Transform& X_RP) {
+  const collision::Mat3 A = X_RN.leftCols<3>();
+  const Eigen::JacobiSVD<collision::Mat3> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  collision::Mat3 U = svd.matrixU();
+  const collision::Mat3 V = svd.matrixV();
+  if ((U * V.transpose()).determinant() < 0) U.col(2) = -U.col(2);
+  X_RP.R = U * V.transpose();
+  X_RP.t = X_RN.col(3);
+  Affine rest = Affine::Zero();
+  const collision::Mat3 left = X_RP.R.transpose() * A;
+  // A rotation up to rounding keeps the file's vertices bit for bit.
+  rest.leftCols<3>() =
+      (left - collision::Mat3::Identity()).norm() < 1e-9 ? collision::Mat3::Identity() : left;
+  return rest;
 }
 
 /// Vertices and triangles of one part being assembled.
@@ -341,8 +361,10 @@ ImportReport import_scene(const fs::path& path, const aiScene& scene, const Impo
     for (std::size_t k = 2; used_names.count(name) != 0; ++k) name = base + "_" + std::to_string(k);
     used_names.insert(name);
     Geometry geometry;
-    append(path, *scene.mMeshes[instance->mesh], instance->X_RN, geometry);
     ImportedPart part;
+    Affine X_geometry = instance->X_RN;
+    if (options.part_frames) X_geometry = split_rigid(instance->X_RN, part.X_RP);
+    append(path, *scene.mMeshes[instance->mesh], X_geometry, geometry);
     part.name = name;
     part.mesh =
         validate(std::move(geometry), path.string() + "#" + name, options.limits, part.validation);

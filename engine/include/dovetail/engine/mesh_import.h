@@ -32,6 +32,12 @@ struct ImportOptions {
   /// true: one Mesh for the whole file; false: one part per mesh instance of
   /// every node (a mesh used by two nodes gives two parts).
   bool merge = true;
+  /// With merge = false only. false: every part's vertices are in the file's
+  /// root frame. true: a part's vertices stay in its node's frame and
+  /// ImportedPart::X_RP is the node's rigid pose in the root frame; scale or
+  /// shear in the node transform stays in the vertices (the rotation is the
+  /// polar factor of the node's 3x3 matrix).
+  bool part_frames = false;
   /// Checked before allocating (declared counts) and again by make_mesh.
   collision::MeshLimits limits;
 };
@@ -44,6 +50,10 @@ struct ImportedPart {
   std::string name;
   collision::Mesh mesh;
   collision::MeshValidation validation;
+  /// Pose of the part's frame in the file's root frame: identity unless
+  /// ImportOptions::part_frames (then mesh vertices map to the root frame by
+  /// X_RP.apply).
+  collision::Transform X_RP;
 };
 
 /// Everything an import produced and noticed.
