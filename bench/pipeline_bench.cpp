@@ -78,14 +78,16 @@ struct Bodies {
       for (std::size_t i = 0; i < n; ++i) {
         const Vec3 cell(static_cast<Real>(i % side), static_cast<Real>((i / side) % side),
                         static_cast<Real>(i / (side * side)));
-        pose[i].t = Vec3::Constant(-half_size + spacing / 2) + spacing * cell + jitter * offsets[i].t;
+        pose[i].t =
+            Vec3::Constant(-half_size + spacing / 2) + spacing * cell + jitter * offsets[i].t;
       }
     }
     const std::vector<Transform> m = random_poses(n, speed, seed + 1);
     for (std::size_t i = 0; i < n; ++i) {
       velocity.push_back(m[i].t);
       const Eigen::AngleAxisd aa(m[i].R);
-      spin.push_back(Eigen::AngleAxisd(spin_angle * aa.angle() / std::numbers::pi, aa.axis()).toRotationMatrix());
+      spin.push_back(Eigen::AngleAxisd(spin_angle * aa.angle() / std::numbers::pi, aa.axis())
+                         .toRotationMatrix());
     }
   }
 
@@ -122,7 +124,8 @@ struct SceneResult {
 SceneResult icollide_scene(std::size_t n, double density, int frames, int runs) {
   std::mt19937_64 rng(42);
   std::vector<std::shared_ptr<const Mesh>> shapes;
-  for (int s = 0; s < 20; ++s) shapes.push_back(std::make_shared<const Mesh>(random_polytope(rng, 30, 1.0)));
+  for (int s = 0; s < 20; ++s)
+    shapes.push_back(std::make_shared<const Mesh>(random_polytope(rng, 30, 1.0)));
   const Real sphere_volume = 4.0 / 3.0 * std::numbers::pi;
   const Real half = 0.5 * std::cbrt(n * sphere_volume / density);
   if (2 * half / std::ceil(std::cbrt(static_cast<double>(n))) < 2.0) {
@@ -134,7 +137,8 @@ SceneResult icollide_scene(std::size_t n, double density, int frames, int runs) 
     Bodies bodies(n, half, 0.02, 0.05, 7, /*separated=*/true);
     CollisionWorld world({.method = Method::kObb, .threads = 1});
     std::vector<PartId> ids;
-    for (std::size_t i = 0; i < n; ++i) ids.push_back(world.add_part({.mesh = shapes[i % shapes.size()], .X_WP = bodies.pose[i]}));
+    for (std::size_t i = 0; i < n; ++i)
+      ids.push_back(world.add_part({.mesh = shapes[i % shapes.size()], .X_WP = bodies.pose[i]}));
     world.step();  // first frame: builds and fills the broad phase
     std::vector<double> frame_ms;
     double box_pairs = 0, colliding = 0, polygon = 0, cached = 0;
@@ -163,37 +167,45 @@ SceneResult icollide_scene(std::size_t n, double density, int frames, int runs) 
 
 int icollide(std::size_t n, double density, int frames, int runs) {
   const SceneResult r = icollide_scene(n, density, frames, runs);
-  std::printf("I-COLLIDE scene: %zu polytopes (about 56 faces), density %.3f, %d frames, median of %d runs\n",
-              n, density, frames, runs);
-  std::printf("ms/frame %.3f  (%.0f frames/s)  box pairs %.1f  polygon-level pairs %.1f  colliding %.1f  cached planes %.1f\n",
-              r.ms_per_frame, 1000.0 / r.ms_per_frame, r.box_pairs, r.polygon_pairs, r.colliding, r.cached);
+  std::printf(
+      "I-COLLIDE scene: %zu polytopes (about 56 faces), density %.3f, %d frames, median of %d "
+      "runs\n",
+      n, density, frames, runs);
+  std::printf(
+      "ms/frame %.3f  (%.0f frames/s)  box pairs %.1f  polygon-level pairs %.1f  colliding %.1f  "
+      "cached planes %.1f\n",
+      r.ms_per_frame, 1000.0 / r.ms_per_frame, r.box_pairs, r.polygon_pairs, r.colliding, r.cached);
   return 0;
 }
 
 int scaling(int frames, int runs) {
-  std::printf("%8s %8s %12s %12s %12s %12s\n", "n", "density", "ms/frame", "us/object", "box_pairs", "colliding");
+  std::printf("%8s %8s %12s %12s %12s %12s\n", "n", "density", "ms/frame", "us/object", "box_pairs",
+              "colliding");
   for (std::size_t n : {250, 500, 1000, 2000, 4000, 8000}) {
     const SceneResult r = icollide_scene(n, 0.05, frames, runs);
-    std::printf("%8zu %8.3f %12.3f %12.3f %12.1f %12.1f\n", n, 0.05, r.ms_per_frame, 1000 * r.ms_per_frame / n,
-                r.box_pairs, r.colliding);
+    std::printf("%8zu %8.3f %12.3f %12.3f %12.1f %12.1f\n", n, 0.05, r.ms_per_frame,
+                1000 * r.ms_per_frame / n, r.box_pairs, r.colliding);
   }
   for (double density : {0.025, 0.05, 0.1, 0.2, 0.4}) {
     const SceneResult r = icollide_scene(1000, density, frames, runs);
-    std::printf("%8d %8.3f %12.3f %12.3f %12.1f %12.1f\n", 1000, density, r.ms_per_frame, r.ms_per_frame,
-                r.box_pairs, r.colliding);
+    std::printf("%8d %8.3f %12.3f %12.3f %12.1f %12.1f\n", 1000, density, r.ms_per_frame,
+                r.ms_per_frame, r.box_pairs, r.colliding);
   }
   return 0;
 }
 
 int threads(int frames, int runs) {
   // Heavy parts pressed into each other: most of the time goes to the polygon level.
-  const auto sphere = std::make_shared<const Mesh>(make_sphere(0.5, 5));      // 20,480 triangles
+  const auto sphere = std::make_shared<const Mesh>(make_sphere(0.5, 5));  // 20,480 triangles
   const auto torus = std::make_shared<const Mesh>(make_torus(0.5, 0.2, 128, 64));  // 16,384
   const std::size_t n = 24;
-  std::printf("threads scene: %zu parts (spheres of 20,480 and tori of 16,384 triangles), %d frames, median of %d runs\n",
-              n, frames, runs);
+  std::printf(
+      "threads scene: %zu parts (spheres of 20,480 and tori of 16,384 triangles), %d frames, "
+      "median of %d runs\n",
+      n, frames, runs);
   std::printf("(this machine has 2 cores: 4 and 8 threads oversubscribe it)\n");
-  std::printf("%8s %12s %12s %10s %14s %10s\n", "threads", "ms/frame", "frames/s", "speed-up", "contacts/frame", "same");
+  std::printf("%8s %12s %12s %10s %14s %10s\n", "threads", "ms/frame", "frames/s", "speed-up",
+              "contacts/frame", "same");
   double base = 0;
   std::vector<std::size_t> reference;
   for (int t : {1, 2, 4, 8}) {
@@ -203,7 +215,8 @@ int threads(int frames, int runs) {
       Bodies bodies(n, 0.9, 0.01, 0.03, 3);
       CollisionWorld world({.method = Method::kObb, .threads = t});
       std::vector<PartId> ids;
-      for (std::size_t i = 0; i < n; ++i) ids.push_back(world.add_part({.mesh = i % 2 ? torus : sphere, .X_WP = bodies.pose[i]}));
+      for (std::size_t i = 0; i < n; ++i)
+        ids.push_back(world.add_part({.mesh = i % 2 ? torus : sphere, .X_WP = bodies.pose[i]}));
       world.step();
       contacts.clear();
       const auto t0 = Clock::now();
@@ -218,8 +231,8 @@ int threads(int frames, int runs) {
     if (t == 1) base = ms, reference = contacts;
     double mean_contacts = 0;
     for (std::size_t c : contacts) mean_contacts += c;
-    std::printf("%8d %12.3f %12.1f %9.2fx %14.0f %10s\n", t, ms, 1000 / ms, base / ms, mean_contacts / frames,
-                contacts == reference ? "yes" : "NO");
+    std::printf("%8d %12.3f %12.1f %9.2fx %14.0f %10s\n", t, ms, 1000 / ms, base / ms,
+                mean_contacts / frames, contacts == reference ? "yes" : "NO");
   }
   return 0;
 }
@@ -228,7 +241,9 @@ int threads(int frames, int runs) {
 
 int main(int argc, char** argv) {
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0) {
-    std::printf("usage: pipeline_bench icollide|scaling|threads [--n N] [--density D] [--frames F] [--runs R]\n");
+    std::printf(
+        "usage: pipeline_bench icollide|scaling|threads [--n N] [--density D] [--frames F] [--runs "
+        "R]\n");
     return argc < 2 ? 2 : 0;
   }
   const std::string mode = argv[1];
@@ -237,10 +252,14 @@ int main(int argc, char** argv) {
   int frames = 100, runs = 3;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string arg = argv[i];
-    if (arg == "--n") n = std::stoul(argv[i + 1]);
-    else if (arg == "--density") density = std::stod(argv[i + 1]);
-    else if (arg == "--frames") frames = std::stoi(argv[i + 1]);
-    else if (arg == "--runs") runs = std::stoi(argv[i + 1]);
+    if (arg == "--n")
+      n = std::stoul(argv[i + 1]);
+    else if (arg == "--density")
+      density = std::stod(argv[i + 1]);
+    else if (arg == "--frames")
+      frames = std::stoi(argv[i + 1]);
+    else if (arg == "--runs")
+      runs = std::stoi(argv[i + 1]);
     else {
       std::fprintf(stderr, "pipeline_bench: unknown option %s\n", arg.c_str());
       return 2;

@@ -58,7 +58,7 @@ struct Contender {
   std::string name;
   double build_ms = 0;
   double bytes_per_triangle = 0;
-  std::vector<double> run_ms;                  ///< total query time per run
+  std::vector<double> run_ms;                    ///< total query time per run
   std::map<double, std::vector<double>> gap_ms;  ///< per gap, per run
   std::vector<char> verdicts;
   double volume_tests = 0, triangle_tests = 0;  ///< per query
@@ -109,7 +109,8 @@ int run(const Options& options) {
   const auto t_poses = Clock::now();
   const auto pose_a = collision::build_model(Method::kBoxtree, a);
   const auto pose_b = a == b ? pose_a : collision::build_model(Method::kBoxtree, b);
-  const std::vector<collision::SampledPose> poses = collision::contact_distance_poses(*pose_a, *pose_b, settings);
+  const std::vector<collision::SampledPose> poses =
+      collision::contact_distance_poses(*pose_a, *pose_b, settings);
   std::printf("poses: %zu (%d directions x %zu gaps), generated in %.0f ms\n\n", poses.size(),
               options.directions, settings.gaps.size(), ms_since(t_poses));
 
@@ -117,11 +118,14 @@ int run(const Options& options) {
   std::vector<Method> methods;
   for (Method m : collision::all_methods()) {
     const std::string name(collision::method_name(m));
-    const bool listed = std::find(options.methods.begin(), options.methods.end(), name) != options.methods.end();
-    if (options.methods.empty() ? (m != Method::kBrute || options.with_brute) : listed) methods.push_back(m);
+    const bool listed =
+        std::find(options.methods.begin(), options.methods.end(), name) != options.methods.end();
+    if (options.methods.empty() ? (m != Method::kBrute || options.with_brute) : listed)
+      methods.push_back(m);
   }
   std::vector<std::pair<std::shared_ptr<const collision::CollisionModel>,
-                        std::shared_ptr<const collision::CollisionModel>>> models;
+                        std::shared_ptr<const collision::CollisionModel>>>
+      models;
   for (Method m : methods) {
     Contender c;
     c.name = std::string(collision::method_name(m));
@@ -173,7 +177,8 @@ int run(const Options& options) {
         const auto tq = Clock::now();
         bool hit;
         if (i < models.size()) {
-          const collision::CollideResult res = models[i].first->collide(*models[i].second, poses[p].X_AB);
+          const collision::CollideResult res =
+              models[i].first->collide(*models[i].second, poses[p].X_AB);
           hit = res.colliding;
           volume_tests += res.stats.volume_tests;
           triangle_tests += res.stats.triangle_tests;
@@ -209,8 +214,8 @@ int run(const Options& options) {
     for (std::size_t p = 0; p < poses.size(); ++p) disagreements += c.verdicts[p] != reference[p];
     const double ms = median(c.run_ms);
     std::printf("%-11s %9.1f %9.1f %11.2f %8.3fx %12.0f %11.0f %12d\n", c.name.c_str(), c.build_ms,
-                c.bytes_per_triangle, 1000.0 * ms / poses.size(), ms / reference_ms,
-                c.volume_tests, c.triangle_tests, disagreements);
+                c.bytes_per_triangle, 1000.0 * ms / poses.size(), ms / reference_ms, c.volume_tests,
+                c.triangle_tests, disagreements);
   }
   std::printf("(vs_last and disagree are relative to %s; medians over %d runs)\n\n", reference_name,
               options.runs);
@@ -231,8 +236,8 @@ int run(const Options& options) {
     for (const Contender& c : contenders) {
       out << "{\"method\":\"" << c.name << "\",\"build_ms\":" << c.build_ms
           << ",\"bytes_per_triangle\":" << c.bytes_per_triangle
-          << ",\"us_per_query\":" << 1000.0 * median(c.run_ms) / poses.size()
-          << ",\"ratio_to_" << reference_name << "\":" << median(c.run_ms) / reference_ms
+          << ",\"us_per_query\":" << 1000.0 * median(c.run_ms) / poses.size() << ",\"ratio_to_"
+          << reference_name << "\":" << median(c.run_ms) / reference_ms
           << ",\"volume_tests\":" << c.volume_tests << ",\"triangle_tests\":" << c.triangle_tests
           << ",\"queries\":" << poses.size() << ",\"runs\":" << options.runs << "}\n";
     }
@@ -254,11 +259,16 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (arg == "--directions") options.directions = std::stoi(value());
-    else if (arg == "--runs") options.runs = std::stoi(value());
-    else if (arg == "--seed") options.seed = std::stoull(value());
-    else if (arg == "--json") options.json = value();
-    else if (arg == "--with-brute") options.with_brute = true;
+    if (arg == "--directions")
+      options.directions = std::stoi(value());
+    else if (arg == "--runs")
+      options.runs = std::stoi(value());
+    else if (arg == "--seed")
+      options.seed = std::stoull(value());
+    else if (arg == "--json")
+      options.json = value();
+    else if (arg == "--with-brute")
+      options.with_brute = true;
     else if (arg == "--methods") {
       std::string list = value();
       for (std::size_t start = 0; start <= list.size();) {
@@ -266,14 +276,16 @@ int main(int argc, char** argv) {
         options.methods.push_back(list.substr(start, comma - start));
         start = comma + 1;
       }
-    }
-    else if (arg == "--help") {
-      std::printf("usage: polygon_bench [A B] [--directions N] [--runs R] [--seed S] [--json FILE] [--with-brute] [--methods m1,m2,...]\n");
+    } else if (arg == "--help") {
+      std::printf(
+          "usage: polygon_bench [A B] [--directions N] [--runs R] [--seed S] [--json FILE] "
+          "[--with-brute] [--methods m1,m2,...]\n");
       return 0;
     } else if (!arg.empty() && arg[0] == '-') {
       std::fprintf(stderr, "polygon_bench: unknown option %s\n", arg.c_str());
       return 2;
-    } else positional.push_back(arg);
+    } else
+      positional.push_back(arg);
   }
   if (positional.size() == 1) positional.push_back(positional[0]);
   if (positional.size() == 2) options.mesh_a = positional[0], options.mesh_b = positional[1];

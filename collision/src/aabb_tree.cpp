@@ -42,7 +42,8 @@ AabbTree::AabbTree(const Mesh& mesh, int max_leaf_size) {
 }
 
 std::size_t AabbTree::bytes() const {
-  return sizeof(*this) + nodes_.capacity() * sizeof(Node) + order_.capacity() * sizeof(std::uint32_t);
+  return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
+         order_.capacity() * sizeof(std::uint32_t);
 }
 
 class AabbPolicy {
@@ -100,10 +101,11 @@ CollideResult AabbTree::collide(const Mesh& mesh_a, const AabbTree& b, const Mes
   return result;
 }
 
-std::unique_ptr<SplitQuery> AabbTree::split(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
-                                   const Transform& X_AB, const CollideRequest& request) const {
-  return std::make_unique<detail::SplitTraversal<detail::PolicyContext<AabbPolicy>>>(mesh_a, mesh_b, X_AB,
-                                                                              request, *this, b);
+std::unique_ptr<SplitQuery> AabbTree::split(const Mesh& mesh_a, const AabbTree& b,
+                                            const Mesh& mesh_b, const Transform& X_AB,
+                                            const CollideRequest& request) const {
+  return std::make_unique<detail::SplitTraversal<detail::PolicyContext<AabbPolicy>>>(
+      mesh_a, mesh_b, X_AB, request, *this, b);
 }
 
 // ----------------------------------------------------------------- OBB tree
@@ -114,8 +116,8 @@ namespace {
 /// of a node are the sums of its children's.
 struct Moments {
   Real area = 0;
-  Vec3 first = Vec3::Zero();    ///< sum of area * centroid
-  Mat3 second = Mat3::Zero();   ///< sum of area * second moment per unit area
+  Vec3 first = Vec3::Zero();   ///< sum of area * centroid
+  Mat3 second = Mat3::Zero();  ///< sum of area * second moment per unit area
   void add(const Moments& m) {
     area += m.area;
     first += m.first;
@@ -152,10 +154,12 @@ Mat3 covariance_axes(const Moments& m) {
 /// the face normal (the tightest box of a triangle has a face in its plane).
 Mat3 triangle_axes(const Mesh& mesh, std::uint32_t triangle) {
   const TriangleIndices& t = mesh.triangles[triangle];
-  const Vec3 e[3] = {mesh.vertices[t[1]] - mesh.vertices[t[0]], mesh.vertices[t[2]] - mesh.vertices[t[1]],
+  const Vec3 e[3] = {mesh.vertices[t[1]] - mesh.vertices[t[0]],
+                     mesh.vertices[t[2]] - mesh.vertices[t[1]],
                      mesh.vertices[t[0]] - mesh.vertices[t[2]]};
   int longest = 0;
-  for (int k = 1; k < 3; ++k) if (e[k].squaredNorm() > e[longest].squaredNorm()) longest = k;
+  for (int k = 1; k < 3; ++k)
+    if (e[k].squaredNorm() > e[longest].squaredNorm()) longest = k;
   Mat3 axes;
   axes.col(0) = e[longest].normalized();
   axes.col(2) = e[0].cross(e[1]).normalized();
@@ -179,7 +183,8 @@ ObbTree::ObbTree(const Mesh& mesh, int max_leaf_size) {
     if (node.is_leaf()) {
       for (std::uint32_t s = node.begin; s < node.end; ++s) {
         const TriangleIndices& t = mesh.triangles[layout.triangles[s].index];
-        moments[i].add(triangle_moments(mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]));
+        moments[i].add(
+            triangle_moments(mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]));
       }
     } else {
       moments[i] = moments[node.first_child];
@@ -210,7 +215,8 @@ ObbTree::ObbTree(const Mesh& mesh, int max_leaf_size) {
 }
 
 std::size_t ObbTree::bytes() const {
-  return sizeof(*this) + nodes_.capacity() * sizeof(Node) + order_.capacity() * sizeof(std::uint32_t);
+  return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
+         order_.capacity() * sizeof(std::uint32_t);
 }
 
 class ObbPolicy {
@@ -267,9 +273,10 @@ CollideResult ObbTree::collide(const Mesh& mesh_a, const ObbTree& b, const Mesh&
 }
 
 std::unique_ptr<SplitQuery> ObbTree::split(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
-                                   const Transform& X_AB, const CollideRequest& request) const {
-  return std::make_unique<detail::SplitTraversal<detail::PolicyContext<ObbPolicy>>>(mesh_a, mesh_b, X_AB,
-                                                                              request, *this, b);
+                                           const Transform& X_AB,
+                                           const CollideRequest& request) const {
+  return std::make_unique<detail::SplitTraversal<detail::PolicyContext<ObbPolicy>>>(
+      mesh_a, mesh_b, X_AB, request, *this, b);
 }
 
 }  // namespace dovetail::collision

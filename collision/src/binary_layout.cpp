@@ -60,7 +60,8 @@ class LayoutBuilder {
       std::array<Aabb, kBins> bins;
       std::array<std::size_t, kBins> count{};
       for (std::uint32_t i = begin; i < end; ++i) {
-        const int b = std::min(kBins - 1, static_cast<int>((t[i].centroid[k] - centroids.lo[k]) * scale));
+        const int b =
+            std::min(kBins - 1, static_cast<int>((t[i].centroid[k] - centroids.lo[k]) * scale));
         bins[b].grow(t[i].lo, t[i].hi);
         ++count[b];
       }
@@ -86,7 +87,8 @@ class LayoutBuilder {
       // All centroids coincide (or the tree is deep): split at the median of the longest axis.
       int axis = 0;
       const Vec3 e = centroids.hi - centroids.lo;
-      for (int k = 1; k < 3; ++k) if (e[k] > e[axis]) axis = k;
+      for (int k = 1; k < 3; ++k)
+        if (e[k] > e[axis]) axis = k;
       const std::uint32_t mid = begin + (end - begin) / 2;
       std::nth_element(t.begin() + begin, t.begin() + mid, t.begin() + end,
                        [axis](const BuildTriangle& x, const BuildTriangle& y) {
@@ -97,9 +99,11 @@ class LayoutBuilder {
     }
     const Real lo = centroids.lo[best_axis];
     const Real scale = kBins / (centroids.hi[best_axis] - lo);
-    const auto split = std::partition(t.begin() + begin, t.begin() + end, [&](const BuildTriangle& p) {
-      return std::min(kBins - 1, static_cast<int>((p.centroid[best_axis] - lo) * scale)) <= best_bin;
-    });
+    const auto split =
+        std::partition(t.begin() + begin, t.begin() + end, [&](const BuildTriangle& p) {
+          return std::min(kBins - 1, static_cast<int>((p.centroid[best_axis] - lo) * scale)) <=
+                 best_bin;
+        });
     return static_cast<std::uint32_t>(split - t.begin());
   }
 
@@ -120,7 +124,8 @@ BinaryLayout build_binary_layout(const Mesh& mesh, int max_leaf) {
   layout.triangles = build_triangles(mesh);
   layout.nodes.reserve(2 * mesh.triangles.size());
   layout.nodes.emplace_back();
-  LayoutBuilder(layout, max_leaf).build(0, 0, static_cast<std::uint32_t>(layout.triangles.size()), 1);
+  LayoutBuilder(layout, max_leaf)
+      .build(0, 0, static_cast<std::uint32_t>(layout.triangles.size()), 1);
   return layout;
 }
 

@@ -21,7 +21,7 @@ struct LayoutNode {
 };
 
 struct BinaryLayout {
-  std::vector<LayoutNode> nodes;       ///< root at 0, every parent before its children
+  std::vector<LayoutNode> nodes;         ///< root at 0, every parent before its children
   std::vector<BuildTriangle> triangles;  ///< in slot order
   std::size_t depth = 0;
   std::size_t leaves = 0;

@@ -170,7 +170,8 @@ class BoxtreeBuilder {
         bin_hi.fill(-std::numeric_limits<double>::infinity());
         bin_lo.fill(std::numeric_limits<double>::infinity());
         for (std::size_t i = begin; i < end; ++i) {
-          const int b = std::min(bins - 1, static_cast<int>((prims_[i].centroid[k] - centroids.lo[k]) * scale));
+          const int b = std::min(
+              bins - 1, static_cast<int>((prims_[i].centroid[k] - centroids.lo[k]) * scale));
           ++count[b];
           bin_hi[b] = std::max(bin_hi[b], prims_[i].hi[k]);
           bin_lo[b] = std::min(bin_lo[b], prims_[i].lo[k]);
@@ -192,7 +193,8 @@ class BoxtreeBuilder {
           Box left = box, right = box;
           left.hi[k] = std::min(box.hi[k], prefix_hi);
           right.lo[k] = std::max(box.lo[k], suffix_lo[b + 1]);
-          const double cost = prefix_count * half_area(left) + suffix_count[b + 1] * half_area(right);
+          const double cost =
+              prefix_count * half_area(left) + suffix_count[b + 1] * half_area(right);
           if (cost < best_cost) best_cost = cost, best_axis = k, best_bin = b;
         }
       }
@@ -216,7 +218,8 @@ class BoxtreeBuilder {
     const double scale = bins / (centroids.hi[best_axis] - centroids.lo[best_axis]);
     const auto split = std::partition(
         prims_.begin() + begin, prims_.begin() + end, [&](const detail::BuildTriangle& p) {
-          return std::min(bins - 1, static_cast<int>((p.centroid[best_axis] - lo) * scale)) <= best_bin;
+          return std::min(bins - 1, static_cast<int>((p.centroid[best_axis] - lo) * scale)) <=
+                 best_bin;
         });
     return {best_axis, static_cast<std::size_t>(split - prims_.begin())};
   }
@@ -310,7 +313,8 @@ class BoxtreeTraversal {
     return true;
   }
 
-  static bool descends_a(const BoxtreeNode& na, const BoxtreeNode& nb, const Side& a, const Side& b) {
+  static bool descends_a(const BoxtreeNode& na, const BoxtreeNode& nb, const Side& a,
+                         const Side& b) {
     return !na.is_leaf() && (nb.is_leaf() || size(a.box) >= size(b.box));
   }
 
@@ -438,8 +442,11 @@ namespace {
 /// Per-query state of a split boxtree query (see SplitTraversal).
 struct BoxtreeContext {
   using Entry = BoxtreeTraversal::Entry;
-  BoxtreeContext(const Transform& X_AB, const Boxtree& a, const Boxtree& b) : X(X_AB), tree_a(a), tree_b(b) {}
-  BoxtreeTraversal make(detail::LeafTester& tester) const { return BoxtreeTraversal(tree_a, tree_b, X, tester); }
+  BoxtreeContext(const Transform& X_AB, const Boxtree& a, const Boxtree& b)
+      : X(X_AB), tree_a(a), tree_b(b) {}
+  BoxtreeTraversal make(detail::LeafTester& tester) const {
+    return BoxtreeTraversal(tree_a, tree_b, X, tester);
+  }
   const Transform& X;
   const Boxtree& tree_a;
   const Boxtree& tree_b;
@@ -448,8 +455,10 @@ struct BoxtreeContext {
 }  // namespace
 
 std::unique_ptr<SplitQuery> Boxtree::split(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,
-                                           const Transform& X_AB, const CollideRequest& request) const {
-  return std::make_unique<detail::SplitTraversal<BoxtreeContext>>(mesh_a, mesh_b, X_AB, request, *this, b);
+                                           const Transform& X_AB,
+                                           const CollideRequest& request) const {
+  return std::make_unique<detail::SplitTraversal<BoxtreeContext>>(mesh_a, mesh_b, X_AB, request,
+                                                                  *this, b);
 }
 
 CollideResult Boxtree::collide(const Mesh& mesh_a, const Boxtree& b, const Mesh& mesh_b,

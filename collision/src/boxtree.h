@@ -33,7 +33,8 @@ struct BoxtreeSettings {
 struct BoxtreeNode {
   float split_left = 0;
   float split_right = 0;
-  std::uint32_t bits = 0;  ///< axis (2 bits, 3 = leaf) | kind or leaf count - 1 (2 bits) | index (28 bits)
+  /// axis (2 bits, 3 = leaf) | kind, or leaf count - 1 (2 bits) | index (28 bits)
+  std::uint32_t bits = 0;
 
   static constexpr std::uint32_t kLeafAxis = 3;
   static constexpr std::uint32_t kBothChildren = 0;
@@ -73,7 +74,7 @@ class Boxtree {
   friend class BoxtreeBuilder;
   friend class BoxtreeTraversal;
 
-  std::vector<BoxtreeNode> nodes_;   ///< root at 0
+  std::vector<BoxtreeNode> nodes_;    ///< root at 0
   std::vector<std::uint32_t> order_;  ///< leaf slots -> Mesh::triangles index
   float root_lo_[3] = {0, 0, 0};
   float root_hi_[3] = {0, 0, 0};

@@ -65,7 +65,12 @@ class BruteForceSplit final : public SplitQuery {
  public:
   BruteForceSplit(const BruteForce& brute, const Mesh& mesh_a, const Mesh& mesh_b,
                   const Transform& X_AB, const CollideRequest& request)
-      : brute_(brute), a_(mesh_a), b_(mesh_b), X_AB_(X_AB), request_(request), transformed_(mesh_b, X_AB_) {
+      : brute_(brute),
+        a_(mesh_a),
+        b_(mesh_b),
+        X_AB_(X_AB),
+        request_(request),
+        transformed_(mesh_b, X_AB_) {
     rows_ = mesh_a.triangles.size();
     chunk_ = (rows_ + detail::kFrontierTarget - 1) / detail::kFrontierTarget;
     parts_.resize((rows_ + chunk_ - 1) / chunk_);
@@ -76,7 +81,8 @@ class BruteForceSplit final : public SplitQuery {
   void run(std::size_t i) override {
     detail::LeafTester tester(a_, b_, X_AB_, request_.all_pairs, parts_[i]);
     brute_.test_rows(static_cast<std::uint32_t>(i * chunk_),
-                     static_cast<std::uint32_t>(std::min(rows_, (i + 1) * chunk_)), b_, &transformed_, tester);
+                     static_cast<std::uint32_t>(std::min(rows_, (i + 1) * chunk_)), b_,
+                     &transformed_, tester);
   }
 
   CollideResult result() override {

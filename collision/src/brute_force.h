@@ -34,8 +34,8 @@ class BruteForce {
   friend class BruteForceSplit;
 
   /// Rows [begin, end) of A against every triangle of B (`transformed`: B in A's frame).
-  void test_rows(std::uint32_t begin, std::uint32_t end, const Mesh& mesh_b, const void* transformed,
-                 detail::LeafTester& tester) const;
+  void test_rows(std::uint32_t begin, std::uint32_t end, const Mesh& mesh_b,
+                 const void* transformed, detail::LeafTester& tester) const;
 
   std::vector<Vec3> lo_, hi_;  ///< per-triangle bounds in the mesh's own frame
 };

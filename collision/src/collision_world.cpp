@@ -35,7 +35,8 @@ struct Part {
   bool dirty = true;
   LevelOfDetail level = LevelOfDetail::kExact;
   std::string name;
-  std::array<std::uint32_t, 6> extremal{};  ///< hull vertices extremal along +-x, +-y, +-z last step
+  std::array<std::uint32_t, 6>
+      extremal{};  ///< hull vertices extremal along +-x, +-y, +-z last step
 };
 
 /// Per-pair state kept across steps (temporal coherence of the convex level).
@@ -110,7 +111,8 @@ struct CollisionWorld::Impl {
   void ensure_hull(Shape& shape) {
     if (shape.hull || shape.hull_failed) return;
     try {
-      shape.hull = std::make_shared<const ConvexHull>(compute_convex_hull(shape.mesh->vertices, shape.mesh->source));
+      shape.hull = std::make_shared<const ConvexHull>(
+          compute_convex_hull(shape.mesh->vertices, shape.mesh->source));
     } catch (const std::invalid_argument&) {
       shape.hull_failed = true;  // a flat part: conservative boxes, no convex level
     }
@@ -195,7 +197,8 @@ struct CollisionWorld::Impl {
   void evaluate_polygon(PairWork& w) {
     const Part& a = parts[w.a];
     const Part& b = parts[w.b];
-    w.result = a.shape->model->collide(*b.shape->model, relative(a.X_WP, b.X_WP), {.all_pairs = true});
+    w.result =
+        a.shape->model->collide(*b.shape->model, relative(a.X_WP, b.X_WP), {.all_pairs = true});
     w.colliding = w.result.colliding;
   }
 
@@ -207,8 +210,8 @@ struct CollisionWorld::Impl {
       for (std::size_t q = begin; q < end; ++q) {
         const PairWork& w = work[heavy_pairs[q]];
         queries[q] = parts[w.a].shape->model->split(*parts[w.b].shape->model,
-                                                     relative(parts[w.a].X_WP, parts[w.b].X_WP),
-                                                     {.all_pairs = true});
+                                                    relative(parts[w.a].X_WP, parts[w.b].X_WP),
+                                                    {.all_pairs = true});
       }
     });
     std::vector<std::pair<std::uint32_t, std::uint32_t>> jobs;  // (query, part)
@@ -242,8 +245,10 @@ struct CollisionWorld::Impl {
       if (p.dirty || !p.in_broadphase) {
         ensure_hull(*p.shape);
         const Aabb box = world_box(p);
-        if (p.in_broadphase) broadphase->move(p.id.index, box);
-        else broadphase->add(p.id.index, box);
+        if (p.in_broadphase)
+          broadphase->move(p.id.index, box);
+        else
+          broadphase->add(p.id.index, box);
         p.in_broadphase = true;
         p.dirty = false;
       }
@@ -281,8 +286,10 @@ struct CollisionWorld::Impl {
     tasks->parallel_for(work.size(), 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         if (!evaluate_coarse(work[i])) continue;
-        if (split_heavy && heavy(work[i])) deferred[i] = 1;
-        else evaluate_polygon(work[i]);
+        if (split_heavy && heavy(work[i]))
+          deferred[i] = 1;
+        else
+          evaluate_polygon(work[i]);
       }
     });
     std::vector<std::size_t> heavy_pairs;
@@ -304,7 +311,8 @@ struct CollisionWorld::Impl {
       const PartPair pair{parts[w.a].id, parts[w.b].id};
       next.colliding.push_back(pair);
       if (w.polygon) {
-        for (const TrianglePair& t : w.result.pairs) next.contacts.push_back({pair.a, pair.b, t.a, t.b});
+        for (const TrianglePair& t : w.result.pairs)
+          next.contacts.push_back({pair.a, pair.b, t.a, t.b});
       } else {
         next.contacts.push_back({pair.a, pair.b, kNoTriangle, kNoTriangle});
       }
@@ -330,7 +338,8 @@ CollisionWorld::CollisionWorld(const WorldSettings& settings) : impl_(std::make_
 CollisionWorld::~CollisionWorld() = default;
 
 PartId CollisionWorld::add_part(const PartDef& def) {
-  if (!def.mesh) throw std::invalid_argument("collision world: part '" + def.name + "' has no mesh");
+  if (!def.mesh)
+    throw std::invalid_argument("collision world: part '" + def.name + "' has no mesh");
   Impl& w = *impl_;
   std::uint32_t index;
   if (!w.free_slots.empty()) {
@@ -381,8 +390,8 @@ const Transform& CollisionWorld::pose(PartId id) const { return impl_->part(id).
 const std::string& CollisionWorld::name(PartId id) const { return impl_->part(id).name; }
 
 std::size_t CollisionWorld::part_count() const {
-  return static_cast<std::size_t>(
-      std::count_if(impl_->parts.begin(), impl_->parts.end(), [](const Part& p) { return p.alive; }));
+  return static_cast<std::size_t>(std::count_if(impl_->parts.begin(), impl_->parts.end(),
+                                                [](const Part& p) { return p.alive; }));
 }
 
 void CollisionWorld::set_interest(PartId a, PartId b, bool interested) {
@@ -407,7 +416,8 @@ std::size_t CollisionWorld::model_bytes() const {
     if (shape->hull) {
       bytes += shape->hull->vertices.size() * sizeof(Vec3) +
                shape->hull->faces.size() * sizeof(TriangleIndices) +
-               (shape->hull->neighbors.size() + shape->hull->neighbor_offsets.size()) * sizeof(std::uint32_t);
+               (shape->hull->neighbors.size() + shape->hull->neighbor_offsets.size()) *
+                   sizeof(std::uint32_t);
     }
   }
   return bytes;

@@ -12,10 +12,12 @@ namespace dovetail::collision {
 DopBasis::DopBasis(int k) {
   std::vector<Vec3> n = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   const std::vector<Vec3> corners = {{1, 1, 1}, {1, -1, 1}, {1, 1, -1}, {1, -1, -1}};
-  const std::vector<Vec3> edges = {{1, 1, 0}, {1, -1, 0}, {1, 0, 1}, {1, 0, -1}, {0, 1, 1}, {0, 1, -1}};
+  const std::vector<Vec3> edges = {{1, 1, 0},  {1, -1, 0}, {1, 0, 1},
+                                   {1, 0, -1}, {0, 1, 1},  {0, 1, -1}};
   if (k == 14 || k == 26) n.insert(n.end(), corners.begin(), corners.end());
   if (k == 18 || k == 26) n.insert(n.end(), edges.begin(), edges.end());
-  if (k != 6 && k != 14 && k != 18 && k != 26) throw std::invalid_argument("DOP-tree: k must be 6, 14, 18 or 26");
+  if (k != 6 && k != 14 && k != 18 && k != 26)
+    throw std::invalid_argument("DOP-tree: k must be 6, 14, 18 or 26");
   axes = static_cast<int>(n.size());
   std::copy(n.begin(), n.end(), normal.begin());
 
@@ -92,7 +94,8 @@ DopTree::DopTree(const Mesh& mesh, int k, int max_leaf_size) : basis_(k) {
     }
   }
   links_.reserve(n);
-  for (const detail::LayoutNode& node : layout.nodes) links_.push_back(detail::NodeLink::from(node));
+  for (const detail::LayoutNode& node : layout.nodes)
+    links_.push_back(detail::NodeLink::from(node));
   order_.reserve(layout.triangles.size());
   for (const detail::BuildTriangle& t : layout.triangles) order_.push_back(t.index);
 }
@@ -236,10 +239,11 @@ CollideResult DopTree::collide(const Mesh& mesh_a, const DopTree& b, const Mesh&
 namespace dovetail::collision {
 
 std::unique_ptr<SplitQuery> DopTree::split(const Mesh& mesh_a, const DopTree& b, const Mesh& mesh_b,
-                                   const Transform& X_AB, const CollideRequest& request) const {
+                                           const Transform& X_AB,
+                                           const CollideRequest& request) const {
   if (b.k() != k()) throw std::invalid_argument("DOP-tree: both trees need the same k");
-  return std::make_unique<detail::SplitTraversal<detail::PolicyContext<DopPolicy>>>(mesh_a, mesh_b, X_AB,
-                                                                              request, *this, b);
+  return std::make_unique<detail::SplitTraversal<detail::PolicyContext<DopPolicy>>>(
+      mesh_a, mesh_b, X_AB, request, *this, b);
 }
 
 }  // namespace dovetail::collision

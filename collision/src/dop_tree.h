@@ -23,8 +23,8 @@ namespace dovetail::collision {
 /// between them used to enclose a rotated DOP.
 struct DopBasis {
   static constexpr int kMaxAxes = 13;
-  int axes = 0;                          ///< k / 2
-  std::array<Vec3, kMaxAxes> normal{};   ///< integer normals, not unit length
+  int axes = 0;                         ///< k / 2
+  std::array<Vec3, kMaxAxes> normal{};  ///< integer normals, not unit length
 
   /// A cone spanned by three of the 2 * axes directions +-normal[j]; the cones
   /// of all faces of the directions' convex hull cover every direction.

@@ -28,7 +28,8 @@ class StructureModel final : public CollisionModel {
  public:
   template <typename... Args>
   StructureModel(Method method, std::shared_ptr<const Mesh> mesh, Args&&... args)
-      : CollisionModel(method, std::move(mesh)), structure_(this->mesh(), std::forward<Args>(args)...) {}
+      : CollisionModel(method, std::move(mesh)),
+        structure_(this->mesh(), std::forward<Args>(args)...) {}
 
   ModelInfo info() const override {
     ModelInfo info;
@@ -44,8 +45,9 @@ class StructureModel final : public CollisionModel {
 
   const StructureModel& same_method(const CollisionModel& b) const {
     if (b.method() != method()) {
-      throw std::invalid_argument("collide: models of methods " + std::string(method_name(method())) +
-                                  " and " + std::string(method_name(b.method())) + " cannot be paired");
+      throw std::invalid_argument("collide: models of methods " +
+                                  std::string(method_name(method())) + " and " +
+                                  std::string(method_name(b.method())) + " cannot be paired");
     }
     return static_cast<const StructureModel&>(b);
   }

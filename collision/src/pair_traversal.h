@@ -94,8 +94,8 @@ class PairTraversal {
     const NodeLink la = p_.link_a(a);
     const NodeLink lb = p_.link_b(b);
     if (la.is_leaf() && lb.is_leaf()) {
-      tester_.test_leaves(p_.slots_a() + la.first_slot(), la.count(), p_.slots_b() + lb.first_slot(),
-                          lb.count());
+      tester_.test_leaves(p_.slots_a() + la.first_slot(), la.count(),
+                          p_.slots_b() + lb.first_slot(), lb.count());
       return;
     }
     if (!la.is_leaf() && (lb.is_leaf() || p_.size_a(a) >= p_.size_b(b))) {
@@ -125,7 +125,9 @@ struct PolicyContext {
   using Entry = typename PairTraversal<Policy>::Entry;
   template <typename Tree>
   PolicyContext(const Transform& X_AB, const Tree& a, const Tree& b) : policy(a, b, X_AB) {}
-  PairTraversal<Policy> make(LeafTester& tester) const { return PairTraversal<Policy>(policy, tester); }
+  PairTraversal<Policy> make(LeafTester& tester) const {
+    return PairTraversal<Policy>(policy, tester);
+  }
   Policy policy;
 };
 

@@ -76,7 +76,8 @@ std::vector<SampledPose> contact_distance_poses(const CollisionModel& a, const C
 
   Uniform u(settings.seed);
   std::vector<SampledPose> poses;
-  // Direction samples that never touch (B passes through a hole of A) are redrawn, a bounded number of times.
+  // Direction samples that never touch (B passes through a hole of A) are redrawn, a bounded number
+  // of times.
   const int max_attempts = settings.directions * 20 + 100;
   int found = 0;
   for (int attempt = 0; attempt < max_attempts && found < settings.directions; ++attempt) {

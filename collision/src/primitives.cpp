@@ -41,8 +41,8 @@ Mesh make_box(const Vec3& h) {
 
 Mesh make_sphere(Real radius, int subdivisions) {
   const Real g = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vec3> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                         {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<Vec3> v = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
+                         {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
   for (Vec3& p : v) p.normalize();
   Triangles t = {tri(0, 11, 5), tri(0, 5, 1),  tri(0, 1, 7),   tri(0, 7, 10), tri(0, 10, 11),
                  tri(1, 5, 9),  tri(5, 11, 4), tri(11, 10, 2), tri(10, 7, 6), tri(7, 1, 8),

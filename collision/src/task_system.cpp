@@ -24,7 +24,8 @@ class SerialTaskSystem final : public TaskSystem {
   void parallel_for(std::size_t count, std::size_t grain,
                     const std::function<void(std::size_t, std::size_t)>& body) override {
     grain = std::max<std::size_t>(grain, 1);
-    for (std::size_t begin = 0; begin < count; begin += grain) body(begin, std::min(count, begin + grain));
+    for (std::size_t begin = 0; begin < count; begin += grain)
+      body(begin, std::min(count, begin + grain));
   }
 };
 

@@ -2,6 +2,8 @@
 // level reports, identically for any thread count, with the right begin/end
 // changes.
 
+#include "dovetail/collision/collision_world.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,7 +11,6 @@
 #include <memory>
 #include <vector>
 
-#include "dovetail/collision/collision_world.h"
 #include "dovetail/collision/pose_sampling.h"
 #include "dovetail/collision/primitives.h"
 
@@ -49,7 +50,8 @@ struct MovingScene {
         if (std::abs(poses[i].t[k]) > half_size) velocity[i][k] = -velocity[i][k];
       }
       const Real angle = spin[i].norm();
-      if (angle > 0) poses[i].R = Eigen::AngleAxisd(angle, spin[i] / angle).toRotationMatrix() * poses[i].R;
+      if (angle > 0)
+        poses[i].R = Eigen::AngleAxisd(angle, spin[i] / angle).toRotationMatrix() * poses[i].R;
     }
   }
 };
@@ -93,9 +95,11 @@ TEST(CollisionWorld, ContactsEqualEveryPairAtThePolygonLevel) {
       convex_separated += r.stats.convex_separated;
       scene.advance();
     }
-    std::printf("[ pipeline ] %s: 40 frames, %zu contacts, %zu frames with contact, %zu pairs separated by planes\n",
-                std::string(broadphase_name(broadphase)).c_str(), contacts, frames_with_contact,
-                convex_separated);
+    std::printf(
+        "[ pipeline ] %s: 40 frames, %zu contacts, %zu frames with contact, %zu pairs separated by "
+        "planes\n",
+        std::string(broadphase_name(broadphase)).c_str(), contacts, frames_with_contact,
+        convex_separated);
     EXPECT_GT(frames_with_contact, 5u);
     EXPECT_GT(convex_separated, 0u);
   }
@@ -229,8 +233,8 @@ namespace {
 
 TEST(CollisionWorld, HeavyPairsSplitOverThreadsGiveIdenticalResults) {
   // Parts large enough that their pairs are split over the threads.
-  const auto sphere = share(make_sphere(0.5, 4));           // 5,120 triangles
-  const auto torus = share(make_torus(0.5, 0.2, 64, 32));   // 4,096
+  const auto sphere = share(make_sphere(0.5, 4));          // 5,120 triangles
+  const auto torus = share(make_torus(0.5, 0.2, 64, 32));  // 4,096
   std::vector<std::vector<Contact>> runs;
   for (int threads : {1, 2, 8}) {
     CollisionWorld world({.threads = threads});

@@ -37,7 +37,8 @@ struct Agreement {
 /// Runs every method on every pose and compares with brute force: verdicts of
 /// first-hit queries, and the full sorted pair lists of all-pairs queries.
 /// Reports the first few disagreements in full.
-Agreement expect_agreement(const std::shared_ptr<const Mesh>& a, const std::shared_ptr<const Mesh>& b,
+Agreement expect_agreement(const std::shared_ptr<const Mesh>& a,
+                           const std::shared_ptr<const Mesh>& b,
                            const std::vector<Transform>& poses, const std::string& scene) {
   std::vector<std::shared_ptr<const CollisionModel>> models_a, models_b;
   for (Method m : all_methods()) {
@@ -49,26 +50,29 @@ Agreement expect_agreement(const std::shared_ptr<const Mesh>& a, const std::shar
   auto disagree = [&](std::size_t p, std::size_t m, const std::string& what) {
     if (++agreement.disagreements <= 5) {
       ADD_FAILURE() << scene << " pose " << p << " method " << method_name(models_a[m]->method())
-                    << ": " << what << "\nR=\n" << poses[p].R << "\nt=" << poses[p].t.transpose();
+                    << ": " << what << "\nR=\n"
+                    << poses[p].R << "\nt=" << poses[p].t.transpose();
     }
   };
   for (std::size_t p = 0; p < poses.size(); ++p) {
-    const CollideResult reference = models_a[brute]->collide(*models_b[brute], poses[p], {.all_pairs = true});
+    const CollideResult reference =
+        models_a[brute]->collide(*models_b[brute], poses[p], {.all_pairs = true});
     agreement.colliding += reference.colliding ? 1 : 0;
     ++agreement.poses;
     for (std::size_t m = 0; m + 1 < models_a.size(); ++m) {
       const CollideResult first = models_a[m]->collide(*models_b[m], poses[p]);
       if (first.colliding != reference.colliding) {
         disagree(p, m, "first-hit verdict differs from brute");
-      } else if (first.colliding &&
-                 (first.pairs.size() != 1 || !std::binary_search(reference.pairs.begin(),
-                                                                  reference.pairs.end(), first.pairs[0]))) {
+      } else if (first.colliding && (first.pairs.size() != 1 ||
+                                     !std::binary_search(reference.pairs.begin(),
+                                                         reference.pairs.end(), first.pairs[0]))) {
         disagree(p, m, "first-hit pair is not an intersecting pair");
       }
       const CollideResult all = models_a[m]->collide(*models_b[m], poses[p], {.all_pairs = true});
       if (all.pairs != reference.pairs) {
-        disagree(p, m, "all-pairs list differs: " + std::to_string(all.pairs.size()) + " vs brute " +
-                           std::to_string(reference.pairs.size()));
+        disagree(p, m,
+                 "all-pairs list differs: " + std::to_string(all.pairs.size()) + " vs brute " +
+                     std::to_string(reference.pairs.size()));
       }
     }
   }
@@ -277,13 +281,16 @@ TEST(Hierarchies, ParallelQueriesEqualSerialAtAnyThreadCount) {
       const std::string name(method_name(models_a[m]->method()));
       int colliding = 0;
       for (std::size_t p = 0; p < poses.size(); ++p) {
-        const CollideResult reference = models_a[m]->collide(*models_b[m], poses[p], {.all_pairs = true});
+        const CollideResult reference =
+            models_a[m]->collide(*models_b[m], poses[p], {.all_pairs = true});
         colliding += reference.colliding;
-        const CollideResult all = models_a[m]->collide_parallel(*models_b[m], poses[p], {.all_pairs = true}, *tasks);
+        const CollideResult all =
+            models_a[m]->collide_parallel(*models_b[m], poses[p], {.all_pairs = true}, *tasks);
         EXPECT_EQ(all.pairs, reference.pairs) << name;
         EXPECT_EQ(all.stats.volume_tests, reference.stats.volume_tests) << name;
         EXPECT_EQ(all.stats.triangle_tests, reference.stats.triangle_tests) << name;
-        const CollideResult first = models_a[m]->collide_parallel(*models_b[m], poses[p], {}, *tasks);
+        const CollideResult first =
+            models_a[m]->collide_parallel(*models_b[m], poses[p], {}, *tasks);
         EXPECT_EQ(first.colliding, reference.colliding) << name;
         if (threads == 1) {
           first_serial.push_back(first);

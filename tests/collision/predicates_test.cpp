@@ -9,8 +9,8 @@
 #include <random>
 #include <vector>
 
-#include "predicates_inline.h"
 #include "../support/random_geometry.h"
+#include "predicates_inline.h"
 
 namespace dovetail::collision {
 namespace {

@@ -19,7 +19,8 @@ TEST(TaskSystem, EveryIndexExactlyOnceAtAnyThreadCount) {
           EXPECT_LE(end - begin, grain);
           for (std::size_t i = begin; i < end; ++i) hits[i].fetch_add(1);
         });
-        for (std::size_t i = 0; i < count; ++i) ASSERT_EQ(hits[i].load(), 1) << threads << " " << count;
+        for (std::size_t i = 0; i < count; ++i)
+          ASSERT_EQ(hits[i].load(), 1) << threads << " " << count;
       }
     }
   }

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "dovetail/collision/predicates.h"
 #include "../support/random_geometry.h"
+#include "dovetail/collision/predicates.h"
 
 namespace dovetail::collision {
 namespace {

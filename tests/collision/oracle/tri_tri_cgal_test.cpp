@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
+#include "../../support/random_geometry.h"
 #include "dovetail/collision/predicates.h"
 #include "dovetail/collision/tri_tri.h"
-#include "../../support/random_geometry.h"
 
 namespace dovetail::collision {
 namespace {

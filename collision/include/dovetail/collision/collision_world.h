@@ -93,15 +93,15 @@ struct StepStats {
   std::size_t cached_planes = 0;     ///< ... with last frame's plane
   std::size_t polygon_pairs = 0;     ///< pairs decided at the polygon level
   std::size_t colliding_pairs = 0;
-  CollideStats polygon;              ///< volume and triangle tests
+  CollideStats polygon;  ///< volume and triangle tests
 };
 
 /// Result of a step: deterministic, the same bits for any thread count.
 struct StepResult {
-  std::vector<Contact> contacts;   ///< sorted by (a, b, triangle_a, triangle_b)
-  std::vector<PartPair> colliding; ///< sorted pairs in contact
-  std::vector<PartPair> began;     ///< in contact now, not at the last step
-  std::vector<PartPair> ended;     ///< in contact at the last step, not now
+  std::vector<Contact> contacts;    ///< sorted by (a, b, triangle_a, triangle_b)
+  std::vector<PartPair> colliding;  ///< sorted pairs in contact
+  std::vector<PartPair> began;      ///< in contact now, not at the last step
+  std::vector<PartPair> ended;      ///< in contact at the last step, not now
   StepStats stats;
 };
 

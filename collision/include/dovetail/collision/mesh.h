@@ -31,7 +31,7 @@ struct Mesh {
 struct MeshLimits {
   std::size_t max_vertices = std::size_t{1} << 26;   ///< 67,108,864
   std::size_t max_triangles = std::size_t{1} << 26;  ///< 67,108,864
-  Real max_abs_coordinate = 1e30;  ///< keeps exact predicates free of overflow
+  Real max_abs_coordinate = 1e30;                    ///< keeps exact predicates free of overflow
 };
 
 /// What validation found and repaired.

@@ -32,10 +32,10 @@ std::span<const Method> all_methods();
 
 /// Shape and size of a built hierarchy.
 struct ModelInfo {
-  std::size_t nodes = 0;   ///< all nodes, leaves included
+  std::size_t nodes = 0;  ///< all nodes, leaves included
   std::size_t leaves = 0;
-  std::size_t depth = 0;   ///< longest root-to-leaf path, root = 1
-  std::size_t bytes = 0;   ///< memory of the hierarchy itself (not the mesh)
+  std::size_t depth = 0;  ///< longest root-to-leaf path, root = 1
+  std::size_t bytes = 0;  ///< memory of the hierarchy itself (not the mesh)
   double bytes_per_triangle = 0.0;
 };
 
