@@ -79,15 +79,6 @@ class LeafTester {
 
   bool done() const { return done_; }
 
-  /// Tests triangle `ia` of A against triangle `ib` of B (B's vertices brought
-  /// into A's frame with Transform::apply, as every method does).
-  void test(std::uint32_t ia, std::uint32_t ib) {
-    const TriangleIndices& tb = b_.triangles[ib];
-    const std::array<Vec3, 3> b = {X_AB_.apply(b_.vertices[tb[0]]), X_AB_.apply(b_.vertices[tb[1]]),
-                                   X_AB_.apply(b_.vertices[tb[2]])};
-    test_transformed(ia, ib, b);
-  }
-
   /// Tests every triangle of one leaf against every triangle of another; B's
   /// triangles are transformed once per leaf pair.
   void test_leaves(const std::uint32_t* tris_a, int count_a, const std::uint32_t* tris_b,
