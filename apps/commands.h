@@ -19,5 +19,7 @@ int poses_command(std::span<const std::string> args);
 int run_command(std::span<const std::string> args);
 /// `dovetail broadphase --boxes FILE ...`: overlapping box pairs, frame by frame.
 int broadphase_command(std::span<const std::string> args);
+/// `dovetail render INPUT --out PNG ...`: draws a mesh or assembly file to PNG.
+int render_command(std::span<const std::string> args);
 
 }  // namespace dovetail::cli

@@ -31,6 +31,7 @@ commands:
   poses     write a contact-distance pose list for two meshes
   run       the built-in job: every method against brute force
   broadphase  overlapping pairs of moving boxes, frame by frame
+  render    draw a mesh or assembly file to PNG
   version   print the version
 
 'dovetail <command> --help' describes a command.
@@ -59,6 +60,7 @@ constexpr Command kCommands[] = {
     {"poses", dovetail::cli::poses_command},
     {"run", dovetail::cli::run_command},
     {"broadphase", dovetail::cli::broadphase_command},
+    {"render", dovetail::cli::render_command},
     {"version", version_command},
 };
 

@@ -1,0 +1,179 @@
+#pragma once
+/// \file scene.h
+/// The scene/object layer: named parts with tags, a parent/child transform
+/// hierarchy, static or movable parts, and per part a render mesh and a
+/// collision mesh; and assembly import, one part per mesh node of a file.
+///
+/// Why: everything above the collision layer (scripts, the hand, reports)
+/// speaks of parts by name. The scene owns those names and the hierarchy, so
+/// a sub-assembly moves as one: a part's world pose is its parent's world
+/// pose times its local pose, X_WC = X_WP * X_PC. Parts are flat arrays
+/// addressed by PartHandle (index + generation), never by pointer; meshes are
+/// shared (`shared_ptr<const Mesh>`) between instances of the same geometry.
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "dovetail/collision/mesh.h"
+#include "dovetail/collision/types.h"
+#include "dovetail/engine/mesh_import.h"
+
+namespace dovetail::engine {
+
+using collision::Transform;
+
+/// Thrown for a misuse of the scene: a duplicate, empty or unknown part
+/// name, a stale handle, a cycle in the hierarchy. what() names the part.
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Identifies a part of a Scene: slot index and generation, so a handle of a
+/// removed part is recognised as stale.
+struct PartHandle {
+  std::uint32_t index = std::numeric_limits<std::uint32_t>::max();
+  std::uint32_t generation = 0;
+  /// Whether the handle refers to some part (it may still be stale).
+  bool valid() const { return index != std::numeric_limits<std::uint32_t>::max(); }
+  friend bool operator==(const PartHandle&, const PartHandle&) = default;
+  friend auto operator<=>(const PartHandle&, const PartHandle&) = default;
+};
+
+/// A part to add to a scene.
+struct PartDesc {
+  std::string name{};               ///< unique in the scene, not empty
+  std::vector<std::string> tags{};  ///< free labels ("fastener", "housing")
+  std::string parent{};             ///< name of the parent part; empty: the world
+  Transform X_PC{};                 ///< local pose: the part in its parent's frame
+  bool movable = true;              ///< false: fixed; pairs of two fixed parts are never tested
+  /// Geometry to draw; may be null for a group (a sub-assembly node).
+  std::shared_ptr<const collision::Mesh> render_mesh{};
+  /// Geometry for collisions; null: the render mesh.
+  std::shared_ptr<const collision::Mesh> collision_mesh{};
+};
+
+/// Named parts in a transform hierarchy.
+class Scene {
+ public:
+  /// Adds a part. Throws SceneError for an empty or duplicate name or an
+  /// unknown parent.
+  PartHandle add_part(const PartDesc& desc);
+  /// Removes a part; its children become children of its parent, keeping
+  /// their world poses. Throws SceneError for a stale handle.
+  void remove_part(PartHandle part);
+
+  /// The part named `name`, or an invalid handle.
+  PartHandle find(std::string_view name) const;
+  /// The part named `name`; throws SceneError naming it when there is none.
+  PartHandle get(std::string_view name) const;
+  /// Whether `part` refers to a live part.
+  bool contains(PartHandle part) const;
+
+  /// All live parts, in name order (the deterministic order of the scene).
+  std::vector<PartHandle> parts() const;
+  /// Live parts carrying `tag`, in name order.
+  std::vector<PartHandle> parts_with_tag(std::string_view tag) const;
+  std::size_t part_count() const { return count_; }
+
+  const std::string& name(PartHandle part) const;
+  const std::vector<std::string>& tags(PartHandle part) const;
+  bool has_tag(PartHandle part, std::string_view tag) const;
+  void add_tag(PartHandle part, const std::string& tag);
+
+  /// The parent, or an invalid handle for a part placed in the world.
+  PartHandle parent(PartHandle part) const;
+  /// Direct children, in name order.
+  std::vector<PartHandle> children(PartHandle part) const;
+  /// Re-parents `part` (an invalid `parent` means the world). With
+  /// keep_world_pose the local pose is changed so the part stays where it
+  /// is; otherwise the local pose is kept. Throws SceneError on a cycle.
+  void set_parent(PartHandle part, PartHandle parent, bool keep_world_pose = true);
+
+  /// X_PC, the part in its parent's frame (the world's for a root part).
+  const Transform& local_pose(PartHandle part) const;
+  void set_local_pose(PartHandle part, const Transform& X_PC);
+  void set_local_pose(std::string_view name, const Transform& X_PC) {
+    set_local_pose(get(name), X_PC);
+  }
+  /// X_WP = X_W(parent) * X_PC, composed from the root down.
+  Transform world_pose(PartHandle part) const;
+  Transform world_pose(std::string_view name) const { return world_pose(get(name)); }
+  /// Sets the local pose so that the world pose becomes X_WP.
+  void set_world_pose(PartHandle part, const Transform& X_WP);
+
+  bool movable(PartHandle part) const;
+  void set_movable(PartHandle part, bool movable);
+
+  const std::shared_ptr<const collision::Mesh>& render_mesh(PartHandle part) const;
+  /// The collision mesh (the render mesh unless another was given); may be null.
+  const std::shared_ptr<const collision::Mesh>& collision_mesh(PartHandle part) const;
+
+ private:
+  struct Slot {
+    std::uint32_t generation = 0;
+    bool alive = false;
+    std::string name;
+    std::vector<std::string> tags;
+    PartHandle parent;
+    Transform X_PC;
+    bool movable = true;
+    std::shared_ptr<const collision::Mesh> render_mesh;
+    std::shared_ptr<const collision::Mesh> collision_mesh;
+  };
+  const Slot& slot(PartHandle part) const;
+  Slot& slot(PartHandle part);
+
+  std::vector<Slot> slots_;
+  std::vector<std::uint32_t> free_;
+  /// (name, index) sorted by name: lookups by binary search, iteration in name order.
+  std::vector<std::pair<std::string, std::uint32_t>> by_name_;
+  std::size_t count_ = 0;
+};
+
+/// X_AC = X_AB * X_BC.
+Transform compose(const Transform& X_AB, const Transform& X_BC);
+
+/// How to load an assembly file.
+struct AssemblyOptions {
+  /// Limits passed to the importer (merge and part_frames are set by the loader).
+  collision::MeshLimits limits;
+  /// Metres per file unit; 0: inferred (see docs/engine.md: a file whose
+  /// bounding box is larger than kMillimetreThreshold along some axis is in
+  /// millimetres, otherwise in metres).
+  double units = 0;
+  bool movable = true;            ///< movable flag of every loaded part
+  std::vector<std::string> tags;  ///< tags given to every loaded part
+};
+
+/// A bounding box larger than this (in file units) along some axis means the
+/// file is in millimetres, when the units are not declared.
+inline constexpr double kMillimetreThreshold = 100.0;
+
+/// What loading an assembly did and noticed.
+struct AssemblyReport {
+  double units = 1;             ///< metres per file unit used
+  bool units_inferred = false;  ///< true when AssemblyOptions::units was 0
+  std::size_t parts = 0;
+  std::size_t triangles = 0;
+  std::size_t shared_meshes = 0;  ///< parts that reuse another part's mesh
+  std::size_t skipped_line_or_point_primitives = 0;
+  std::vector<std::string> notes;  ///< from the importer and the loader
+};
+
+/// Loads `path` as a scene: one part per mesh instance of every node, named
+/// as the importer names them (unique), placed at the node's pose in the
+/// file's root frame (a flat list: intermediate nodes are folded into the
+/// parts' poses), scaled to metres. Identical meshes are shared. Throws
+/// ImportError naming the file for anything import_file refuses.
+Scene load_assembly(const std::filesystem::path& path, const AssemblyOptions& options = {},
+                    AssemblyReport* report = nullptr);
+
+}  // namespace dovetail::engine

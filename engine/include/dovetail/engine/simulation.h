@@ -1,0 +1,163 @@
+#pragma once
+/// \file simulation.h
+/// The fixed-step simulation loop over a Scene and a collision::CollisionWorld.
+///
+/// Why: one frame runs the same stages in the same order every time (see
+/// DESIGN.md, "One frame, in order"): queued actions and the frame hook
+/// (where input, hand and interaction plug in), commit of the poses,
+/// collision pipeline, events, output. Simulated time is frame * time step,
+/// never wall time, so a headless run goes as fast as it can and gives the
+/// same report on any machine and at any thread count.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "dovetail/collision/collision_world.h"
+#include "dovetail/engine/events.h"
+#include "dovetail/engine/report.h"
+#include "dovetail/engine/scene.h"
+
+namespace dovetail::engine {
+
+/// Loop settings.
+struct SimulationSettings {
+  double time_step = 1.0 / 90.0;  ///< seconds per frame (90 Hz)
+  int collision_threads = 1;      ///< worker threads of the pipeline; 0 = all cores
+  collision::Method method = collision::Method::kObb;
+  collision::BroadphaseMethod broadphase = collision::BroadphaseMethod::kSweepAndPrune;
+  bool convex_level = true;
+  /// Whether part_moved events go into the report's timeline (they are
+  /// always delivered to subscribers). Off by default: a moving part gives one per frame.
+  bool timeline_part_moved = false;
+};
+
+/// "Set part X's local pose at frame k": applied at the start of frame k, in
+/// the order the commands were queued.
+struct PoseCommand {
+  std::uint64_t frame = 0;
+  std::string part{};
+  Transform X_PC{};  ///< the new local pose
+};
+
+/// An axis-aligned box in the world frame.
+struct Box {
+  collision::Vec3 min = collision::Vec3::Zero();
+  collision::Vec3 max = collision::Vec3::Zero();
+};
+
+/// A named region: parts whose world box overlaps it are inside (touching
+/// counts); entering and leaving are events.
+struct Region {
+  std::string name{};
+  Box box{};
+  /// Only these parts (by name); empty: every part with a collision mesh.
+  std::vector<std::string> parts{};
+};
+
+/// What one frame did.
+struct FrameResult {
+  std::uint64_t frame = 0;    ///< the frame just simulated
+  double time = 0;            ///< its simulated time
+  std::vector<Event> events;  ///< in delivery order
+  std::uint64_t state_hash = 0;
+  collision::StepStats collision{};
+};
+
+/// Runs a scene frame by frame.
+class Simulation {
+ public:
+  /// Called at the start of each frame, after the queued pose commands and
+  /// before the commit: the place for input, hand and interaction.
+  using FrameHook = std::function<void(Simulation&, std::uint64_t frame, double time)>;
+
+  explicit Simulation(Scene scene, const SimulationSettings& settings = {});
+  ~Simulation();
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+  Simulation(Simulation&&) noexcept;
+  Simulation& operator=(Simulation&&) noexcept;
+
+  /// The scene; changes made between frames are committed by the next frame
+  /// (parts added or removed there are added to or removed from the collision world).
+  Scene& scene() { return scene_; }
+  const Scene& scene() const { return scene_; }
+  EventBus& events() { return bus_; }
+  const SimulationSettings& settings() const { return settings_; }
+
+  /// Queues a pose command; throws SceneError for an unknown part (and step()
+  /// throws it at frame k if the part was removed by then).
+  void queue_pose(const PoseCommand& command);
+  void set_frame_hook(FrameHook hook) { hook_ = std::move(hook); }
+  /// A timer firing in the first frame whose time reaches `time`.
+  void add_timer(const std::string& name, double time);
+  /// Adds a region; throws SceneError for a duplicate name or an unknown part.
+  void add_region(const Region& region);
+
+  /// Simulates one frame, paused or not.
+  const FrameResult& step();
+  /// Simulates up to `frames` frames; stops early when paused (a subscriber
+  /// may pause). With progress, shows a ProgressMeter on stderr. Returns the
+  /// frames simulated.
+  std::uint64_t run(std::uint64_t frames, bool progress = false);
+  void set_paused(bool paused) { paused_ = paused; }
+  bool paused() const { return paused_; }
+
+  /// Frames simulated so far; the next frame's number.
+  std::uint64_t frame() const { return frame_; }
+  /// Simulated time of the next frame.
+  double time() const { return static_cast<double>(frame_) * settings_.time_step; }
+  /// state_hash of the scene after the last frame (of the initial scene before any).
+  std::uint64_t state_hash() const { return state_hash_; }
+  const FrameResult& last_frame() const { return last_; }
+  /// The report so far (timeline, contact statistics, state hash, timings).
+  const Report& report() const { return report_; }
+
+  /// The collision world, for settings such as interest and levels of detail.
+  collision::CollisionWorld& collision_world() { return *world_; }
+  /// The collision id of a part, or an invalid id when it has no collision mesh.
+  collision::PartId collision_id(PartHandle part) const;
+
+ private:
+  struct Registered;
+  void commit(std::vector<Event>& events, double now);
+  void contact_events(const collision::StepResult& step, std::vector<Event>& events, double now);
+  void timer_events(std::vector<Event>& events, double now);
+  void region_events(std::vector<Event>& events, double now);
+
+  Scene scene_;
+  SimulationSettings settings_;
+  std::unique_ptr<collision::CollisionWorld> world_;
+  EventBus bus_;
+  FrameHook hook_;
+  std::vector<PoseCommand> commands_;  ///< sorted by frame, stable
+  struct Timer {
+    std::string name;
+    double time = 0;
+    bool fired = false;
+  };
+  std::vector<Timer> timers_;
+  struct RegionState {
+    Region region;
+    std::vector<std::string> inside;  ///< sorted part names inside now
+  };
+  std::vector<RegionState> regions_;
+  /// Per scene slot: the registered part, if any.
+  std::vector<std::unique_ptr<Registered>> registered_;
+  /// The scene name of every part in the collision world.
+  std::map<collision::PartId, std::string> collision_names_;
+  std::vector<collision::PartId> removed_;  ///< removed since the last collision step
+  /// Contact statistics by (a, b) names.
+  std::map<std::pair<std::string, std::string>, PairContactStats> contact_stats_;
+  std::uint64_t frame_ = 0;
+  bool paused_ = false;
+  std::uint64_t state_hash_ = 0;
+  FrameResult last_;
+  Report report_;
+};
+
+}  // namespace dovetail::engine

@@ -1,0 +1,65 @@
+#include "dovetail/engine/events.h"
+
+#include <algorithm>
+#include <tuple>
+
+namespace dovetail::engine {
+
+std::string_view event_kind_name(EventKind kind) {
+  switch (kind) {
+    case EventKind::kTimer:
+      return "timer";
+    case EventKind::kPartMoved:
+      return "part_moved";
+    case EventKind::kContactBegin:
+      return "contact_begin";
+    case EventKind::kContactEnd:
+      return "contact_end";
+    case EventKind::kRegionEnter:
+      return "region_enter";
+    case EventKind::kRegionLeave:
+      return "region_leave";
+    case EventKind::kGrasp:
+      return "grasp";
+    case EventKind::kRelease:
+      return "release";
+    case EventKind::kSlideBegin:
+      return "slide_begin";
+    case EventKind::kSlideEnd:
+      return "slide_end";
+    case EventKind::kMate:
+      return "mate";
+  }
+  return "unknown";
+}
+
+bool event_less(const Event& x, const Event& y) {
+  return std::tie(x.frame, x.kind, x.a, x.b) < std::tie(y.frame, y.kind, y.a, y.b);
+}
+
+EventBus::SubscriptionId EventBus::subscribe(EventKind kind, Handler handler) {
+  subscriptions_.push_back({next_id_, false, kind, std::move(handler)});
+  return next_id_++;
+}
+
+EventBus::SubscriptionId EventBus::subscribe_all(Handler handler) {
+  subscriptions_.push_back({next_id_, true, EventKind::kTimer, std::move(handler)});
+  return next_id_++;
+}
+
+void EventBus::unsubscribe(SubscriptionId id) {
+  std::erase_if(subscriptions_, [id](const Subscription& s) { return s.id == id; });
+}
+
+void EventBus::publish(std::vector<Event>& events) {
+  std::sort(events.begin(), events.end(), event_less);
+  // A handler may subscribe or unsubscribe; deliver to a snapshot.
+  const std::vector<Subscription> current = subscriptions_;
+  for (const Event& event : events) {
+    for (const Subscription& s : current) {
+      if (s.all || s.kind == event.kind) s.handler(event);
+    }
+  }
+}
+
+}  // namespace dovetail::engine

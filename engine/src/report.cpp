@@ -1,0 +1,214 @@
+#include "dovetail/engine/report.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+
+#include "dovetail/engine/scene.h"
+
+namespace dovetail::engine {
+
+namespace {
+
+/// Shortest text that reads back to the same double.
+std::string number(double value) {
+  char buffer[32];
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(buffer, sizeof(buffer), "%.*g", digits, value);
+    if (std::strtod(buffer, nullptr) == value) break;
+  }
+  return buffer;
+}
+
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char escape[8];
+          std::snprintf(escape, sizeof(escape), "\\u%04x", static_cast<unsigned>(c));
+          out += escape;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string hex(std::uint64_t value) {
+  char buffer[24];
+  std::snprintf(buffer, sizeof(buffer), "0x%016llx", static_cast<unsigned long long>(value));
+  return buffer;
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  out.flush();
+  if (!out) throw std::runtime_error(path.string() + ": cannot be written");
+}
+
+void hash_bytes(std::uint64_t& hash, const void* data, std::size_t size) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < size; ++i) {
+    hash ^= bytes[i];
+    hash *= 0x100000001b3ull;
+  }
+}
+
+void hash_double(std::uint64_t& hash, double value) {
+  std::uint64_t bits = std::bit_cast<std::uint64_t>(value);
+  unsigned char bytes[8];
+  for (int i = 0; i < 8; ++i) bytes[i] = static_cast<unsigned char>(bits >> (8 * i));
+  hash_bytes(hash, bytes, 8);
+}
+
+double seconds_now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+std::uint64_t state_hash(const Scene& scene) {
+  std::uint64_t hash = kFnvOffset;
+  for (const PartHandle part : scene.parts()) {
+    const std::string& name = scene.name(part);
+    hash_bytes(hash, name.data(), name.size() + 1);  // with the terminating 0
+    const Transform X_WP = scene.world_pose(part);
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) hash_double(hash, X_WP.R(r, c));
+    }
+    for (int k = 0; k < 3; ++k) hash_double(hash, X_WP.t(k));
+  }
+  return hash;
+}
+
+std::string Report::timings_json() const {
+  std::vector<double> totals;
+  double collision_sum = 0, total_sum = 0;
+  for (const FrameTiming& t : timings) {
+    totals.push_back(t.total_ms);
+    collision_sum += t.collision_ms;
+    total_sum += t.total_ms;
+  }
+  std::sort(totals.begin(), totals.end());
+  const double median = totals.empty() ? 0 : totals[totals.size() / 2];
+  std::string out = "{\n    \"frames\": " + std::to_string(timings.size()) +
+                    ",\n    \"total_ms\": " + number(total_sum) +
+                    ",\n    \"collision_ms\": " + number(collision_sum) +
+                    ",\n    \"frame_ms_median\": " + number(median) + ",\n    \"per_frame\": [";
+  for (std::size_t i = 0; i < timings.size(); ++i) {
+    out += i == 0 ? "\n      " : ",\n      ";
+    out += "{\"frame\": " + std::to_string(i) +
+           ", \"collision_ms\": " + number(timings[i].collision_ms) +
+           ", \"total_ms\": " + number(timings[i].total_ms) + "}";
+  }
+  out += timings.empty() ? "]\n  }" : "\n    ]\n  }";
+  return out;
+}
+
+std::string Report::to_json(bool with_timings) const {
+  std::string out = "{\n";
+  out += "  \"format\": \"dovetail-report\",\n";
+  out += "  \"version\": 1,\n";
+  out += "  \"time_step\": " + number(time_step) + ",\n";
+  out += "  \"frames\": " + std::to_string(frames) + ",\n";
+  out += "  \"time\": " + number(static_cast<double>(frames) * time_step) + ",\n";
+  out += "  \"parts\": " + std::to_string(parts) + ",\n";
+  out += "  \"state_hash\": \"" + hex(state_hash) + "\",\n";
+  out += "  \"events\": [";
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const Event& e = events[i];
+    out += i == 0 ? "\n    " : ",\n    ";
+    out += "{\"frame\": " + std::to_string(e.frame) + ", \"time\": " + number(e.time) +
+           ", \"kind\": " + quoted(std::string(event_kind_name(e.kind))) +
+           ", \"a\": " + quoted(e.a);
+    if (!e.b.empty()) out += ", \"b\": " + quoted(e.b);
+    out += "}";
+  }
+  out += events.empty() ? "],\n" : "\n  ],\n";
+  out += "  \"contacts\": [";
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    const PairContactStats& c = contacts[i];
+    out += i == 0 ? "\n    " : ",\n    ";
+    out += "{\"a\": " + quoted(c.a) + ", \"b\": " + quoted(c.b) +
+           ", \"frames_in_contact\": " + std::to_string(c.frames_in_contact) +
+           ", \"first_frame\": " + std::to_string(c.first_frame) +
+           ", \"last_frame\": " + std::to_string(c.last_frame) +
+           ", \"max_contacts\": " + std::to_string(c.max_contacts) + "}";
+  }
+  out += contacts.empty() ? "]" : "\n  ]";
+  if (with_timings) out += ",\n  \"timings\": " + timings_json();
+  out += "\n}\n";
+  return out;
+}
+
+void Report::write_json(const std::filesystem::path& path, bool with_timings) const {
+  write_text(path, to_json(with_timings));
+}
+
+void Report::write_timings_json(const std::filesystem::path& path) const {
+  write_text(path, "{\n  \"timings\": " + timings_json() + "\n}\n");
+}
+
+ProgressMeter::ProgressMeter(std::uint64_t total, std::FILE* out)
+    : total_(total),
+      out_(out != nullptr ? out : stderr),
+      terminal_(isatty(fileno(out_)) != 0),
+      start_s_(seconds_now()) {}
+
+void ProgressMeter::update(std::uint64_t done) {
+  if (terminal_) {
+    const int percent = total_ == 0 ? 100 : static_cast<int>(done * 100 / total_);
+    if (percent == last_percent_) return;
+    last_percent_ = percent;
+    constexpr int kWidth = 40;
+    const int filled = percent * kWidth / 100;
+    std::fprintf(out_, "\r[%s%s] %3d%% frame %llu/%llu", std::string(filled, '#').c_str(),
+                 std::string(kWidth - filled, ' ').c_str(), percent,
+                 static_cast<unsigned long long>(done), static_cast<unsigned long long>(total_));
+    std::fflush(out_);
+    return;
+  }
+  constexpr double kEverySeconds = 5.0;
+  const double now = seconds_now();
+  if (last_print_s_ < 0) last_print_s_ = start_s_;
+  if (now - last_print_s_ < kEverySeconds) return;
+  last_print_s_ = now;
+  std::fprintf(out_, "frame %llu/%llu\n", static_cast<unsigned long long>(done),
+               static_cast<unsigned long long>(total_));
+  std::fflush(out_);
+}
+
+void ProgressMeter::finish() {
+  if (terminal_) {
+    last_percent_ = -1;
+    update(total_);
+    std::fputc('\n', out_);
+  } else {
+    std::fprintf(out_, "frame %llu/%llu done\n", static_cast<unsigned long long>(total_),
+                 static_cast<unsigned long long>(total_));
+  }
+  std::fflush(out_);
+}
+
+}  // namespace dovetail::engine

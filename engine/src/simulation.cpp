@@ -1,0 +1,292 @@
+#include "dovetail/engine/simulation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <utility>
+
+namespace dovetail::engine {
+
+using collision::PartId;
+using collision::Vec3;
+
+/// A scene part as the loop last committed it.
+struct Simulation::Registered {
+  PartHandle handle;
+  PartId id;  ///< invalid for a part without a collision mesh
+  Transform X_WP;
+  Box local_box;  ///< bounds of the collision mesh in the part's frame
+};
+
+namespace {
+
+bool same_bits(const Transform& x, const Transform& y) {
+  return std::memcmp(x.R.data(), y.R.data(), sizeof(double) * 9) == 0 &&
+         std::memcmp(x.t.data(), y.t.data(), sizeof(double) * 3) == 0;
+}
+
+/// World box of a local box under X_WP: the bounds of its 8 transformed corners.
+Box world_box(const Box& local, const Transform& X_WP) {
+  Box out{Vec3::Constant(INFINITY), Vec3::Constant(-INFINITY)};
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vec3 p(corner & 1 ? local.max.x() : local.min.x(),
+                 corner & 2 ? local.max.y() : local.min.y(),
+                 corner & 4 ? local.max.z() : local.min.z());
+    const Vec3 p_W = X_WP.apply(p);
+    out.min = out.min.cwiseMin(p_W);
+    out.max = out.max.cwiseMax(p_W);
+  }
+  return out;
+}
+
+bool overlap(const Box& x, const Box& y) {
+  return (x.min.array() <= y.max.array()).all() && (y.min.array() <= x.max.array()).all();
+}
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+Simulation::Simulation(Scene scene, const SimulationSettings& settings)
+    : scene_(std::move(scene)), settings_(settings) {
+  if (!(settings_.time_step > 0) || !std::isfinite(settings_.time_step)) {
+    throw std::invalid_argument("simulation: the time step must be a positive number of seconds");
+  }
+  world_ = std::make_unique<collision::CollisionWorld>(
+      collision::WorldSettings{.method = settings_.method,
+                               .broadphase = settings_.broadphase,
+                               .convex_level = settings_.convex_level,
+                               .threads = settings_.collision_threads});
+  std::vector<Event> ignored;
+  commit(ignored, 0);
+  state_hash_ = engine::state_hash(scene_);
+  report_.time_step = settings_.time_step;
+  report_.parts = scene_.part_count();
+  report_.state_hash = state_hash_;
+}
+
+Simulation::~Simulation() = default;
+Simulation::Simulation(Simulation&&) noexcept = default;
+Simulation& Simulation::operator=(Simulation&&) noexcept = default;
+
+collision::PartId Simulation::collision_id(PartHandle part) const {
+  if (!part.valid() || part.index >= registered_.size() || !registered_[part.index] ||
+      registered_[part.index]->handle != part) {
+    return {};
+  }
+  return registered_[part.index]->id;
+}
+
+void Simulation::queue_pose(const PoseCommand& command) {
+  scene_.get(command.part);  // unknown names fail now, not at frame k
+  const auto at =
+      std::upper_bound(commands_.begin(), commands_.end(), command.frame,
+                       [](std::uint64_t frame, const PoseCommand& c) { return frame < c.frame; });
+  commands_.insert(at, command);
+}
+
+void Simulation::add_timer(const std::string& name, double time) {
+  timers_.push_back({name, time, false});
+}
+
+void Simulation::add_region(const Region& region) {
+  for (const RegionState& r : regions_) {
+    if (r.region.name == region.name) {
+      throw SceneError("simulation: duplicate region name '" + region.name + "'");
+    }
+  }
+  for (const std::string& part : region.parts) scene_.get(part);
+  regions_.push_back({region, {}});
+}
+
+void Simulation::commit(std::vector<Event>& events, double now) {
+  // Parts gone from the scene leave the collision world.
+  for (std::unique_ptr<Registered>& r : registered_) {
+    if (r && !scene_.contains(r->handle)) {
+      if (r->id.valid()) {
+        world_->remove_part(r->id);
+        removed_.push_back(r->id);
+      }
+      r.reset();
+    }
+  }
+  for (const PartHandle part : scene_.parts()) {
+    const Transform X_WP = scene_.world_pose(part);
+    if (part.index >= registered_.size()) registered_.resize(part.index + 1);
+    std::unique_ptr<Registered>& r = registered_[part.index];
+    if (!r) {
+      r = std::make_unique<Registered>();
+      r->handle = part;
+      r->X_WP = X_WP;
+      const auto& mesh = scene_.collision_mesh(part);
+      if (mesh) {
+        r->id = world_->add_part({.mesh = mesh,
+                                  .X_WP = X_WP,
+                                  .movable = scene_.movable(part),
+                                  .level = collision::LevelOfDetail::kExact,
+                                  .name = scene_.name(part)});
+        collision_names_[r->id] = scene_.name(part);
+        const collision::Bounds b = collision::mesh_bounds(*mesh);
+        r->local_box = {b.min, b.max};
+      }
+      continue;
+    }
+    if (same_bits(r->X_WP, X_WP)) continue;
+    r->X_WP = X_WP;
+    if (r->id.valid()) world_->set_pose(r->id, X_WP);
+    events.push_back({EventKind::kPartMoved, frame_, now, scene_.name(part), {}});
+  }
+}
+
+void Simulation::contact_events(const collision::StepResult& step, std::vector<Event>& events,
+                                double now) {
+  auto names = [this](const collision::PartPair& pair) {
+    std::pair<std::string, std::string> n{collision_names_.at(pair.a), collision_names_.at(pair.b)};
+    if (n.second < n.first) std::swap(n.first, n.second);
+    return n;
+  };
+  for (const collision::PartPair& pair : step.began) {
+    auto [a, b] = names(pair);
+    events.push_back({EventKind::kContactBegin, frame_, now, std::move(a), std::move(b)});
+  }
+  for (const collision::PartPair& pair : step.ended) {
+    auto [a, b] = names(pair);
+    events.push_back({EventKind::kContactEnd, frame_, now, std::move(a), std::move(b)});
+  }
+  // Contacts are sorted by pair: count each pair's run.
+  std::size_t i = 0;
+  while (i < step.contacts.size()) {
+    const collision::PartPair pair{step.contacts[i].a, step.contacts[i].b};
+    std::size_t j = i;
+    while (j < step.contacts.size() && step.contacts[j].a == pair.a &&
+           step.contacts[j].b == pair.b) {
+      ++j;
+    }
+    const auto key = names(pair);
+    auto it = contact_stats_.find(key);
+    if (it == contact_stats_.end()) {
+      it = contact_stats_.emplace(key, PairContactStats{key.first, key.second}).first;
+      it->second.first_frame = frame_;
+    }
+    PairContactStats& s = it->second;
+    ++s.frames_in_contact;
+    s.last_frame = frame_;
+    s.max_contacts = std::max<std::uint64_t>(s.max_contacts, j - i);
+    i = j;
+  }
+}
+
+void Simulation::timer_events(std::vector<Event>& events, double now) {
+  for (Timer& timer : timers_) {
+    if (timer.fired || now < timer.time) continue;
+    timer.fired = true;
+    events.push_back({EventKind::kTimer, frame_, now, timer.name, {}});
+  }
+}
+
+void Simulation::region_events(std::vector<Event>& events, double now) {
+  for (RegionState& state : regions_) {
+    std::vector<std::string> inside;
+    auto test = [&](PartHandle part) {
+      if (!part.valid() || part.index >= registered_.size() || !registered_[part.index]) return;
+      const Registered& r = *registered_[part.index];
+      if (!r.id.valid()) return;
+      if (overlap(world_box(r.local_box, r.X_WP), state.region.box)) {
+        inside.push_back(scene_.name(part));
+      }
+    };
+    if (state.region.parts.empty()) {
+      for (const PartHandle part : scene_.parts()) test(part);
+    } else {
+      for (const std::string& name : state.region.parts) test(scene_.find(name));
+      std::sort(inside.begin(), inside.end());
+    }
+    std::vector<std::string> entered, left;
+    std::set_difference(inside.begin(), inside.end(), state.inside.begin(), state.inside.end(),
+                        std::back_inserter(entered));
+    std::set_difference(state.inside.begin(), state.inside.end(), inside.begin(), inside.end(),
+                        std::back_inserter(left));
+    for (std::string& part : entered) {
+      events.push_back({EventKind::kRegionEnter, frame_, now, std::move(part), state.region.name});
+    }
+    for (std::string& part : left) {
+      events.push_back({EventKind::kRegionLeave, frame_, now, std::move(part), state.region.name});
+    }
+    state.inside = std::move(inside);
+  }
+}
+
+const FrameResult& Simulation::step() {
+  const auto frame_start = std::chrono::steady_clock::now();
+  const double now = time();
+  std::vector<Event> events;
+
+  // 1-3. Actions queued for this frame, then input, hand and interaction.
+  auto due = commands_.begin();
+  while (due != commands_.end() && due->frame <= frame_) {
+    scene_.set_local_pose(due->part, due->X_PC);
+    ++due;
+  }
+  commands_.erase(commands_.begin(), due);
+  if (hook_) hook_(*this, frame_, now);
+
+  // 4. Commit the poses.
+  commit(events, now);
+
+  // 5. Collision pipeline.
+  const auto collision_start = std::chrono::steady_clock::now();
+  const collision::StepResult& result = world_->step();
+  const double collision_ms = ms_since(collision_start);
+
+  // 6. Events: differences from the last frame.
+  contact_events(result, events, now);
+  // Removed parts' pairs have ended now; their names are no longer needed.
+  for (const PartId id : removed_) collision_names_.erase(id);
+  removed_.clear();
+  timer_events(events, now);
+  region_events(events, now);
+
+  // 7. Subscribers react; what they change is committed by the next frame.
+  bus_.publish(events);
+
+  // 8. Output.
+  state_hash_ = engine::state_hash(scene_);
+  last_.frame = frame_;
+  last_.time = now;
+  last_.events = events;
+  last_.state_hash = state_hash_;
+  last_.collision = result.stats;
+  for (const Event& e : events) {
+    if (e.kind != EventKind::kPartMoved || settings_.timeline_part_moved) {
+      report_.events.push_back(e);
+    }
+  }
+  report_.contacts.clear();
+  for (const auto& [key, stats] : contact_stats_) report_.contacts.push_back(stats);
+  ++frame_;
+  report_.frames = frame_;
+  report_.parts = scene_.part_count();
+  report_.state_hash = state_hash_;
+  report_.timings.push_back({collision_ms, ms_since(frame_start)});
+  return last_;
+}
+
+std::uint64_t Simulation::run(std::uint64_t frames, bool progress) {
+  std::unique_ptr<ProgressMeter> meter;
+  if (progress) meter = std::make_unique<ProgressMeter>(frames);
+  std::uint64_t done = 0;
+  while (done < frames && !paused_) {
+    step();
+    ++done;
+    if (meter) meter->update(done);
+  }
+  if (meter) meter->finish();
+  return done;
+}
+
+}  // namespace dovetail::engine

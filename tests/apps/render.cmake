@@ -1,0 +1,59 @@
+# `dovetail render`: included from CMakeLists.txt, uses its dovetail_cli_test.
+
+set(render_engine
+    /usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb)
+set(render_keys "\"width\":160&&\"height\":120&&\"camera\":\"auto\"&&\"parts\":[1-9]&&\"triangles\":[1-9]")
+
+dovetail_cli_test(render_help EXIT 0 ARGS render --help
+                  STDOUT "^usage: dovetail render INPUT --out PNG&&--width&&--height&&--camera")
+dovetail_cli_test(render_listed EXIT 0 ARGS --help STDOUT "render ")
+
+# ---- results: a PNG of the asked size, the same bytes every time
+foreach(run first second)
+  dovetail_cli_test(render_engine_${run} EXIT 0
+                    ARGS render ${render_engine} --out ${out}/render_${run}.png --width 160
+                         --height 120
+                    STDOUT "^{[^\n]*}\n$&&${render_keys}" REMOVE ${out}/render_${run}.png)
+  set_tests_properties(cli.render_engine_${run} PROPERTIES FIXTURES_SETUP render_${run})
+endforeach()
+add_test(NAME cli.render_engine_png
+         COMMAND ${CMAKE_COMMAND} -DPNG=${out}/render_first.png -DWIDTH=160 -DHEIGHT=120
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/check_png.cmake)
+set_tests_properties(cli.render_engine_png PROPERTIES FIXTURES_REQUIRED render_first)
+add_test(NAME cli.render_engine_same_bytes
+         COMMAND ${CMAKE_COMMAND} -E compare_files ${out}/render_first.png
+                 ${out}/render_second.png)
+set_tests_properties(cli.render_engine_same_bytes PROPERTIES
+                     FIXTURES_REQUIRED "render_first;render_second")
+dovetail_cli_test(render_obj EXIT 0
+                  ARGS render ${cube} --out ${out}/render_cube.png --width 33 --height 17
+                       --camera auto
+                  STDOUT "\"parts\":1&&\"triangles\":12" REMOVE ${out}/render_cube.png)
+
+# ---- bad input, unwritable output: exit 1, the file named
+dovetail_cli_test(render_missing_input EXIT 1
+                  ARGS render ${data}/missing.glb --out ${out}/render_missing.png
+                  STDERR "^dovetail: [^\n]*missing.glb: file not found")
+dovetail_cli_test(render_bad_input EXIT 1
+                  ARGS render ${data}/nan_vertex.obj --out ${out}/render_nan.png
+                  STDERR "^dovetail: [^\n]*nan_vertex.obj: [^\n]*not finite")
+dovetail_cli_test(render_unwritable_out EXIT 1
+                  ARGS render ${cube} --out ${out}/no/such/folder/image.png
+                  STDERR "^dovetail: [^\n]*no/such/folder/image.png: cannot be written")
+dovetail_cli_test(render_out_is_directory EXIT 1
+                  ARGS render ${cube} --out ${out}
+                  STDERR "cli_out: cannot be written: is a directory")
+
+# ---- usage errors: exit 2
+dovetail_cli_test(render_missing_out EXIT 2 ARGS render ${cube} STDERR "missing --out")
+dovetail_cli_test(render_no_input EXIT 2 ARGS render --out ${out}/render_none.png
+                  STDERR "expected one mesh or assembly file")
+dovetail_cli_test(render_zero_width EXIT 2
+                  ARGS render ${cube} --out ${out}/render_zero.png --width 0 STDERR "--width")
+dovetail_cli_test(render_huge_height EXIT 2
+                  ARGS render ${cube} --out ${out}/render_huge.png --height 16385 STDERR "--height")
+dovetail_cli_test(render_unknown_camera EXIT 2
+                  ARGS render ${cube} --out ${out}/render_cam.png --camera top
+                  STDERR "no camera named 'top'")
+dovetail_cli_test(render_out_is_input EXIT 2 ARGS render ${cube} --out ${data}/../data/cube.obj
+                  STDERR "would be overwritten")
