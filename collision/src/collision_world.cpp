@@ -9,6 +9,7 @@
 
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/task_system.h"
+#include "dovetail/collision/tri_tri.h"
 #include "hierarchy_common.h"
 
 namespace dovetail::collision {
@@ -43,6 +44,10 @@ struct Part {
 struct PairState {
   SeparatingPlaneCache plane;
   GjkCache gjk;
+  /// First-hit mode: the triangle pair that intersected last step. Parts in
+  /// contact usually still touch there, which then decides the pair at once.
+  TrianglePair witness;
+  bool has_witness = false;
 };
 
 std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
@@ -193,13 +198,38 @@ struct CollisionWorld::Impl {
     return true;
   }
 
+  /// All intersecting triangle pairs, or only whether there is one.
+  CollideRequest polygon_request() const {
+    return {.all_pairs = settings.contacts == ContactDetail::kTriangles};
+  }
+
   /// The polygon level of one pair, in one piece.
   void evaluate_polygon(PairWork& w) {
     const Part& a = parts[w.a];
     const Part& b = parts[w.b];
-    w.result =
-        a.shape->model->collide(*b.shape->model, relative(a.X_WP, b.X_WP), {.all_pairs = true});
+    const Transform X_AB = relative(a.X_WP, b.X_WP);
+    const CollideRequest request = polygon_request();
+    if (!request.all_pairs && w.state->has_witness &&
+        witness_still_intersects(*a.shape->mesh, *b.shape->mesh, X_AB, w.state->witness)) {
+      w.result = CollideResult{.colliding = true, .pairs = {w.state->witness}, .stats = {0, 1}};
+      w.colliding = true;
+      return;
+    }
+    w.result = a.shape->model->collide(*b.shape->model, X_AB, request);
     w.colliding = w.result.colliding;
+    w.state->has_witness = !request.all_pairs && w.colliding;
+    if (w.state->has_witness) w.state->witness = w.result.pairs.front();
+  }
+
+  /// The exact test of last step's intersecting triangle pair at the new pose
+  /// (B's vertices mapped by Transform::apply, as the hierarchies do).
+  static bool witness_still_intersects(const Mesh& a, const Mesh& b, const Transform& X_AB,
+                                       const TrianglePair& t) {
+    const TriangleIndices& ta = a.triangles[t.a];
+    const TriangleIndices& tb = b.triangles[t.b];
+    return triangles_intersect(a.vertices[ta[0]], a.vertices[ta[1]], a.vertices[ta[2]],
+                               X_AB.apply(b.vertices[tb[0]]), X_AB.apply(b.vertices[tb[1]]),
+                               X_AB.apply(b.vertices[tb[2]]));
   }
 
   /// The polygon level of heavy pairs, each divided into parts, all parts of
@@ -211,7 +241,7 @@ struct CollisionWorld::Impl {
         const PairWork& w = work[heavy_pairs[q]];
         queries[q] = parts[w.a].shape->model->split(*parts[w.b].shape->model,
                                                     relative(parts[w.a].X_WP, parts[w.b].X_WP),
-                                                    {.all_pairs = true});
+                                                    polygon_request());
       }
     });
     std::vector<std::pair<std::uint32_t, std::uint32_t>> jobs;  // (query, part)
@@ -281,7 +311,10 @@ struct CollisionWorld::Impl {
     // 3. Decide the pairs in parallel over pairs (coarse grain); the polygon
     //    level of heavy pairs is deferred and then split over the threads one
     //    pair at a time (fine grain). Either way each pair's result is the same.
-    const bool split_heavy = tasks->thread_count() > 1;
+    // First-hit queries are not split: a divided query may do different work
+    // than an undivided one, and the counters must not depend on the threads.
+    const bool split_heavy =
+        tasks->thread_count() > 1 && settings.contacts == ContactDetail::kTriangles;
     std::vector<char> deferred(work.size(), 0);
     tasks->parallel_for(work.size(), 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
@@ -310,7 +343,7 @@ struct CollisionWorld::Impl {
       if (!w.colliding) continue;
       const PartPair pair{parts[w.a].id, parts[w.b].id};
       next.colliding.push_back(pair);
-      if (w.polygon) {
+      if (w.polygon && settings.contacts == ContactDetail::kTriangles) {
         for (const TrianglePair& t : w.result.pairs)
           next.contacts.push_back({pair.a, pair.b, t.a, t.b});
       } else {

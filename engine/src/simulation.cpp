@@ -61,7 +61,8 @@ Simulation::Simulation(Scene scene, const SimulationSettings& settings)
       collision::WorldSettings{.method = settings_.method,
                                .broadphase = settings_.broadphase,
                                .convex_level = settings_.convex_level,
-                               .threads = settings_.collision_threads});
+                               .threads = settings_.collision_threads,
+                               .contacts = settings_.contacts});
   std::vector<Event> ignored;
   commit(ignored, 0);
   state_hash_ = engine::state_hash(scene_);

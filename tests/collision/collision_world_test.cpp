@@ -251,3 +251,44 @@ TEST(CollisionWorld, HeavyPairsSplitOverThreadsGiveIdenticalResults) {
 
 }  // namespace
 }  // namespace dovetail::collision
+
+namespace dovetail::collision {
+namespace {
+
+TEST(CollisionWorld, PairDetailFindsTheSamePairsAtAnyThreadCount) {
+  // First-hit queries with last step's intersecting triangle pair tried first
+  // must decide every pair as the all-pairs queries do.
+  std::vector<std::vector<PartPair>> reference;
+  {
+    MovingScene scene(14, 5);
+    CollisionWorld world;
+    std::vector<PartId> ids;
+    for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+      ids.push_back(world.add_part({.mesh = scene.meshes[i], .X_WP = scene.poses[i]}));
+    }
+    for (int frame = 0; frame < 40; ++frame) {
+      for (std::size_t i = 0; i < ids.size(); ++i) world.set_pose(ids[i], scene.poses[i]);
+      reference.push_back(world.step().colliding);
+      scene.advance();
+    }
+  }
+  for (int threads : {1, 2, 8}) {
+    MovingScene scene(14, 5);
+    CollisionWorld world({.threads = threads, .contacts = ContactDetail::kPairs});
+    std::vector<PartId> ids;
+    for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+      ids.push_back(world.add_part({.mesh = scene.meshes[i], .X_WP = scene.poses[i]}));
+    }
+    for (int frame = 0; frame < 40; ++frame) {
+      for (std::size_t i = 0; i < ids.size(); ++i) world.set_pose(ids[i], scene.poses[i]);
+      const StepResult& r = world.step();
+      ASSERT_EQ(r.colliding, reference[frame]) << "threads " << threads << " frame " << frame;
+      ASSERT_EQ(r.contacts.size(), r.colliding.size());
+      for (const Contact& c : r.contacts) EXPECT_EQ(c.triangle_a, kNoTriangle);
+      scene.advance();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace dovetail::collision

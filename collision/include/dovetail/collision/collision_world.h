@@ -53,20 +53,31 @@ struct PartDef {
   std::string name{};
 };
 
+/// How much a step reports about each pair in contact.
+enum class ContactDetail : std::uint8_t {
+  /// Every intersecting triangle pair (contacts for sliding, highlighting).
+  kTriangles,
+  /// Only that the pair touches: the polygon level stops at the first
+  /// intersecting triangle pair, much cheaper for parts pushed deep into each
+  /// other; one contact per pair, with kNoTriangle.
+  kPairs,
+};
+
 /// Pipeline settings.
 struct WorldSettings {
   Method method = Method::kObb;  ///< polygon-level hierarchy
   BroadphaseMethod broadphase = BroadphaseMethod::kSweepAndPrune;
   bool convex_level = true;  ///< separating-plane test before the polygon level
   int threads = 1;           ///< 1 = fully serial; 0 = one per hardware thread
+  ContactDetail contacts = ContactDetail::kTriangles;
 };
 
 /// Marks a contact found at the box or hull level, which has no triangles.
 inline constexpr std::uint32_t kNoTriangle = std::numeric_limits<std::uint32_t>::max();
 
-/// One contact: at the polygon level an intersecting triangle pair (indices
-/// into each part's Mesh::triangles); at coarser levels one entry per pair
-/// with kNoTriangle. `a` has the smaller index.
+/// One contact: at the polygon level with ContactDetail::kTriangles an
+/// intersecting triangle pair (indices into each part's Mesh::triangles);
+/// otherwise one entry per pair with kNoTriangle. `a` has the smaller index.
 struct Contact {
   PartId a;
   PartId b;

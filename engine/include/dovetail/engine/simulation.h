@@ -31,6 +31,10 @@ struct SimulationSettings {
   collision::Method method = collision::Method::kObb;
   collision::BroadphaseMethod broadphase = collision::BroadphaseMethod::kSweepAndPrune;
   bool convex_level = true;
+  /// Pairs (default): the pipeline only decides whether parts touch, enough
+  /// for events and reports; triangles: every intersecting triangle pair,
+  /// for highlighting or contact analysis (much dearer for deep penetration).
+  collision::ContactDetail contacts = collision::ContactDetail::kPairs;
   /// Whether part_moved events go into the report's timeline (they are
   /// always delivered to subscribers). Off by default: a moving part gives one per frame.
   bool timeline_part_moved = false;
