@@ -44,8 +44,9 @@ Scene test_scene() {
 
 /// The slider enters the block at frame 5 and leaves at frame 10; the ball
 /// rolls into the block at frame 12 and stays; timers at 0 and 0.05 s; a region.
-Simulation scripted(int threads) {
-  Simulation sim(test_scene(), {.collision_threads = threads});
+Simulation scripted(int threads,
+                    collision::ContactDetail detail = collision::ContactDetail::kPairs) {
+  Simulation sim(test_scene(), {.collision_threads = threads, .contacts = detail});
   sim.queue_pose({5, "slider", at(0.9, 0, 0)});
   sim.queue_pose({10, "slider", at(3, 0, 0)});
   sim.queue_pose({12, "ball", at(-0.95, 0.1, 0)});
@@ -156,6 +157,27 @@ TEST(Simulation, SameEventsHashAndReportForAnyThreadCount) {
             std::string::npos)
       << reports[0];
   EXPECT_EQ(reports[0].find("timings"), std::string::npos);
+}
+
+TEST(Simulation, TriangleContactsCountedAndDeterministic) {
+  std::vector<std::string> reports;
+  for (const int threads : {1, 2, 8}) {
+    Simulation sim = scripted(threads, collision::ContactDetail::kTriangles);
+    sim.run(20);
+    reports.push_back(sim.report().to_json());
+    const std::vector<PairContactStats>& stats = sim.report().contacts;
+    ASSERT_EQ(stats.size(), 2u);
+    // Every intersecting triangle pair counts; the pairs are those of the pairs-only run.
+    EXPECT_GT(stats[0].max_contacts, 1u);
+    EXPECT_GT(stats[1].max_contacts, 1u);
+    EXPECT_EQ(stats[1].frames_in_contact, 5u);
+  }
+  EXPECT_EQ(reports[0], reports[1]);
+  EXPECT_EQ(reports[0], reports[2]);
+  Simulation pairs = scripted(1);
+  pairs.run(20);
+  EXPECT_EQ(only(pairs.report().events, EventKind::kContactBegin).size(), 2u);
+  EXPECT_EQ(pairs.report().contacts[0].max_contacts, 1u);
 }
 
 TEST(Simulation, EngineAssemblyIsDeterministicAcrossThreads) {
