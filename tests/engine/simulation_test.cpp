@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -212,6 +213,32 @@ TEST(Simulation, StateHashFollowsPosesBitForBit) {
   b.run(2);
   EXPECT_NE(a.state_hash(), b.state_hash());
   EXPECT_EQ(b.last_frame().state_hash, b.state_hash());
+}
+
+TEST(Simulation, StateHashIsTheDocumentedFnv1a) {
+  // Recomputed from the definition in docs/engine.md, independently of the engine.
+  Scene scene = test_scene();
+  std::uint64_t expected = 0xcbf29ce484222325ull;
+  auto feed = [&](unsigned char byte) {
+    expected ^= byte;
+    expected *= 0x100000001b3ull;
+  };
+  for (const char* name : {"ball", "block", "rider", "slider"}) {
+    for (const char* c = name; *c != 0; ++c) feed(static_cast<unsigned char>(*c));
+    feed(0);
+    const Transform X_WP = scene.world_pose(name);
+    std::vector<double> values;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) values.push_back(X_WP.R(r, c));
+    }
+    for (int k = 0; k < 3; ++k) values.push_back(X_WP.t(k));
+    for (const double v : values) {
+      std::uint64_t bits = 0;
+      std::memcpy(&bits, &v, sizeof(bits));
+      for (int i = 0; i < 8; ++i) feed(static_cast<unsigned char>(bits >> (8 * i)));
+    }
+  }
+  EXPECT_EQ(state_hash(scene), expected);
 }
 
 TEST(Simulation, PauseStepAndSubscribers) {
