@@ -1,6 +1,9 @@
 #include "dovetail/engine/simulation.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <stdlib.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstring>
@@ -325,6 +328,34 @@ TEST(Report, ProgressPrintsPlainLinesWhenNotATerminal) {
   ASSERT_NE(std::fgets(line, sizeof(line), out), nullptr);
   EXPECT_EQ(std::string(line), "frame 10/10 done\n");
   std::fclose(out);
+}
+
+TEST(Report, ProgressDrawsABarOnATerminal) {
+  const int master = posix_openpt(O_RDWR | O_NOCTTY);
+  if (master < 0) GTEST_SKIP() << "no pseudo-terminal available";
+  ASSERT_EQ(grantpt(master), 0);
+  ASSERT_EQ(unlockpt(master), 0);
+  const int slave = open(ptsname(master), O_RDWR | O_NOCTTY);
+  ASSERT_GE(slave, 0);
+  std::FILE* out = fdopen(slave, "w");
+  ASSERT_NE(out, nullptr);
+  {
+    ProgressMeter meter(4, out);
+    for (std::uint64_t k = 1; k <= 4; ++k) meter.update(k);
+    meter.finish();
+  }
+  std::fclose(out);
+  std::string text;
+  char buffer[4096];
+  for (;;) {
+    const ssize_t n = read(master, buffer, sizeof(buffer));
+    if (n <= 0) break;
+    text.append(buffer, static_cast<std::size_t>(n));
+    if (text.find('\n') != std::string::npos) break;
+  }
+  close(master);
+  EXPECT_NE(text.find("\r["), std::string::npos) << text;
+  EXPECT_NE(text.find("100% frame 4/4"), std::string::npos) << text;
 }
 
 }  // namespace
