@@ -123,6 +123,8 @@ class Simulation {
 
   /// The collision world, for settings such as interest and levels of detail.
   collision::CollisionWorld& collision_world() { return *world_; }
+  /// The collision world, read only (for instance its last step's contacts).
+  const collision::CollisionWorld& collision_world() const { return *world_; }
   /// The collision id of a part, or an invalid id when it has no collision mesh.
   collision::PartId collision_id(PartHandle part) const;
 
