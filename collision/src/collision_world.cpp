@@ -24,7 +24,26 @@ struct Shape {
   bool hull_failed = false;                     ///< flat part: no hull, conservative boxes
   Vec3 local_min, local_max;                    ///< bounds in the part's frame
   Real max_abs = 0;
+  /// Triangles around each vertex (compressed): those of vertex v are
+  /// vertex_triangles[vertex_offsets[v] .. vertex_offsets[v + 1]). Built with
+  /// the model; used to follow a moving contact from one triangle to the next.
+  std::vector<std::uint32_t> vertex_offsets, vertex_triangles;
 };
+
+/// Fills the vertex-to-triangle table of a shape.
+void build_vertex_triangles(Shape& shape) {
+  const Mesh& mesh = *shape.mesh;
+  shape.vertex_offsets.assign(mesh.vertices.size() + 1, 0);
+  for (const TriangleIndices& t : mesh.triangles) {
+    for (std::uint32_t v : t) ++shape.vertex_offsets[v + 1];
+  }
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) shape.vertex_offsets[v + 1] += shape.vertex_offsets[v];
+  shape.vertex_triangles.resize(shape.vertex_offsets.back());
+  std::vector<std::uint32_t> fill(shape.vertex_offsets.begin(), shape.vertex_offsets.end() - 1);
+  for (std::uint32_t i = 0; i < mesh.triangles.size(); ++i) {
+    for (std::uint32_t v : mesh.triangles[i]) shape.vertex_triangles[fill[v]++] = i;
+  }
+}
 
 struct Part {
   PartId id;
@@ -124,7 +143,9 @@ struct CollisionWorld::Impl {
   }
 
   void ensure_model(Shape& shape) {
-    if (!shape.model) shape.model = build_model(settings.method, shape.mesh);
+    if (shape.model) return;
+    shape.model = build_model(settings.method, shape.mesh);
+    if (settings.contacts == ContactDetail::kPairs) build_vertex_triangles(shape);
   }
 
   /// The part's world box: extremal hull vertices found by walking from last
@@ -209,27 +230,60 @@ struct CollisionWorld::Impl {
     const Part& b = parts[w.b];
     const Transform X_AB = relative(a.X_WP, b.X_WP);
     const CollideRequest request = polygon_request();
-    if (!request.all_pairs && w.state->has_witness &&
-        witness_still_intersects(*a.shape->mesh, *b.shape->mesh, X_AB, w.state->witness)) {
-      w.result = CollideResult{.colliding = true, .pairs = {w.state->witness}, .stats = {0, 1}};
-      w.colliding = true;
-      return;
+    if (!request.all_pairs && w.state->has_witness) {
+      std::uint64_t tests = 0;
+      if (follow_witness(*a.shape, *b.shape, X_AB, w.state->witness, tests)) {
+        w.result = CollideResult{.colliding = true, .pairs = {w.state->witness}, .stats = {0, tests}};
+        w.colliding = true;
+        return;
+      }
+      w.result.stats.triangle_tests = tests;
     }
+    const std::uint64_t witness_tests = w.result.stats.triangle_tests;
     w.result = a.shape->model->collide(*b.shape->model, X_AB, request);
+    w.result.stats.triangle_tests += witness_tests;
     w.colliding = w.result.colliding;
     w.state->has_witness = !request.all_pairs && w.colliding;
     if (w.state->has_witness) w.state->witness = w.result.pairs.front();
   }
 
-  /// The exact test of last step's intersecting triangle pair at the new pose
-  /// (B's vertices mapped by Transform::apply, as the hierarchies do).
-  static bool witness_still_intersects(const Mesh& a, const Mesh& b, const Transform& X_AB,
-                                       const TrianglePair& t) {
+  /// Exact test of one triangle pair at a pose (B's vertices mapped by
+  /// Transform::apply, as the hierarchies do).
+  static bool pair_intersects(const Mesh& a, const Mesh& b, const Transform& X_AB,
+                              const TrianglePair& t) {
     const TriangleIndices& ta = a.triangles[t.a];
     const TriangleIndices& tb = b.triangles[t.b];
     return triangles_intersect(a.vertices[ta[0]], a.vertices[ta[1]], a.vertices[ta[2]],
                                X_AB.apply(b.vertices[tb[0]]), X_AB.apply(b.vertices[tb[1]]),
                                X_AB.apply(b.vertices[tb[2]]));
+  }
+
+  /// Follows last step's contact: the witness pair itself, then each of its
+  /// triangles against the triangles around the other's vertices (the
+  /// contact usually moves to a neighbour). On success `witness` is the pair
+  /// found. A hit is a proof; a miss proves nothing and the caller traverses.
+  static bool follow_witness(const Shape& a, const Shape& b, const Transform& X_AB,
+                             TrianglePair& witness, std::uint64_t& tests) {
+    ++tests;
+    if (pair_intersects(*a.mesh, *b.mesh, X_AB, witness)) return true;
+    const TrianglePair last = witness;
+    for (std::uint32_t v : a.mesh->triangles[last.a]) {
+      for (std::uint32_t k = a.vertex_offsets[v]; k < a.vertex_offsets[v + 1]; ++k) {
+        const TrianglePair candidate{a.vertex_triangles[k], last.b};
+        if (candidate.a == last.a) continue;
+        ++tests;
+        if (pair_intersects(*a.mesh, *b.mesh, X_AB, candidate)) return witness = candidate, true;
+      }
+    }
+    for (std::uint32_t v : b.mesh->triangles[last.b]) {
+      for (std::uint32_t k = b.vertex_offsets[v]; k < b.vertex_offsets[v + 1]; ++k) {
+        const TrianglePair candidate{last.a, b.vertex_triangles[k]};
+        if (candidate.b == last.b) continue;
+        ++tests;
+        if (pair_intersects(*a.mesh, *b.mesh, X_AB, candidate)) return witness = candidate, true;
+      }
+    }
+    return false;
   }
 
   /// The polygon level of heavy pairs, each divided into parts, all parts of
