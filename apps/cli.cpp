@@ -202,38 +202,6 @@ BuiltModel build_timed(collision::Method method, std::shared_ptr<const collision
 
 bool stderr_is_terminal() { return isatty(STDERR_FILENO) != 0; }
 
-std::string json_string(std::string_view text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buffer[8];
-          std::snprintf(buffer, sizeof buffer, "\\u%04x", static_cast<unsigned>(c));
-          out += buffer;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
-
 std::string json_array(const std::vector<std::string>& items) {
   std::string out(1, '[');
   for (std::size_t i = 0; i < items.size(); ++i) {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "dovetail/collision/model.h"
+#include "dovetail/engine/json.h"
 #include "dovetail/engine/mesh_import.h"
 
 namespace dovetail::cli {
@@ -125,8 +126,7 @@ class JsonLine {
   std::string body_;
 };
 
-/// `text` as a JSON string literal, quotes included.
-std::string json_string(std::string_view text);
+using engine::json_string;
 /// `[item,item,...]` from items that are already JSON.
 std::string json_array(const std::vector<std::string>& items);
 /// A finite double as JSON (shortest round-trip form); null when not finite.

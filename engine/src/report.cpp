@@ -9,6 +9,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "dovetail/engine/json.h"
 #include "dovetail/engine/scene.h"
 
 namespace dovetail::engine {
@@ -23,35 +24,6 @@ std::string number(double value) {
     if (std::strtod(buffer, nullptr) == value) break;
   }
   return buffer;
-}
-
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char escape[8];
-          std::snprintf(escape, sizeof(escape), "\\u%04x", static_cast<unsigned>(c));
-          out += escape;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
 }
 
 std::string hex(std::uint64_t value) {
@@ -140,9 +112,9 @@ std::string Report::to_json(bool with_timings) const {
     const Event& e = events[i];
     out += i == 0 ? "\n    " : ",\n    ";
     out += "{\"frame\": " + std::to_string(e.frame) + ", \"time\": " + number(e.time) +
-           ", \"kind\": " + quoted(std::string(event_kind_name(e.kind))) +
-           ", \"a\": " + quoted(e.a);
-    if (!e.b.empty()) out += ", \"b\": " + quoted(e.b);
+           ", \"kind\": " + json_string(std::string(event_kind_name(e.kind))) +
+           ", \"a\": " + json_string(e.a);
+    if (!e.b.empty()) out += ", \"b\": " + json_string(e.b);
     out += "}";
   }
   out += events.empty() ? "],\n" : "\n  ],\n";
@@ -150,7 +122,7 @@ std::string Report::to_json(bool with_timings) const {
   for (std::size_t i = 0; i < contacts.size(); ++i) {
     const PairContactStats& c = contacts[i];
     out += i == 0 ? "\n    " : ",\n    ";
-    out += "{\"a\": " + quoted(c.a) + ", \"b\": " + quoted(c.b) +
+    out += "{\"a\": " + json_string(c.a) + ", \"b\": " + json_string(c.b) +
            ", \"frames_in_contact\": " + std::to_string(c.frames_in_contact) +
            ", \"first_frame\": " + std::to_string(c.first_frame) +
            ", \"last_frame\": " + std::to_string(c.last_frame) +

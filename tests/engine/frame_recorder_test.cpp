@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/temp_dir.h"
 #include "dovetail/collision/primitives.h"
 #include "dovetail/engine/scene_render.h"
 #include "dovetail/engine/simulation.h"
@@ -24,25 +25,10 @@ namespace {
 namespace fs = std::filesystem;
 using collision::Vec3;
 
-/// A fresh folder under the system temp folder, removed with its content.
-class TempDir {
+/// A fresh folder for one test.
+class TempDir : public test::TempDir {
  public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "dovetail_frames_XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
+  TempDir() : test::TempDir("dovetail_frames") {}
 };
 
 /// Pixels whose colour is `color` times one shade factor, within rounding.

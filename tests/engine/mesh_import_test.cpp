@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "../support/temp_dir.h"
+
 namespace dovetail::engine {
 namespace {
 
@@ -21,25 +23,10 @@ using collision::Vec3;
 const fs::path kModels = DOVETAIL_ASSIMP_MODELS;
 const fs::path kData = DOVETAIL_TEST_DATA;
 
-/// A fresh folder under the system temp folder, removed with its content.
-class TempDir {
+/// A fresh folder for one test.
+class TempDir : public test::TempDir {
  public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "dovetail_import_XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
+  TempDir() : test::TempDir("dovetail_import") {}
 };
 
 void write_file(const fs::path& path, const std::string& bytes) {

@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "../support/temp_dir.h"
 #include "dovetail/engine/mesh_import.h"
 
 namespace dovetail::engine {
@@ -25,24 +26,10 @@ using collision::Vec3;
 const fs::path kEngine =
     fs::path(DOVETAIL_ASSIMP_MODELS) / "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
 
-/// A fresh folder under the system temp folder, removed with its content.
-class TempDir {
+/// A fresh folder for one test.
+class TempDir : public test::TempDir {
  public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "dovetail_render_XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
+  TempDir() : test::TempDir("dovetail_render") {}
 };
 
 std::array<std::uint8_t, 3> rgb_at(const Image& image, std::size_t pixel) {
