@@ -93,12 +93,7 @@ class AabbPolicy {
 
 CollideResult AabbTree::collide(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
                                 const Transform& X_AB, const CollideRequest& request) const {
-  CollideResult result;
-  detail::LeafTester tester(mesh_a, mesh_b, X_AB, request.all_pairs, result);
-  const AabbPolicy policy(*this, b, X_AB);
-  detail::PairTraversal<AabbPolicy>(policy, tester).run();
-  tester.finish();
-  return result;
+  return detail::collide_with_policy<AabbPolicy>(*this, b, mesh_a, mesh_b, X_AB, request);
 }
 
 std::unique_ptr<SplitQuery> AabbTree::split(const Mesh& mesh_a, const AabbTree& b,
@@ -264,12 +259,7 @@ class ObbPolicy {
 
 CollideResult ObbTree::collide(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
                                const Transform& X_AB, const CollideRequest& request) const {
-  CollideResult result;
-  detail::LeafTester tester(mesh_a, mesh_b, X_AB, request.all_pairs, result);
-  const ObbPolicy policy(*this, b, X_AB);
-  detail::PairTraversal<ObbPolicy>(policy, tester).run();
-  tester.finish();
-  return result;
+  return detail::collide_with_policy<ObbPolicy>(*this, b, mesh_a, mesh_b, X_AB, request);
 }
 
 std::unique_ptr<SplitQuery> ObbTree::split(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,

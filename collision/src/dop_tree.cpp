@@ -226,12 +226,7 @@ class DopPolicy {
 CollideResult DopTree::collide(const Mesh& mesh_a, const DopTree& b, const Mesh& mesh_b,
                                const Transform& X_AB, const CollideRequest& request) const {
   if (b.k() != k()) throw std::invalid_argument("DOP-tree: both trees need the same k");
-  CollideResult result;
-  detail::LeafTester tester(mesh_a, mesh_b, X_AB, request.all_pairs, result);
-  const DopPolicy policy(*this, b, X_AB);
-  detail::PairTraversal<DopPolicy>(policy, tester).run();
-  tester.finish();
-  return result;
+  return detail::collide_with_policy<DopPolicy>(*this, b, mesh_a, mesh_b, X_AB, request);
 }
 
 }  // namespace dovetail::collision

@@ -131,6 +131,20 @@ struct PolicyContext {
   Policy policy;
 };
 
+/// A whole query over two trees of one policy type (the policy is built from
+/// the trees and the pose): the traversal from the roots, sorted result.
+template <typename Policy, typename Tree>
+CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh_a,
+                                  const Mesh& mesh_b, const Transform& X_AB,
+                                  const CollideRequest& request) {
+  CollideResult result;
+  LeafTester tester(mesh_a, mesh_b, X_AB, request.all_pairs, result);
+  const Policy policy(a, b, X_AB);
+  PairTraversal<Policy>(policy, tester).run();
+  tester.finish();
+  return result;
+}
+
 /// For policies whose test needs nothing cached on A's side.
 struct NoEnclosure {};
 
