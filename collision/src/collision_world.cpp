@@ -67,6 +67,9 @@ struct PairState {
   /// contact usually still touch there, which then decides the pair at once.
   TrianglePair witness;
   bool has_witness = false;
+  /// First-hit mode: the subtree pair around the last hit, searched next
+  /// when the witness and its neighbours no longer intersect.
+  TraversalHint hint;
 };
 
 std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
@@ -240,7 +243,9 @@ struct CollisionWorld::Impl {
       w.result.stats.triangle_tests = tests;
     }
     const std::uint64_t witness_tests = w.result.stats.triangle_tests;
-    w.result = a.shape->model->collide(*b.shape->model, X_AB, request);
+    CollideRequest hinted = request;
+    if (!request.all_pairs) hinted.hint = &w.state->hint;
+    w.result = a.shape->model->collide(*b.shape->model, X_AB, hinted);
     w.result.stats.triangle_tests += witness_tests;
     w.colliding = w.result.colliding;
     w.state->has_witness = !request.all_pairs && w.colliding;
@@ -319,6 +324,28 @@ struct CollisionWorld::Impl {
     constexpr std::size_t kHeavyProduct = std::size_t{1} << 20;
     return parts[w.a].shape->mesh->triangle_count() * parts[w.b].shape->mesh->triangle_count() >=
            kHeavyProduct;
+  }
+
+  void prepare() {
+    std::vector<Shape*> todo;
+    std::vector<char> needs_model;
+    std::unordered_map<Shape*, std::size_t> index;
+    for (const Part& p : parts) {
+      if (!p.alive) continue;
+      const auto [it, inserted] = index.emplace(p.shape.get(), todo.size());
+      if (inserted) {
+        todo.push_back(p.shape.get());
+        needs_model.push_back(0);
+      }
+      if (p.level == LevelOfDetail::kExact) needs_model[it->second] = 1;
+    }
+    // Distinct shapes are independent: each task builds one shape's data.
+    tasks->parallel_for(todo.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        ensure_hull(*todo[i]);
+        if (needs_model[i] || todo[i]->hull_failed) ensure_model(*todo[i]);
+      }
+    });
   }
 
   const StepResult& step() {
@@ -492,6 +519,8 @@ void CollisionWorld::set_pair_level(PartId a, PartId b, LevelOfDetail level) {
   impl_->part(b);
   impl_->levels[pair_key(a.index, b.index)] = level;
 }
+
+void CollisionWorld::prepare() { impl_->prepare(); }
 
 const StepResult& CollisionWorld::step() { return impl_->step(); }
 const StepResult& CollisionWorld::last_step() const { return impl_->result; }

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "proxy_pairs.h"
+
 namespace dovetail::collision {
 
 Octree::Octree(int leaf_size, int max_depth) : leaf_size_(leaf_size), max_depth_(max_depth) {
@@ -310,7 +312,7 @@ void Octree::pairs(std::vector<ProxyPair>& out) {
   }
   candidates_.clear();
   visit(0, 0, out);
-  std::sort(out.begin(), out.end());
+  detail::sort_proxy_pairs(out, sort_keys_);
   last_stats_ = stats_;
   stats_ = {};
 }

@@ -43,6 +43,7 @@ class Octree final : public Broadphase {
   std::size_t node_count() const { return nodes_.size() - 8 * free_blocks_.size(); }
 
  private:
+  std::vector<std::uint64_t> sort_keys_;  ///< scratch of pairs()
   static constexpr std::uint32_t kNone = 0xffffffffu;
   struct Node {
     Vec3 lo = Vec3::Zero();  ///< cell bounds

@@ -62,6 +62,24 @@ class PairTraversal {
 
   void run_from(const Entry& e) { visit(e.a, e.enc_a, e.b, e.enc_b); }
 
+  /// Records, for a first-hit query, the node pair `levels` above the leaf
+  /// pair where the hit is found (or the highest pair visited, if fewer).
+  void record_hint(TraversalHint* hint, int levels) {
+    hint_ = hint;
+    hint_levels_ = levels;
+  }
+
+  /// A first-hit query that searches the hinted subtree pair first (when it
+  /// still overlaps) and the whole trees only when that finds nothing.
+  void run_hinted(TraversalHint& hint, std::size_t node_count_a, std::size_t node_count_b) {
+    if (hint.valid && hint.node_a < node_count_a && hint.node_b < node_count_b) {
+      const Entry e{hint.node_a, p_.enclose_a(hint.node_a), hint.node_b, p_.enclose_b(hint.node_b)};
+      if (overlapping(e)) run_from(e);
+      if (tester_.done()) return;
+    }
+    run();
+  }
+
  private:
   Entry root_entry() const { return {0, p_.enclose_a(0), 0, p_.enclose_b(0)}; }
 
@@ -96,6 +114,10 @@ class PairTraversal {
     if (la.is_leaf() && lb.is_leaf()) {
       tester_.test_leaves(p_.slots_a() + la.first_slot(), la.count(),
                           p_.slots_b() + lb.first_slot(), lb.count());
+      if (hint_ && tester_.done()) {
+        *hint_ = {a, b, true};
+        hint_countdown_ = hint_levels_;
+      }
       return;
     }
     if (!la.is_leaf() && (lb.is_leaf() || p_.size_a(a) >= p_.size_b(b))) {
@@ -103,21 +125,36 @@ class PairTraversal {
         const EncA enc_c = p_.enclose_a(c);
         tester_.count_volume_test();
         if (p_.overlap(c, enc_c, b, enc_b)) visit(c, enc_c, b, enc_b);
-        if (tester_.done()) return;
+        if (tester_.done()) return unwind(a, b);
       }
     } else {
       for (std::uint32_t c = lb.first_child(); c < lb.first_child() + 2; ++c) {
         const EncB enc_c = p_.enclose_b(c);
         tester_.count_volume_test();
         if (p_.overlap(a, enc_a, c, enc_c)) visit(a, enc_a, c, enc_c);
-        if (tester_.done()) return;
+        if (tester_.done()) return unwind(a, b);
       }
+    }
+  }
+
+  /// On the way back up from a first hit: the hint climbs to (a, b) until it
+  /// is hint_levels_ above the leaf pair.
+  void unwind(std::uint32_t a, std::uint32_t b) {
+    if (hint_ && hint_countdown_ > 0) {
+      --hint_countdown_;
+      *hint_ = {a, b, true};
     }
   }
 
   const Policy& p_;
   LeafTester& tester_;
+  TraversalHint* hint_ = nullptr;
+  int hint_levels_ = 0;
+  int hint_countdown_ = 0;
 };
+
+/// Levels above the intersecting leaf pair a TraversalHint records.
+inline constexpr int kHintLevels = 8;
 
 /// Per-query state of a split PairTraversal query (see SplitTraversal).
 template <typename Policy>
@@ -140,7 +177,13 @@ CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh
   CollideResult result;
   LeafTester tester(mesh_a, mesh_b, X_AB, request.all_pairs, result);
   const Policy policy(a, b, X_AB);
-  PairTraversal<Policy>(policy, tester).run();
+  PairTraversal<Policy> traversal(policy, tester);
+  if (request.hint && !request.all_pairs) {
+    traversal.record_hint(request.hint, kHintLevels);
+    traversal.run_hinted(*request.hint, a.node_count(), b.node_count());
+  } else {
+    traversal.run();
+  }
   tester.finish();
   return result;
 }

@@ -4,6 +4,8 @@
 #include <bit>
 #include <cassert>
 
+#include "proxy_pairs.h"
+
 namespace dovetail::collision {
 
 namespace {
@@ -312,7 +314,7 @@ void SweepAndPrune::pairs(std::vector<ProxyPair>& out) {
     const ProxyId b = id_of_[static_cast<std::uint32_t>(key)];
     out.push_back(a < b ? ProxyPair{a, b} : ProxyPair{b, a});
   }
-  std::sort(out.begin(), out.end());
+  detail::sort_proxy_pairs(out, sort_keys_);
   last_stats_ = stats_;
   stats_ = {};
 }

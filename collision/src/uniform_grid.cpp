@@ -6,6 +6,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "proxy_pairs.h"
+
 namespace dovetail::collision {
 
 namespace {
@@ -350,7 +352,7 @@ void UniformGrid::pairs(std::vector<ProxyPair>& out) {
     }
   }
   stats_.box_tests += tests;
-  std::sort(out.begin(), out.end());
+  detail::sort_proxy_pairs(out, sort_keys_);
   last_stats_ = stats_;
   stats_ = {};
 }

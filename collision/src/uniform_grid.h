@@ -49,6 +49,7 @@ class UniformGrid final : public Broadphase {
   static constexpr std::uint64_t kMaxCells = 4096;
 
  private:
+  std::vector<std::uint64_t> sort_keys_;  ///< scratch of pairs()
   static constexpr std::uint32_t kNone = 0xffffffffu;
   using CellIndex = std::array<std::int32_t, 3>;
   struct Range {

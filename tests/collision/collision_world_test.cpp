@@ -256,8 +256,10 @@ namespace dovetail::collision {
 namespace {
 
 TEST(CollisionWorld, PairDetailFindsTheSamePairsAtAnyThreadCount) {
-  // First-hit queries with last step's intersecting triangle pair tried first
-  // must decide every pair as the all-pairs queries do.
+  // First-hit queries with last step's intersecting triangle pair tried
+  // first, then the subtree pair around it (TraversalHint), must decide every
+  // pair as the all-pairs queries do, for every hierarchy, whether the
+  // hierarchies are built up front (prepare) or on first need.
   std::vector<std::vector<PartPair>> reference;
   {
     MovingScene scene(14, 5);
@@ -272,20 +274,25 @@ TEST(CollisionWorld, PairDetailFindsTheSamePairsAtAnyThreadCount) {
       scene.advance();
     }
   }
-  for (int threads : {1, 2, 8}) {
-    MovingScene scene(14, 5);
-    CollisionWorld world({.threads = threads, .contacts = ContactDetail::kPairs});
-    std::vector<PartId> ids;
-    for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
-      ids.push_back(world.add_part({.mesh = scene.meshes[i], .X_WP = scene.poses[i]}));
-    }
-    for (int frame = 0; frame < 40; ++frame) {
-      for (std::size_t i = 0; i < ids.size(); ++i) world.set_pose(ids[i], scene.poses[i]);
-      const StepResult& r = world.step();
-      ASSERT_EQ(r.colliding, reference[frame]) << "threads " << threads << " frame " << frame;
-      ASSERT_EQ(r.contacts.size(), r.colliding.size());
-      for (const Contact& c : r.contacts) EXPECT_EQ(c.triangle_a, kNoTriangle);
-      scene.advance();
+  for (Method method : {Method::kObb, Method::kAabb, Method::kDop18, Method::kBoxtree}) {
+    for (int threads : {1, 2, 8}) {
+      MovingScene scene(14, 5);
+      CollisionWorld world(
+          {.method = method, .threads = threads, .contacts = ContactDetail::kPairs});
+      std::vector<PartId> ids;
+      for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+        ids.push_back(world.add_part({.mesh = scene.meshes[i], .X_WP = scene.poses[i]}));
+      }
+      if (threads == 2) world.prepare();
+      for (int frame = 0; frame < 40; ++frame) {
+        for (std::size_t i = 0; i < ids.size(); ++i) world.set_pose(ids[i], scene.poses[i]);
+        const StepResult& r = world.step();
+        ASSERT_EQ(r.colliding, reference[frame])
+            << method_name(method) << " threads " << threads << " frame " << frame;
+        ASSERT_EQ(r.contacts.size(), r.colliding.size());
+        for (const Contact& c : r.contacts) EXPECT_EQ(c.triangle_a, kNoTriangle);
+        scene.advance();
+      }
     }
   }
 }

@@ -257,6 +257,48 @@ TEST(Hierarchies, RepeatedQueriesAreIdentical) {
   }
 }
 
+TEST(Hierarchies, TraversalHintsNeverChangeTheVerdict) {
+  // A torus sweeping slowly through a sphere: first-hit queries carrying a
+  // TraversalHint from frame to frame must give brute force's verdict at
+  // every pose, and the hint must be picked up where hits are found.
+  const auto a = share(make_sphere(0.6, 3));
+  const auto b = share(make_torus(0.7, 0.25, 32, 16));
+  const auto brute_a = build_model(Method::kBrute, a);
+  const auto brute_b = build_model(Method::kBrute, b);
+  for (Method m : {Method::kAabb, Method::kObb, Method::kDop6, Method::kDop18, Method::kDop26}) {
+    const auto ma = build_model(m, a);
+    const auto mb = build_model(m, b);
+    TraversalHint hint;
+    int colliding = 0, hinted_hits = 0;
+    std::uint64_t tests_hinted = 0, tests_plain = 0;
+    for (int frame = 0; frame < 400; ++frame) {
+      const Real s = 0.005 * frame;
+      Transform X;
+      X.R = Eigen::AngleAxisd(0.7 * s, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+      X.t = Vec3(-1.6 + 1.6 * s, 0.3 * std::sin(4 * s), 0.1);
+      const bool was_valid = hint.valid;
+      const CollideResult hinted = ma->collide(*mb, X, {.hint = &hint});
+      const CollideResult plain = ma->collide(*mb, X);
+      const bool expected = brute_a->collide(*brute_b, X).colliding;
+      ASSERT_EQ(hinted.colliding, expected) << method_name(m) << " frame " << frame;
+      ASSERT_EQ(plain.colliding, expected) << method_name(m) << " frame " << frame;
+      colliding += expected;
+      if (hinted.colliding) {
+        ASSERT_TRUE(hint.valid);
+        hinted_hits += was_valid;
+      }
+      tests_hinted += hinted.stats.volume_tests;
+      tests_plain += plain.stats.volume_tests;
+    }
+    EXPECT_GT(colliding, 50) << method_name(m);
+    EXPECT_LT(colliding, 350) << method_name(m);
+    EXPECT_GT(hinted_hits, 0) << method_name(m);
+    std::printf("%-6s volume tests with hints %llu, without %llu\n",
+                std::string(method_name(m)).c_str(), static_cast<unsigned long long>(tests_hinted),
+                static_cast<unsigned long long>(tests_plain));
+  }
+}
+
 }  // namespace
 }  // namespace dovetail::collision
 

@@ -16,11 +16,30 @@ struct TrianglePair {
   friend auto operator<=>(const TrianglePair&, const TrianglePair&) = default;
 };
 
+/// Where a first-hit query of the same two models found its hit last time:
+/// a pair of hierarchy nodes a few levels above the intersecting leaves.
+///
+/// Why: under coherent motion a contact moves a few triangles per frame. The
+/// next query searches the remembered subtree pair first, which takes a
+/// handful of volume tests, and traverses from the roots only when the
+/// subtree pair holds no intersection any more. A hit is a proof either way,
+/// so the verdict never depends on the hint; only the work does.
+struct TraversalHint {
+  std::uint32_t node_a = 0;
+  std::uint32_t node_b = 0;
+  bool valid = false;
+};
+
 /// What a query should find.
 struct CollideRequest {
   /// false: stop at the first intersecting pair (yes/no); true: report every
   /// intersecting triangle pair, sorted by (a, b).
   bool all_pairs = false;
+  /// First-hit queries on the AABB, OBB and DOP trees: read, when valid, and
+  /// rewritten with the subtree pair of this query's hit (left unchanged when
+  /// there is none). Must come from queries of the same two models. Ignored
+  /// by all-pairs queries and by the other methods.
+  TraversalHint* hint = nullptr;
 };
 
 /// Work a query did; the cost model is volume_tests * C_bv + triangle_tests * C_p.

@@ -139,6 +139,12 @@ class CollisionWorld {
   /// Level of detail for one pair, overriding the parts' levels.
   void set_pair_level(PartId a, PartId b, LevelOfDetail level);
 
+  /// Builds now, over the task system's threads, the hulls of all parts and
+  /// the polygon-level hierarchies of all parts that can reach an exact pair,
+  /// instead of on first need during step(). Optional: results are the same
+  /// either way; it keeps one-off set-up cost out of the stepping loop.
+  void prepare();
+
   /// Runs the pipeline on the current poses.
   const StepResult& step();
   const StepResult& last_step() const;

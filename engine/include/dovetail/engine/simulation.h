@@ -102,6 +102,11 @@ class Simulation {
   /// Adds a region; throws SceneError for a duplicate name or an unknown part.
   void add_region(const Region& region);
 
+  /// Builds the collision hulls and hierarchies of the current parts now
+  /// (CollisionWorld::prepare) rather than on first contact; optional, the
+  /// frames are the same either way.
+  void prepare() { world_->prepare(); }
+
   /// Simulates one frame, paused or not.
   const FrameResult& step();
   /// Simulates up to `frames` frames; stops early when paused (a subscriber
