@@ -1,0 +1,74 @@
+#pragma once
+/// \file containment.h
+/// Point in closed mesh, and whether one part lies fully inside another.
+///
+/// Why: a part dropped inside a housing, or swallowed whole by a grasp
+/// volume, has no intersecting triangles, so the collision query reports
+/// nothing. When the surfaces do not meet, one part is inside the other
+/// exactly when one of its points is, and that is decided exactly: ray
+/// parity with orient3d signs only. See docs/proximity.md, "Containment".
+
+#include <cstddef>
+
+#include "dovetail/collision/mesh.h"
+#include "dovetail/collision/model.h"
+#include "dovetail/collision/types.h"
+
+namespace dovetail::collision {
+
+/// True when every edge of `mesh` is shared by exactly two triangles that
+/// use it in opposite directions (a closed, consistently oriented surface,
+/// possibly of several shells). Vertices at equal positions count as one, so
+/// meshes with split vertices are judged by their geometry.
+bool is_closed(const Mesh& mesh);
+
+/// Where a point lies against a closed mesh.
+enum class PointLocation {
+  kOutside,
+  kInside,     ///< inside the solid: odd number of surface crossings to infinity
+  kOnSurface,  ///< on a triangle (closed), decided exactly
+};
+
+/// Exact location of `p_M` (in the mesh's frame) against closed `mesh`, by
+/// the parity of crossings of a segment from the point to beyond the mesh's
+/// bounds. Every decision is an exact orient3d sign; a segment that grazes
+/// an edge or vertex, or lies in a triangle's plane, is discarded and the
+/// next of a fixed list of directions is tried, so the answer is exact and
+/// deterministic. For an open mesh the answer is unspecified (see
+/// is_closed).
+PointLocation locate_point(const Mesh& mesh, const Vec3& p_M);
+
+/// locate_point(mesh, p_M) != kOutside: the closed solid contains the point.
+bool point_inside(const Mesh& mesh, const Vec3& p_M);
+
+/// Three-valued answer: an open mesh has no inside.
+enum class Inside { kNo, kYes, kUnknown };
+
+/// Containment of two parts, `inner` at pose X_outer_inner in outer's frame.
+struct ContainmentResult {
+  /// The surfaces share a point (touching included): neither part is then
+  /// contained in the other; the contact is reported by compute_contacts.
+  bool surfaces_intersect = false;
+  /// Inner lies in outer's solid (its whole surface strictly inside).
+  /// kUnknown when outer is not closed.
+  Inside inner_in_outer = Inside::kUnknown;
+  /// Outer lies in inner's solid. kUnknown when inner is not closed.
+  Inside outer_in_inner = Inside::kUnknown;
+  /// Inner lies inside some shell of outer, in its solid or in a cavity the
+  /// shell encloses (a part inside a hollow housing). kUnknown when outer is
+  /// not closed.
+  Inside inner_enclosed_by_outer = Inside::kUnknown;
+  /// The same for outer inside a shell of inner.
+  Inside outer_enclosed_by_inner = Inside::kUnknown;
+};
+
+/// Containment of meshes `outer` and `inner` (inner at X_outer_inner). The
+/// surfaces are tested with every triangle pair through an AABB tree built
+/// for the call; pass models to reuse built ones.
+ContainmentResult contains(const Mesh& outer, const Mesh& inner, const Transform& X_outer_inner);
+
+/// The same with built models (any method, both the same).
+ContainmentResult contains(const CollisionModel& outer, const CollisionModel& inner,
+                           const Transform& X_outer_inner);
+
+}  // namespace dovetail::collision

@@ -1,0 +1,349 @@
+#include "dovetail/collision/contacts.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+#include "dovetail/collision/model.h"
+#include "dovetail/collision/primitives.h"
+
+namespace dovetail::collision {
+namespace {
+
+std::shared_ptr<const CollisionModel> model(Mesh mesh) {
+  return build_model(Method::kAabb, std::make_shared<const Mesh>(std::move(mesh)));
+}
+
+Transform translation(Real x, Real y, Real z) {
+  Transform X;
+  X.t = Vec3(x, y, z);
+  return X;
+}
+
+Transform rotation_z(Real angle, const Vec3& t) {
+  Transform X;
+  X.R = Eigen::AngleAxis<Real>(angle, Vec3::UnitZ()).toRotationMatrix();
+  // Keep the z row exact, so the rotated faces stay exactly in their planes.
+  X.R(2, 0) = X.R(2, 1) = X.R(0, 2) = X.R(1, 2) = 0;
+  X.R(2, 2) = 1;
+  X.t = t;
+  return X;
+}
+
+/// A block [-2, 2]^2 x [0, 1] with a square through-hole [-1, 1]^2 along z;
+/// closed, outward normals (the hole's walls face into the hole).
+Mesh housing_with_square_hole() {
+  std::vector<Vec3> v;
+  const Real o = 2;
+  const Real h = 1;
+  for (Real z : {0.0, 1.0}) {
+    for (auto [x, y] : {std::pair{-o, -o}, {o, -o}, {o, o}, {-o, o}}) v.emplace_back(x, y, z);
+    for (auto [x, y] : {std::pair{-h, -h}, {h, -h}, {h, h}, {-h, h}}) v.emplace_back(x, y, z);
+  }
+  // Outer square 0..3 (bottom), 8..11 (top); inner square 4..7, 12..15.
+  std::vector<TriangleIndices> t;
+  const auto quad = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
+    t.push_back({a, b, c});
+    t.push_back({a, c, d});
+  };
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    const std::uint32_t j = (i + 1) % 4;
+    quad(8 + i, 8 + j, 12 + j, 12 + i);  // top ring, facing +z
+    quad(0 + i, 4 + i, 4 + j, 0 + j);    // bottom ring, facing -z
+    quad(0 + i, 0 + j, 8 + j, 8 + i);    // outer wall, facing out
+    quad(4 + i, 12 + i, 12 + j, 4 + j);  // hole wall, facing into the hole
+  }
+  return make_mesh(std::move(v), std::move(t), "housing");
+}
+
+/// Area of the overlap of axis-aligned rectangles [lo, hi] (x, y).
+Real rect_overlap(Real ax0, Real ax1, Real ay0, Real ay1, Real bx0, Real bx1, Real by0, Real by1) {
+  const Real w = std::max(0.0, std::min(ax1, bx1) - std::max(ax0, bx0));
+  const Real h = std::max(0.0, std::min(ay1, by1) - std::max(ay0, by0));
+  return w * h;
+}
+
+void expect_near(const Vec3& actual, const Vec3& expected, Real tol) {
+  EXPECT_NEAR((actual - expected).norm(), 0.0, tol)
+      << actual.transpose() << " vs " << expected.transpose();
+}
+
+TEST(Contacts, EmptyPairsGiveNoPatches) {
+  const Mesh box = make_box(Vec3(1, 1, 1));
+  EXPECT_TRUE(compute_contacts(box, box, translation(5, 0, 0), {}).empty());
+  const auto a = model(make_box(Vec3(1, 1, 1)));
+  EXPECT_TRUE(compute_contacts(*a, *a, translation(2.5, 0, 0)).empty());
+}
+
+TEST(Contacts, BoxRestingOnBoxIsOneFacePatch) {
+  // A: [-2, 2]^2 x [-1, 1]; B: half extents (1, 0.5, 0.5) resting on A's top.
+  const auto a = model(make_box(Vec3(2, 2, 1)));
+  const auto b = model(make_box(Vec3(1, 0.5, 0.5)));
+  struct Offset {
+    Real x, y;
+  };
+  for (const Offset o : {Offset{0, 0}, Offset{0.5, -0.25}, Offset{1.5, 0.25}, Offset{-2.5, 1.75},
+                         Offset{2.75, -2.25}, Offset{1, 1.5}}) {
+    SCOPED_TRACE(testing::Message() << "offset " << o.x << ", " << o.y);
+    const std::vector<ContactPatch> patches =
+        compute_contacts(*a, *b, translation(o.x, o.y, 1.5), {.touching_tolerance = 1e-9});
+    ASSERT_EQ(patches.size(), 1u);
+    const ContactPatch& p = patches[0];
+    const Real x0 = std::max(-2.0, o.x - 1), x1 = std::min(2.0, o.x + 1);
+    const Real y0 = std::max(-2.0, o.y - 0.5), y1 = std::min(2.0, o.y + 0.5);
+    const Real area = rect_overlap(-2, 2, -2, 2, o.x - 1, o.x + 1, o.y - 0.5, o.y + 0.5);
+    EXPECT_EQ(p.kind, ContactKind::kFace);
+    EXPECT_NEAR(p.area, area, 1e-12);
+    expect_near(p.normal, Vec3(0, 0, 1), 1e-12);
+    expect_near(p.point, Vec3(0.5 * (x0 + x1), 0.5 * (y0 + y1), 1), 1e-12);
+    EXPECT_EQ(p.depth, 0.0);
+    EXPECT_FALSE(p.penetrating);
+    EXPECT_GE(p.pairs.size(), 4u);
+  }
+}
+
+TEST(Contacts, LargerBoxOnSmallerBoxCoversTheWholeTop) {
+  const auto a = model(make_box(Vec3(1, 1, 1)));
+  const auto b = model(make_box(Vec3(3, 2, 0.5)));
+  const std::vector<ContactPatch> patches = compute_contacts(*a, *b, translation(0.5, 0, 1.5));
+  ASSERT_EQ(patches.size(), 1u);
+  EXPECT_NEAR(patches[0].area, 4.0, 1e-12);
+  expect_near(patches[0].normal, Vec3(0, 0, 1), 1e-12);
+  expect_near(patches[0].point, Vec3(0, 0, 1), 1e-12);
+}
+
+TEST(Contacts, BoxRotatedAboutZGivesTheOverlapPolygonArea) {
+  // B: a 2 x 2 square footprint rotated about z; A's top is [-2, 2]^2 at z = 1.
+  const auto a = model(make_box(Vec3(2, 2, 1)));
+  const auto b = model(make_box(Vec3(1, 1, 0.5)));
+  struct Case {
+    Real angle, x, y, area;
+  };
+  const Real pi = std::numbers::pi;
+  // Inside: the whole square. Centre on an edge: a line through the centre of a
+  // centrally symmetric shape halves it. Centre on a corner, rotated 45 degrees:
+  // the diamond's quarter.
+  for (const Case c : {Case{0.3, 0, 0, 4}, Case{pi / 6, 0.4, -0.2, 4}, Case{pi / 4, 2, 0, 2},
+                       Case{pi / 6, 0, -2, 2}, Case{1.1, -2, 0.3, 2}, Case{pi / 4, 2, 2, 1}}) {
+    SCOPED_TRACE(testing::Message() << "angle " << c.angle << " at " << c.x << ", " << c.y);
+    const std::vector<ContactPatch> patches =
+        compute_contacts(*a, *b, rotation_z(c.angle, Vec3(c.x, c.y, 1.5)));
+    ASSERT_EQ(patches.size(), 1u);
+    EXPECT_EQ(patches[0].kind, ContactKind::kFace);
+    EXPECT_NEAR(patches[0].area, c.area, 1e-12);
+    expect_near(patches[0].normal, Vec3(0, 0, 1), 1e-12);
+    EXPECT_NEAR(patches[0].point.z(), 1.0, 1e-12);
+    EXPECT_FALSE(patches[0].penetrating);
+  }
+}
+
+TEST(Contacts, SquarePegAgainstHoleWallIsAFacePatchAcrossTheAxis) {
+  const auto housing = model(housing_with_square_hole());
+  // Peg [0, 1] x [-0.5, 0.5] x [-0.5, 1.5]: its +x face lies on the wall x = 1.
+  const auto peg = model(make_box(Vec3(0.5, 0.5, 1)));
+  const std::vector<ContactPatch> patches =
+      compute_contacts(*housing, *peg, translation(0.5, 0, 0.5));
+  ASSERT_EQ(patches.size(), 1u);
+  EXPECT_EQ(patches[0].kind, ContactKind::kFace);
+  EXPECT_NEAR(patches[0].area, 1.0, 1e-12);  // y in [-0.5, 0.5], z in [0, 1]
+  expect_near(patches[0].normal, Vec3(-1, 0, 0), 1e-12);
+  expect_near(patches[0].point, Vec3(1, 0, 0.5), 1e-12);
+  EXPECT_FALSE(patches[0].penetrating);
+}
+
+TEST(Contacts, CylinderPegTouchingOneSideOfTheHole) {
+  const auto housing = model(housing_with_square_hole());
+  // Radius 0.5, 16 facets, vertex 0 at (0.5, 0): moved by 0.5 it touches x = 1 along a line.
+  const auto peg = model(make_cylinder(0.5, 2, 16));
+  const std::vector<ContactPatch> patches =
+      compute_contacts(*housing, *peg, translation(0.5, 0, -0.5));
+  ASSERT_EQ(patches.size(), 1u);
+  const ContactPatch& p = patches[0];
+  EXPECT_EQ(p.kind, ContactKind::kCurve);
+  EXPECT_EQ(p.area, 0.0);
+  EXPECT_NEAR(p.length, 1.0, 1e-12);  // the housing's height
+  expect_near(p.normal, Vec3(-1, 0, 0), 1e-12);
+  EXPECT_NEAR(p.normal.z(), 0.0, 1e-15);  // perpendicular to the hole's axis
+  expect_near(p.point, Vec3(1, 0, 0.5), 1e-12);
+  EXPECT_NEAR(p.depth, 0.0, 1e-15);
+  EXPECT_FALSE(p.penetrating);
+}
+
+TEST(Contacts, CylinderPegTouchingFourSidesGivesFourPatches) {
+  const auto housing = model(housing_with_square_hole());
+  // Radius 1: vertices at angles 0, 90, 180, 270 degrees touch the four walls.
+  const auto peg = model(make_cylinder(1, 2, 16));
+  const std::vector<ContactPatch> patches =
+      compute_contacts(*housing, *peg, translation(0, 0, -0.5));
+  ASSERT_EQ(patches.size(), 4u);
+  for (const ContactPatch& p : patches) {
+    EXPECT_NEAR(p.normal.z(), 0.0, 1e-12);
+    // Each normal points across the axis, from the wall towards the hole's centre.
+    const Vec3 to_axis = Vec3(-p.point.x(), -p.point.y(), 0).normalized();
+    expect_near(p.normal, to_axis, 1e-9);
+    EXPECT_NEAR(Vec3(p.point.x(), p.point.y(), 0).norm(), 1.0, 1e-9);
+    EXPECT_FALSE(p.penetrating);
+  }
+}
+
+/// Patches of (b, a) at X_AB's inverse, mapped back into A's frame, match (a, b)'s
+/// with the normals flipped.
+void expect_swap_symmetric(const CollisionModel& a, const CollisionModel& b,
+                           const Transform& X_AB) {
+  const std::vector<ContactPatch> ab = compute_contacts(a, b, X_AB);
+  const std::vector<ContactPatch> ba = compute_contacts(b, a, X_AB.inverse());
+  ASSERT_EQ(ab.size(), ba.size());
+  ASSERT_FALSE(ab.empty());
+  for (const ContactPatch& q : ba) {
+    const Vec3 point_A = X_AB.apply(q.point);
+    const Vec3 normal_A = X_AB.R * q.normal;
+    const ContactPatch* match = nullptr;
+    for (const ContactPatch& p : ab) {
+      if ((p.point - point_A).norm() < 1e-9) match = &p;
+    }
+    ASSERT_NE(match, nullptr) << "no patch at " << point_A.transpose();
+    expect_near(normal_A, -match->normal, 1e-9);
+    EXPECT_NEAR(q.area, match->area, 1e-12);
+    EXPECT_NEAR(q.length, match->length, 1e-12);
+    EXPECT_NEAR(q.depth, match->depth, 1e-12);
+    EXPECT_EQ(q.kind, match->kind);
+    EXPECT_EQ(q.pairs.size(), match->pairs.size());
+  }
+}
+
+TEST(Contacts, SwappingAAndBFlipsTheNormals) {
+  const auto big = model(make_box(Vec3(2, 2, 1)));
+  const auto small = model(make_box(Vec3(1, 0.5, 0.5)));
+  expect_swap_symmetric(*big, *small, translation(1.5, 0.25, 1.5));
+  const auto square = model(make_box(Vec3(1, 1, 0.5)));
+  expect_swap_symmetric(*big, *square, rotation_z(std::numbers::pi / 6, Vec3(0, -2, 1.5)));
+  expect_swap_symmetric(*big, *square, translation(0.5, 0.5, 1.4));  // penetrating
+  const auto housing = model(housing_with_square_hole());
+  expect_swap_symmetric(*housing, *model(make_cylinder(0.5, 2, 16)), translation(0.5, 0, -0.5));
+  expect_swap_symmetric(*housing, *model(make_cylinder(1, 2, 16)), translation(0, 0, -0.5));
+  expect_swap_symmetric(*housing, *model(make_box(Vec3(0.5, 0.5, 1))), translation(0.5, 0, 0.5));
+}
+
+TEST(Contacts, TouchingAndPenetratingAreToldApart) {
+  const auto a = model(make_box(Vec3(2, 2, 1)));
+  const auto b = model(make_box(Vec3(1, 1, 0.5)));
+  struct Case {
+    Real z;  // B's centre; 1.5 is exact touching
+    Real tolerance;
+    Real depth;
+    bool penetrating;
+  };
+  for (const Case c :
+       {Case{1.5, 1e-6, 0, false}, Case{1.5, 0, 0, false}, Case{1.4, 1e-6, 0.1, true},
+        Case{1.4, 0.2, 0.1, false}, Case{1.5 - 1e-4, 1e-3, 1e-4, false},
+        Case{1.5 - 1e-4, 1e-5, 1e-4, true}, Case{1.25, 1e-6, 0.25, true}}) {
+    SCOPED_TRACE(testing::Message() << "z " << c.z << " tolerance " << c.tolerance);
+    const std::vector<ContactPatch> patches =
+        compute_contacts(*a, *b, translation(0.5, -0.25, c.z), {.touching_tolerance = c.tolerance});
+    ASSERT_EQ(patches.size(), 1u);
+    EXPECT_NEAR(patches[0].depth, c.depth, 1e-12);
+    EXPECT_EQ(patches[0].penetrating, c.penetrating);
+    expect_near(patches[0].normal, Vec3(0, 0, 1), 1e-12);
+  }
+  // Sunk boxes cross along a curve around B's footprint.
+  const std::vector<ContactPatch> sunk = compute_contacts(*a, *b, translation(0.5, -0.25, 1.4));
+  EXPECT_EQ(sunk[0].kind, ContactKind::kCurve);
+  EXPECT_NEAR(sunk[0].length, 8.0, 1e-12);
+  expect_near(sunk[0].point, Vec3(0.5, -0.25, 1), 1e-12);
+}
+
+TEST(Contacts, VertexOnFaceIsAPointPatch) {
+  // An octahedron standing on one vertex on A's top face.
+  std::vector<Vec3> v = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  std::vector<TriangleIndices> t = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                                    {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  const auto a = model(make_box(Vec3(2, 2, 1)));
+  const auto b = model(make_mesh(std::move(v), std::move(t), "octahedron"));
+  const std::vector<ContactPatch> patches = compute_contacts(*a, *b, translation(0.25, -0.75, 2));
+  ASSERT_EQ(patches.size(), 1u);
+  EXPECT_EQ(patches[0].kind, ContactKind::kPoint);
+  expect_near(patches[0].point, Vec3(0.25, -0.75, 1), 1e-15);
+  expect_near(patches[0].normal, Vec3(0, 0, 1), 1e-12);
+  EXPECT_EQ(patches[0].pairs.size(), 4u);
+  EXPECT_FALSE(patches[0].penetrating);
+}
+
+TEST(Contacts, SeparateRegionsAreSeparatePatchesInPairOrder) {
+  // B bridges two blocks: two face patches, ordered by their smallest pair.
+  std::vector<Vec3> v;
+  std::vector<TriangleIndices> t;
+  for (Real cx : {-3.0, 3.0}) {
+    const Mesh block = make_box(Vec3(1, 1, 1));
+    const auto base = static_cast<std::uint32_t>(v.size());
+    for (const Vec3& p : block.vertices) v.push_back(p + Vec3(cx, 0, 0));
+    for (const TriangleIndices& f : block.triangles)
+      t.push_back({f[0] + base, f[1] + base, f[2] + base});
+  }
+  const Mesh two = make_mesh(std::move(v), std::move(t), "two blocks");
+  const Mesh plank = make_box(Vec3(4, 0.5, 0.25));
+  const auto a = model(two);
+  const auto b = model(plank);
+  const std::vector<ContactPatch> patches = compute_contacts(*a, *b, translation(0, 0, 1.25));
+  ASSERT_EQ(patches.size(), 2u);
+  EXPECT_LT(patches[0].pairs.front(), patches[1].pairs.front());
+  for (const ContactPatch& p : patches) {
+    EXPECT_NEAR(p.area, 2.0, 1e-12);  // x in [2, 4] (or [-4, -2]) times y in [-0.5, 0.5]
+    expect_near(p.normal, Vec3(0, 0, 1), 1e-12);
+  }
+  EXPECT_NEAR(patches[0].point.x(), -3.0, 1e-12);
+  EXPECT_NEAR(patches[1].point.x(), 3.0, 1e-12);
+
+  // The same through the span overload, pairs given shuffled and duplicated.
+  CollideResult hits = a->collide(*b, translation(0, 0, 1.25), {.all_pairs = true});
+  std::vector<TrianglePair> shuffled(hits.pairs.rbegin(), hits.pairs.rend());
+  shuffled.push_back(hits.pairs.front());
+  const std::vector<ContactPatch> again =
+      compute_contacts(two, plank, translation(0, 0, 1.25), shuffled);
+  ASSERT_EQ(again.size(), 2u);
+  EXPECT_EQ(again[0].pairs, patches[0].pairs);
+  EXPECT_EQ(again[1].pairs, patches[1].pairs);
+}
+
+TEST(Contacts, NearlyCoplanarFacesInARotatedFrame) {
+  // Both boxes turned by one general rotation Q: B's bottom lies on A's top up
+  // to rounding, so the faces are coplanar only within the tolerance.
+  const Mat3 Q = Eigen::AngleAxis<Real>(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  const Mesh box_a = make_box(Vec3(2, 2, 1));
+  std::vector<Vec3> va;
+  for (const Vec3& p : box_a.vertices) va.push_back(Q * p);
+  const auto a = model(make_mesh(va, box_a.triangles, "rotated box"));
+  const auto b = model(make_box(Vec3(1, 0.5, 0.5)));
+  // X_AB = Q * translation(0.5, 0, 1.5 - push): B pushed into A by up to 1e-12,
+  // then rotated. The bottom faces are found within the coplanar tolerance
+  // even where the exact test sees a gap of a few ulps.
+  for (const Real push : {0.0, 1e-15, 1e-12}) {
+    SCOPED_TRACE(testing::Message() << "push " << push);
+    Transform X;
+    X.R = Q;
+    X.t = Q * Vec3(0.5, 0, 1.5 - push);
+    const std::vector<ContactPatch> patches = compute_contacts(*a, *b, X);
+    ASSERT_EQ(patches.size(), 1u);
+    EXPECT_EQ(patches[0].kind, ContactKind::kFace);
+    EXPECT_NEAR(patches[0].area, 2.0, 1e-9);
+    expect_near(patches[0].normal, Q * Vec3(0, 0, 1), 1e-9);
+    EXPECT_LT(patches[0].depth, 1e-9);
+    EXPECT_FALSE(patches[0].penetrating);
+    expect_near(patches[0].point, Q * Vec3(0.5, 0, 1), 1e-9);
+  }
+  // Beyond the coplanar tolerance the bottom faces do not count: B sunk by 1e-6
+  // crosses A's top along its footprint's rim.
+  Transform X;
+  X.R = Q;
+  X.t = Q * Vec3(0.5, 0, 1.5 - 1e-6);
+  const std::vector<ContactPatch> sunk = compute_contacts(*a, *b, X, {.touching_tolerance = 1e-7});
+  ASSERT_EQ(sunk.size(), 1u);
+  EXPECT_EQ(sunk[0].kind, ContactKind::kCurve);
+  EXPECT_NEAR(sunk[0].depth, 1e-6, 1e-12);
+  EXPECT_TRUE(sunk[0].penetrating);
+}
+
+}  // namespace
+}  // namespace dovetail::collision

@@ -1,0 +1,172 @@
+#include "dovetail/collision/containment.h"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <vector>
+
+#include "dovetail/collision/model.h"
+#include "dovetail/collision/primitives.h"
+
+namespace dovetail::collision {
+namespace {
+
+Transform translation(Real x, Real y, Real z) {
+  Transform X;
+  X.t = Vec3(x, y, z);
+  return X;
+}
+
+/// A box with half extents `outer` and a cavity with half extents `inner`:
+/// the inner box's triangles reversed so its faces point into the cavity.
+Mesh hollow_box(const Vec3& outer, const Vec3& inner) {
+  const Mesh a = make_box(outer);
+  const Mesh b = make_box(inner);
+  std::vector<Vec3> v = a.vertices;
+  std::vector<TriangleIndices> t = a.triangles;
+  const auto base = static_cast<std::uint32_t>(v.size());
+  v.insert(v.end(), b.vertices.begin(), b.vertices.end());
+  for (const TriangleIndices& f : b.triangles) t.push_back({f[0] + base, f[2] + base, f[1] + base});
+  return make_mesh(std::move(v), std::move(t), "hollow box");
+}
+
+TEST(Containment, IsClosed) {
+  EXPECT_TRUE(is_closed(make_box(Vec3(1, 2, 3))));
+  EXPECT_TRUE(is_closed(make_sphere(1, 2)));
+  EXPECT_TRUE(is_closed(make_torus(2, 0.5, 16, 8)));
+  EXPECT_TRUE(is_closed(make_cylinder(1, 2, 12)));
+  EXPECT_TRUE(is_closed(hollow_box(Vec3(2, 2, 2), Vec3(1, 1, 1))));
+  EXPECT_FALSE(is_closed(make_wavy_sheet(1, 0.1, 3, 5)));
+
+  // A box with one triangle removed is open; with one triangle flipped it is inconsistent.
+  Mesh box = make_box(Vec3(1, 1, 1));
+  Mesh open = box;
+  open.triangles.pop_back();
+  EXPECT_FALSE(is_closed(open));
+  Mesh flipped = box;
+  std::swap(flipped.triangles[3][1], flipped.triangles[3][2]);
+  EXPECT_FALSE(is_closed(flipped));
+
+  // Split vertices (every triangle with its own copies) are welded by position.
+  std::vector<Vec3> v;
+  std::vector<TriangleIndices> t;
+  for (const TriangleIndices& f : box.triangles) {
+    const auto base = static_cast<std::uint32_t>(v.size());
+    for (std::uint32_t i : f) v.push_back(box.vertices[i]);
+    t.push_back({base, base + 1, base + 2});
+  }
+  EXPECT_TRUE(is_closed(make_mesh(std::move(v), std::move(t), "split box")));
+}
+
+TEST(Containment, PointInsideBoxSphereAndTorus) {
+  const Mesh box = make_box(Vec3(1, 1, 1));
+  EXPECT_EQ(locate_point(box, Vec3(0, 0, 0)), PointLocation::kInside);
+  EXPECT_EQ(locate_point(box, Vec3(0.999, -0.999, 0.5)), PointLocation::kInside);
+  EXPECT_EQ(locate_point(box, Vec3(1.001, 0, 0)), PointLocation::kOutside);
+  EXPECT_EQ(locate_point(box, Vec3(5, 5, 5)), PointLocation::kOutside);
+  // On a face, an edge, a vertex, and on a face diagonal: exactly on the surface.
+  for (const Vec3& p :
+       {Vec3(1, 0.3, -0.2), Vec3(1, 1, 0.5), Vec3(-1, -1, 1), Vec3(0.5, 0.5, 1), Vec3(0, 0, -1)}) {
+    EXPECT_EQ(locate_point(box, p), PointLocation::kOnSurface) << p.transpose();
+    EXPECT_TRUE(point_inside(box, p));
+  }
+  // One ulp off the face, either way.
+  EXPECT_EQ(locate_point(box, Vec3(std::nextafter(1.0, 2.0), 0.3, 0.2)), PointLocation::kOutside);
+  EXPECT_EQ(locate_point(box, Vec3(std::nextafter(1.0, 0.0), 0.3, 0.2)), PointLocation::kInside);
+  // Points in line with edges and vertices along the axes (degenerate for axis rays).
+  EXPECT_EQ(locate_point(box, Vec3(0, 0, 0.5)), PointLocation::kInside);
+  EXPECT_EQ(locate_point(box, Vec3(-3, 1, 1)), PointLocation::kOutside);
+
+  const Mesh sphere = make_sphere(1, 3);
+  EXPECT_TRUE(point_inside(sphere, Vec3(0, 0, 0)));
+  EXPECT_TRUE(point_inside(sphere, Vec3(0.5, 0.5, 0.5)));
+  EXPECT_FALSE(point_inside(sphere, Vec3(0.8, 0.8, 0.1)));
+
+  const Mesh torus = make_torus(2, 0.5, 32, 16);
+  EXPECT_FALSE(point_inside(torus, Vec3(0, 0, 0)));  // the hole
+  EXPECT_TRUE(point_inside(torus, Vec3(2, 0, 0)));   // the tube
+  EXPECT_TRUE(point_inside(torus, Vec3(0, -2, 0.2)));
+  EXPECT_FALSE(point_inside(torus, Vec3(2, 0, 0.6)));
+}
+
+TEST(Containment, SmallSphereInsideLargeSphere) {
+  const Mesh big = make_sphere(2, 3);
+  const Mesh small = make_sphere(0.5, 2);
+  const ContainmentResult inside = contains(big, small, translation(0.3, -0.4, 0.5));
+  EXPECT_FALSE(inside.surfaces_intersect);
+  EXPECT_EQ(inside.inner_in_outer, Inside::kYes);
+  EXPECT_EQ(inside.inner_enclosed_by_outer, Inside::kYes);
+  EXPECT_EQ(inside.outer_in_inner, Inside::kNo);
+  EXPECT_EQ(inside.outer_enclosed_by_inner, Inside::kNo);
+
+  // Swapped roles: the large sphere is inside nothing, the small one is inside it.
+  const ContainmentResult swapped = contains(small, big, translation(-0.3, 0.4, -0.5));
+  EXPECT_EQ(swapped.inner_in_outer, Inside::kNo);
+  EXPECT_EQ(swapped.outer_in_inner, Inside::kYes);
+
+  // Moved apart: neither. Moved through the surface: intersecting, neither.
+  const ContainmentResult apart = contains(big, small, translation(4, 0, 0));
+  EXPECT_FALSE(apart.surfaces_intersect);
+  EXPECT_EQ(apart.inner_in_outer, Inside::kNo);
+  EXPECT_EQ(apart.outer_in_inner, Inside::kNo);
+  const ContainmentResult crossing = contains(big, small, translation(1.8, 0, 0));
+  EXPECT_TRUE(crossing.surfaces_intersect);
+  EXPECT_EQ(crossing.inner_in_outer, Inside::kNo);
+  EXPECT_EQ(crossing.outer_in_inner, Inside::kNo);
+}
+
+TEST(Containment, PartInsideAHollowHousing) {
+  // Walls 1 thick around a 2 x 2 x 2 cavity.
+  const Mesh housing = hollow_box(Vec3(2, 2, 2), Vec3(1, 1, 1));
+  const Mesh part = make_box(Vec3(0.25, 0.25, 0.25));
+  const auto outer = build_model(Method::kObb, std::make_shared<const Mesh>(housing));
+  const auto inner = build_model(Method::kObb, std::make_shared<const Mesh>(part));
+
+  // In the cavity: enclosed by the housing, but not in its material.
+  const ContainmentResult cavity = contains(*outer, *inner, translation(0.5, -0.5, 0.25));
+  EXPECT_FALSE(cavity.surfaces_intersect);
+  EXPECT_EQ(cavity.inner_enclosed_by_outer, Inside::kYes);
+  EXPECT_EQ(cavity.inner_in_outer, Inside::kNo);
+  EXPECT_EQ(cavity.outer_in_inner, Inside::kNo);
+
+  // Inside a wall: in the material, and enclosed.
+  const ContainmentResult wall = contains(*outer, *inner, translation(1.5, 0, 0));
+  EXPECT_FALSE(wall.surfaces_intersect);
+  EXPECT_EQ(wall.inner_in_outer, Inside::kYes);
+  EXPECT_EQ(wall.inner_enclosed_by_outer, Inside::kYes);
+
+  // Moved out: neither. Touching the cavity's wall from inside: the surfaces meet.
+  const ContainmentResult out = contains(*outer, *inner, translation(5, 0, 0));
+  EXPECT_EQ(out.inner_in_outer, Inside::kNo);
+  EXPECT_EQ(out.inner_enclosed_by_outer, Inside::kNo);
+  const ContainmentResult touching = contains(*outer, *inner, translation(0.75, 0, 0));
+  EXPECT_TRUE(touching.surfaces_intersect);
+  EXPECT_EQ(touching.inner_enclosed_by_outer, Inside::kNo);
+  // Through a wall.
+  const ContainmentResult through = contains(*outer, *inner, translation(1, 0, 0));
+  EXPECT_TRUE(through.surfaces_intersect);
+  EXPECT_EQ(through.inner_in_outer, Inside::kNo);
+
+  // A box inside a large sphere, and the same box moved out of it.
+  const Mesh sphere = make_sphere(3, 3);
+  EXPECT_EQ(contains(sphere, part, translation(2.1, 0.2, -0.1)).inner_in_outer, Inside::kYes);
+  EXPECT_EQ(contains(sphere, part, translation(10, 0.2, -0.1)).inner_in_outer, Inside::kNo);
+}
+
+TEST(Containment, OpenMeshesAreUnknown) {
+  const Mesh sheet = make_wavy_sheet(2, 0.1, 3, 6);
+  const Mesh box = make_box(Vec3(0.25, 0.25, 0.25));
+  // The sheet has no inside: whether the box is in it is unknown; the box is
+  // closed, so whether the sheet is in the box is decided.
+  const ContainmentResult r = contains(sheet, box, translation(0, 0, 1));
+  EXPECT_FALSE(r.surfaces_intersect);
+  EXPECT_EQ(r.inner_in_outer, Inside::kUnknown);
+  EXPECT_EQ(r.inner_enclosed_by_outer, Inside::kUnknown);
+  EXPECT_EQ(r.outer_in_inner, Inside::kNo);
+  const Mesh big = make_box(Vec3(5, 5, 5));
+  EXPECT_EQ(contains(big, sheet, Transform::identity()).inner_in_outer, Inside::kYes);
+  EXPECT_EQ(contains(big, sheet, Transform::identity()).outer_in_inner, Inside::kUnknown);
+}
+
+}  // namespace
+}  // namespace dovetail::collision
