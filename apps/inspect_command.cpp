@@ -15,7 +15,8 @@ constexpr const char* kHelp =
 
 Reads a mesh file (any format assimp reads) as `query` does and reports what
 was found: vertices, triangles, validation findings (degenerate triangles
-removed, unused vertices, skipped point/line primitives, notes), bounds, and
+removed, unused vertices, skipped point/line primitives, notes), the file's cameras
+(by name, for `render --camera`), bounds, and
 for every method the hierarchy built over it: nodes, leaves, depth, bytes,
 bytes per triangle and build time.
 
@@ -92,6 +93,8 @@ int inspect_command(std::span<const std::string> argv) {
   if (args.flag("json")) {
     std::vector<std::string> notes;
     for (const std::string& note : loaded.report.notes) notes.push_back(json_string(note));
+    std::vector<std::string> cameras;
+    for (const auto& camera : loaded.report.cameras) cameras.push_back(json_string(camera.first));
     std::vector<std::string> method_items;
     for (const MethodRow& row : rows) {
       JsonLine item;
@@ -115,6 +118,7 @@ int inspect_command(std::span<const std::string> argv) {
         .add("skipped_line_or_point_primitives",
              std::uint64_t{loaded.report.skipped_line_or_point_primitives})
         .add_raw("notes", json_array(notes))
+        .add_raw("cameras", json_array(cameras))
         .add_raw("bounds_min", json_vec(bounds.min))
         .add_raw("bounds_max", json_vec(bounds.max))
         .add("diagonal", diagonal);
@@ -150,6 +154,9 @@ int inspect_command(std::span<const std::string> argv) {
   std::printf("diagonal            %.9g\n", diagonal);
   for (const std::string& note : loaded.report.notes) {
     std::printf("note                %s\n", note.c_str());
+  }
+  for (const auto& camera : loaded.report.cameras) {
+    std::printf("camera              %s\n", camera.first.c_str());
   }
   if (args.flag("parts")) {
     std::printf("\n%-32s %10s %10s\n", "part", "vertices", "triangles");

@@ -23,8 +23,10 @@ Draws a mesh or assembly file off-screen and writes the picture as PNG.
   --out PNG      the image to write
   --width W      image width in pixels, 1 to 16384 (default 1024)
   --height H     image height in pixels, 1 to 16384 (default 768)
-  --camera NAME  a named camera of the scene, or auto (default): look at the centre
-                 of the scene from a fixed oblique direction, the whole scene in view
+  --camera NAME  a camera of the file (glTF cameras are named after their node, e.g.
+                 nodes[81]; `dovetail inspect` lists them), a built-in view (front,
+                 back, right, left, top, bottom, iso: the whole scene in view along
+                 that axis, y up), or auto (default, the same as iso)
 
 Flat shading with a light at the camera, depth-tested, no anti-aliasing; the
 same input and options give the same PNG bytes. Prints a one-line JSON summary
@@ -80,13 +82,14 @@ int render_command(std::span<const std::string> argv) {
   const engine::RenderScene scene = engine::scene_from_import(report);
   report.parts.clear();
 
-  if (settings.camera != "auto") {
-    bool known = false;
-    for (const auto& entry : scene.cameras) known = known || entry.first == settings.camera;
-    if (!known) {
-      throw UsageError("render: no camera named '" + settings.camera + "' in " + input +
-                       " (use --camera auto)");
-    }
+  if (!engine::has_camera(scene, settings.camera)) {
+    std::string known;
+    for (const auto& entry : scene.cameras) known += (known.empty() ? "" : ", ") + entry.first;
+    std::string views;
+    for (const std::string& v : engine::builtin_views()) views += (views.empty() ? "" : ", ") + v;
+    throw UsageError("render: no camera named '" + settings.camera + "' in " + input +
+                     " (its cameras: " + (known.empty() ? std::string("none") : known) +
+                     "; views: " + views + "; or auto)");
   }
 
   const auto start = std::chrono::steady_clock::now();

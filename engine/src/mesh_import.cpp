@@ -13,6 +13,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <utility>
@@ -120,6 +121,49 @@ std::vector<Instance> collect_instances(const fs::path& path, const aiScene& sce
     }
   }
   return instances;
+}
+
+/// Transform of `node` to the file's root: its own composed with its
+/// ancestors' (the hierarchy is known to be acyclic by now).
+Affine node_to_root(const aiNode& node) {
+  Affine X_RN = to_affine(node.mTransformation);
+  for (const aiNode* parent = node.mParent; parent != nullptr; parent = parent->mParent) {
+    X_RN = compose(to_affine(parent->mTransformation), X_RN);
+  }
+  return X_RN;
+}
+
+/// The file's perspective cameras in its root frame. Assimp gives the field
+/// of view as the full horizontal angle (its glTF importer: yfov x aspect),
+/// so the vertical one follows from the aspect ratio.
+void collect_cameras(const aiScene& scene, ImportReport& report) {
+  for (unsigned i = 0; i < scene.mNumCameras; ++i) {
+    const aiCamera& camera = *scene.mCameras[i];
+    const std::string name = camera.mName.C_Str();
+    if (!(camera.mHorizontalFOV > 0)) {
+      report.notes.push_back("skipped orthographic camera '" + name + "'");
+      continue;
+    }
+    const aiNode* node = scene.mRootNode->FindNode(camera.mName);
+    const Affine X_RN = node != nullptr ? node_to_root(*node) : Affine::Identity();
+    const Vec3 eye = apply(X_RN, camera.mPosition);
+    const collision::Mat3 R = X_RN.leftCols<3>();
+    const Vec3 look = R * Vec3(camera.mLookAt.x, camera.mLookAt.y, camera.mLookAt.z);
+    const Vec3 up = R * Vec3(camera.mUp.x, camera.mUp.y, camera.mUp.z);
+    const double aspect = camera.mAspect > 0 ? camera.mAspect : 1.0;
+    const double fov_y = 2 * std::atan(std::tan(0.5 * camera.mHorizontalFOV) / aspect);
+    Camera out;
+    out.eye = eye;
+    out.target = eye + look.normalized();
+    out.up = up;
+    out.fov_y_degrees = fov_y * 180 / std::numbers::pi;
+    if (!out.eye.allFinite() || !out.target.allFinite() || !out.up.allFinite() ||
+        !(out.up.squaredNorm() > 0) || !(out.fov_y_degrees > 0 && out.fov_y_degrees < 180)) {
+      report.notes.push_back("skipped camera '" + name + "' with a degenerate pose or field of view");
+      continue;
+    }
+    report.cameras.emplace_back(name, out);
+  }
 }
 
 /// Splits X_RN into a rigid pose X_RP (the polar rotation of its 3x3 part,
@@ -351,6 +395,7 @@ ImportReport import_scene(const fs::path& path, const aiScene& scene, const Impo
     part.name = path.filename().string();
     part.mesh = validate(std::move(geometry), path.string(), options.limits, part.validation);
     report.parts.push_back(std::move(part));
+    collect_cameras(scene, report);
     return report;
   }
 
@@ -370,6 +415,7 @@ ImportReport import_scene(const fs::path& path, const aiScene& scene, const Impo
         validate(std::move(geometry), path.string() + "#" + name, options.limits, part.validation);
     report.parts.push_back(std::move(part));
   }
+  collect_cameras(scene, report);
   return report;
 }
 
@@ -390,13 +436,13 @@ ImportReport import_file(const fs::path& path, const ImportOptions& options) {
   // Zero-area triangles are found exactly by make_mesh; assimp's area test uses
   // an absolute threshold that would drop real triangles of small parts.
   importer.SetPropertyBool(AI_CONFIG_PP_FD_CHECKAREA, false);
-  // Only positions matter for collisions; dropping the rest lets
-  // JoinIdenticalVertices weld by position.
+  // Only positions matter for collisions (and cameras for pictures); dropping
+  // the rest lets JoinIdenticalVertices weld by position.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
                               aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                   aiComponent_COLORS | aiComponent_TEXCOORDS |
                                   aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
-                                  aiComponent_TEXTURES | aiComponent_LIGHTS | aiComponent_CAMERAS);
+                                  aiComponent_TEXTURES | aiComponent_LIGHTS);
 
   const aiScene* scene = nullptr;
   std::size_t repeated = 0;

@@ -232,14 +232,18 @@ void draw(const Geometry& geometry, const View& view, const RenderSettings& sett
   check_gl("drawing");
 }
 
-const Camera& find_camera(const RenderScene& scene, const std::string& name) {
+Camera find_camera(const RenderScene& scene, const std::string& name, double aspect) {
   for (const auto& [camera_name, camera] : scene.cameras) {
     if (camera_name == name) return camera;
   }
+  if (std::optional<Camera> view = view_camera(scene, aspect, name)) return *view;
   std::string known;
   for (const auto& entry : scene.cameras) known += (known.empty() ? "" : ", ") + entry.first;
-  throw RenderError("no camera named '" + name + "' (cameras: " +
-                    (known.empty() ? std::string("none") : known) + "; or 'auto')");
+  std::string views;
+  for (const std::string& v : builtin_views()) views += (views.empty() ? "" : ", ") + v;
+  throw RenderError("no camera named '" + name + "' (cameras of the scene: " +
+                    (known.empty() ? std::string("none") : known) + "; views: " + views +
+                    "; or 'auto')");
 }
 
 }  // namespace
@@ -263,7 +267,64 @@ collision::Bounds scene_bounds(const RenderScene& scene) {
   return bounds;
 }
 
+namespace {
+
+struct BuiltinView {
+  const char* name;
+  Vec3 direction;  ///< from the target towards the eye
+  Vec3 up;
+};
+
+const std::array<BuiltinView, 7> kViews = {{
+    {"front", Vec3::UnitZ(), Vec3::UnitY()},
+    {"back", -Vec3::UnitZ(), Vec3::UnitY()},
+    {"right", Vec3::UnitX(), Vec3::UnitY()},
+    {"left", -Vec3::UnitX(), Vec3::UnitY()},
+    {"top", Vec3::UnitY(), -Vec3::UnitZ()},
+    {"bottom", -Vec3::UnitY(), Vec3::UnitZ()},
+    {"iso", Vec3(1.0, 0.75, 1.4).normalized(), Vec3::UnitY()},
+}};
+
+/// The camera looking along -d (d: from the target towards the eye) with
+/// `up`, framed to hold the whole scene.
+Camera framed_camera(const RenderScene& scene, double aspect, const Vec3& d, const Vec3& up);
+
+}  // namespace
+
+const std::vector<std::string>& builtin_views() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const BuiltinView& v : kViews) out.emplace_back(v.name);
+    return out;
+  }();
+  return names;
+}
+
+std::optional<Camera> view_camera(const RenderScene& scene, double aspect, const std::string& view) {
+  for (const BuiltinView& v : kViews) {
+    if (view == v.name) return framed_camera(scene, aspect, v.direction, v.up);
+  }
+  return std::nullopt;
+}
+
+bool has_camera(const RenderScene& scene, const std::string& name) {
+  if (name.empty() || name == "auto") return true;
+  for (const auto& entry : scene.cameras) {
+    if (entry.first == name) return true;
+  }
+  for (const BuiltinView& v : kViews) {
+    if (name == v.name) return true;
+  }
+  return false;
+}
+
 Camera auto_camera(const RenderScene& scene, double aspect) {
+  return framed_camera(scene, aspect, kViews.back().direction, kViews.back().up);
+}
+
+namespace {
+
+Camera framed_camera(const RenderScene& scene, double aspect, const Vec3& d, const Vec3& up) {
   if (!std::isfinite(aspect) || aspect <= 0) aspect = 1;
   const collision::Bounds bounds = scene_bounds(scene);
   const Vec3 center = 0.5 * (bounds.min + bounds.max);
@@ -272,8 +333,7 @@ Camera auto_camera(const RenderScene& scene, double aspect) {
 
   Camera camera;
   camera.target = center;
-  camera.up = Vec3::UnitY();
-  const Vec3 d = Vec3(1.0, 0.75, 1.4).normalized();  // from the target towards the eye
+  camera.up = up;
   const Vec3 r = camera.up.cross(d).normalized();
   const Vec3 u = d.cross(r);
   const double tan_y = std::tan(camera.fov_y_degrees * std::numbers::pi / 360.0);
@@ -323,6 +383,8 @@ Camera auto_camera(const RenderScene& scene, double aspect) {
   return camera;
 }
 
+}  // namespace
+
 Image render(const RenderScene& scene, const RenderSettings& settings) {
   for (const auto& [what, value] :
        {std::pair{"width", settings.width}, std::pair{"height", settings.height}}) {
@@ -335,7 +397,7 @@ Image render(const RenderScene& scene, const RenderSettings& settings) {
   const double aspect = static_cast<double>(settings.width) / settings.height;
   const Camera camera = settings.camera.empty() || settings.camera == "auto"
                             ? auto_camera(scene, aspect)
-                            : find_camera(scene, settings.camera);
+                            : find_camera(scene, settings.camera, aspect);
   const View view = make_view(camera);
   const Geometry geometry = build_geometry(scene, view, settings.highlight);
 
@@ -380,6 +442,7 @@ RenderScene scene_from_import(const ImportReport& report) {
     item.name = report.parts[i].name;
     scene.items.push_back(std::move(item));
   }
+  scene.cameras = report.cameras;
   return scene;
 }
 

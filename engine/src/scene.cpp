@@ -222,6 +222,14 @@ std::string mesh_key(const Mesh& mesh) {
 
 }  // namespace
 
+void Scene::add_camera(const std::string& name, const Camera& camera) {
+  if (name.empty()) throw SceneError("scene: a camera needs a name");
+  for (const NamedCamera& c : cameras_) {
+    if (c.first == name) throw SceneError("scene: duplicate camera name '" + name + "'");
+  }
+  cameras_.emplace_back(name, camera);
+}
+
 Scene load_assembly(const fs::path& path, const AssemblyOptions& options, AssemblyReport* report) {
   ImportOptions import_options;
   import_options.merge = false;
@@ -270,6 +278,11 @@ Scene load_assembly(const fs::path& path, const AssemblyOptions& options, Assemb
     scene.add_part(desc);
     summary.triangles += it->second->triangle_count();
     ++summary.parts;
+  }
+  for (auto& [name, camera] : imported.cameras) {
+    camera.eye *= summary.units;
+    camera.target *= summary.units;
+    scene.add_camera(name, camera);
   }
   if (report != nullptr) *report = std::move(summary);
   return scene;

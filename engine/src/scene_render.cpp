@@ -41,6 +41,7 @@ RenderScene render_scene(const Scene& scene, const collision::StepResult* step,
     throw RenderError("render_scene: a collision step needs the map from parts to collision ids");
   }
   RenderScene out;
+  out.cameras = scene.cameras();
   std::map<collision::PartId, Highlight> by_id;
   for (const PartHandle part : scene.parts()) {
     const auto& mesh = scene.render_mesh(part);

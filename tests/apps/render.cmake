@@ -53,7 +53,19 @@ dovetail_cli_test(render_zero_width EXIT 2
 dovetail_cli_test(render_huge_height EXIT 2
                   ARGS render ${cube} --out ${out}/render_huge.png --height 16385 STDERR "--height")
 dovetail_cli_test(render_unknown_camera EXIT 2
-                  ARGS render ${cube} --out ${out}/render_cam.png --camera top
-                  STDERR "no camera named 'top'")
+                  ARGS render ${cube} --out ${out}/render_cam.png --camera overview
+                  STDERR "no camera named 'overview'&&views: front, back, right, left, top")
+# ---- cameras: the file's own (listed by inspect) and the built-in views
+dovetail_cli_test(render_file_camera EXIT 0
+                  ARGS render ${render_engine} --out ${out}/render_file_camera.png --width 64
+                       --height 48 --camera nodes[81]
+                  STDOUT "\"camera\":\"nodes\\[81\\]\"" REMOVE ${out}/render_file_camera.png)
+dovetail_cli_test(render_view_top EXIT 0
+                  ARGS render ${cube} --out ${out}/render_top.png --width 33 --height 17
+                       --camera top
+                  STDOUT "\"camera\":\"top\"" REMOVE ${out}/render_top.png)
+dovetail_cli_test(inspect_lists_cameras EXIT 0
+                  ARGS inspect ${render_engine} --method obb --json
+                  STDOUT "\"cameras\":\\[\"nodes\\[81\\]\"\\]")
 dovetail_cli_test(render_out_is_input EXIT 2 ARGS render ${cube} --out ${data}/../data/cube.obj
                   STDERR "would be overwritten")

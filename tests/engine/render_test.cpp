@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <numbers>
 #include <set>
 #include <string>
 #include <thread>
@@ -228,6 +229,57 @@ TEST(Render, AutoCameraIsDeterministicAndSeesTheCentre) {
   EXPECT_GT((a.eye - a.target).norm(), radius);
 }
 
+TEST_F(EngineRender, FileCameraAndBuiltInViewsShowTheEngine) {
+  // The engine file carries one perspective camera; every built-in view frames
+  // the whole engine, and each view is a different picture.
+  ASSERT_EQ(scene_->cameras.size(), 1u);
+  EXPECT_EQ(scene_->cameras[0].first, "nodes[81]");
+  const Camera& file_camera = scene_->cameras[0].second;
+  EXPECT_NEAR(file_camera.eye.x(), 1005.987, 1e-2);  // the node's translation, file units
+  EXPECT_NEAR(file_camera.fov_y_degrees, 0.3143463730812073 * 180 / std::numbers::pi, 1e-4);
+  std::vector<std::string> names = builtin_views();
+  names.push_back("nodes[81]");
+  std::set<std::string> pictures;  // the images' bytes
+  for (const std::string& name : names) {
+    RenderSettings settings;
+    settings.width = 160;
+    settings.height = 120;
+    settings.camera = name;
+    ASSERT_TRUE(has_camera(*scene_, name));
+    const Image image = render(*scene_, settings);
+    const auto background = to_bytes(settings.background);
+    std::size_t foreground = 0;
+    for (std::size_t p = 0; p < image.rgba.size() / 4; ++p) foreground += rgb_at(image, p) != background;
+    EXPECT_GT(foreground, 160u * 120u / 10) << name;
+    if (name != "nodes[81]") {
+      // Framed like auto: the corners show the background.
+      EXPECT_EQ(rgb_at(image, 0), background) << name;
+      EXPECT_EQ(rgb_at(image, 160 * 120 - 1), background) << name;
+    }
+    pictures.insert(std::string(image.rgba.begin(), image.rgba.end()));
+  }
+  EXPECT_EQ(pictures.size(), names.size());
+  // "iso" is auto's view.
+  RenderSettings iso, automatic;
+  iso.width = automatic.width = 96;
+  iso.height = automatic.height = 64;
+  iso.camera = "iso";
+  EXPECT_EQ(render(*scene_, iso).rgba, render(*scene_, automatic).rgba);
+  EXPECT_FALSE(has_camera(*scene_, "nope"));
+}
+
+TEST(Render, UnknownCameraNamesTheChoices) {
+  RenderSettings settings;
+  settings.camera = "nope";
+  try {
+    render(small_scene(), settings);
+    FAIL() << "no error";
+  } catch (const RenderError& e) {
+    EXPECT_NE(std::string(e.what()).find("'nope'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("front"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Render, BadInputIsRejected) {
   RenderScene scene = small_scene();
   RenderSettings settings;
@@ -335,7 +387,8 @@ TEST(Render, SceneFromImportHasOneItemPerPart) {
   std::size_t differing = 0;
   for (std::size_t p = 0; p < a.rgba.size() / 4; ++p) differing += rgb_at(a, p) != rgb_at(b, p);
   EXPECT_LT(differing, a.rgba.size() / 4 / 50);
-  EXPECT_TRUE(scene.cameras.empty());
+  EXPECT_EQ(scene.cameras, report.cameras);  // the file's own camera comes along
+  EXPECT_EQ(scene.cameras.size(), 1u);
 }
 
 }  // namespace

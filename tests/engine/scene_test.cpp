@@ -120,6 +120,28 @@ TEST(Scene, MovingAParentMovesItsChildren) {
   EXPECT_TRUE(scene.world_pose(gripper).t.isApprox(X_WG.t, 1e-12));
 }
 
+TEST(Assembly, FileCamerasBecomeSceneCamerasInMetres) {
+  AssemblyReport report;
+  const Scene scene = load_assembly(kEngine, {}, &report);
+  ASSERT_DOUBLE_EQ(report.units, 0.001);
+  ASSERT_EQ(scene.cameras().size(), 1u);
+  const Camera& camera = scene.cameras()[0].second;
+  // The camera node's matrix places the eye at (1005.99, 766.32, 953.35) mm
+  // looking along the node's -z axis.
+  EXPECT_NEAR(camera.eye.x(), 1.00599, 1e-5);
+  EXPECT_NEAR(camera.eye.y(), 0.76632, 1e-5);
+  EXPECT_NEAR(camera.eye.z(), 0.95335, 1e-5);
+  const Vec3 look = (camera.target - camera.eye).normalized();
+  EXPECT_NEAR(look.x(), -0.6246951818466187, 1e-6);
+  EXPECT_NEAR(look.y(), -0.4685211479663849, 1e-6);
+  EXPECT_NEAR(look.z(), -0.6246950030326843, 1e-6);
+  Scene copy = scene;
+  EXPECT_THROW(copy.add_camera("nodes[81]", camera), SceneError);
+  EXPECT_THROW(copy.add_camera("", camera), SceneError);
+  copy.add_camera("overview", camera);
+  EXPECT_EQ(copy.cameras().back().first, "overview");
+}
+
 TEST(Assembly, EngineLoadsAsSeparateNamedParts) {
   AssemblyReport report;
   const Scene scene = load_assembly(kEngine, {}, &report);

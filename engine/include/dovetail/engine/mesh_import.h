@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "dovetail/collision/mesh.h"
+#include "dovetail/engine/camera.h"
 
 namespace dovetail::engine {
 
@@ -59,6 +60,10 @@ struct ImportedPart {
 /// Everything an import produced and noticed.
 struct ImportReport {
   std::vector<ImportedPart> parts;  ///< one when merged; depth-first node order otherwise
+  /// The file's perspective cameras in its root frame, named as the importer
+  /// names them (the camera node's name; `nodes[i]` for an unnamed glTF
+  /// node), in file order. Orthographic cameras are skipped with a note.
+  std::vector<NamedCamera> cameras;
   std::size_t skipped_line_or_point_primitives = 0;  ///< not triangles, left out
   std::vector<std::string> notes;                    ///< things worth telling the user, not errors
 };

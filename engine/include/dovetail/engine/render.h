@@ -22,6 +22,7 @@
 
 #include "dovetail/collision/mesh.h"
 #include "dovetail/collision/types.h"
+#include "dovetail/engine/camera.h"
 #include "dovetail/engine/mesh_import.h"
 
 namespace dovetail::engine {
@@ -48,25 +49,19 @@ struct RenderItem {
   std::string name;  ///< for messages
 };
 
-/// A pinhole camera looking from `eye` at `target`.
-struct Camera {
-  collision::Vec3 eye = collision::Vec3(1, 1, 1);
-  collision::Vec3 target = collision::Vec3::Zero();
-  collision::Vec3 up = collision::Vec3::UnitY();  ///< need not be orthogonal to the view direction
-  double fov_y_degrees = 35;                      ///< vertical field of view, in (0, 180)
-};
-
 /// Everything that is drawn.
 struct RenderScene {
   std::vector<RenderItem> items;
-  std::vector<std::pair<std::string, Camera>> cameras;  ///< named cameras, looked up by name
+  std::vector<NamedCamera> cameras;  ///< named cameras, looked up by name before the built-in views
 };
 
 /// How to draw.
 struct RenderSettings {
   int width = 1024;    ///< pixels, 1 to kMaxImageSize
   int height = 768;    ///< pixels, 1 to kMaxImageSize
-  std::string camera;  ///< empty or "auto": auto_camera; otherwise a camera of the scene
+  /// Empty or "auto": auto_camera; otherwise a camera of the scene, or a
+  /// built-in view (see view_camera).
+  std::string camera;
   Color background{0.93F, 0.94F, 0.96F};
   Color highlight{1.0F, 0.1F, 0.1F};
 };
@@ -94,6 +89,20 @@ collision::Bounds scene_bounds(const RenderScene& scene);
 /// (width / height). Deterministic.
 Camera auto_camera(const RenderScene& scene, double aspect);
 
+/// Names of the built-in views: front (from +z), back (from -z), right (from
+/// +x), left (from -x), top (from +y, -z up), bottom (from -y, +z up) and iso
+/// (auto_camera's oblique direction); y is up unless stated.
+const std::vector<std::string>& builtin_views();
+
+/// A built-in view framed like auto_camera: looking at the scene's centre
+/// along the view's direction, backed off until everything fits an image of
+/// the given aspect. Nullopt for a name that is not a built-in view.
+std::optional<Camera> view_camera(const RenderScene& scene, double aspect, const std::string& view);
+
+/// Whether `name` selects a camera for `scene`: "auto", a named camera of the
+/// scene, or a built-in view.
+bool has_camera(const RenderScene& scene, const std::string& name);
+
 /// Draws the scene. Throws RenderError for bad settings (sizes, an unknown
 /// camera name, a degenerate camera), an item without mesh or with an
 /// out-of-range highlighted triangle, or when the off-screen context cannot be
@@ -107,7 +116,7 @@ void write_png(const Image& image, const std::filesystem::path& path);
 
 /// One item per imported part (posed by the part's X_RP, so the file's root
 /// frame is the world; palette colours in part order; named after the
-/// parts), no cameras.
+/// parts), and the file's cameras.
 RenderScene scene_from_import(const ImportReport& report);
 
 }  // namespace dovetail::engine

@@ -23,6 +23,7 @@
 
 #include "dovetail/collision/mesh.h"
 #include "dovetail/collision/types.h"
+#include "dovetail/engine/camera.h"
 #include "dovetail/engine/mesh_import.h"
 
 namespace dovetail::engine {
@@ -116,6 +117,12 @@ class Scene {
   /// The collision mesh (the render mesh unless another was given); may be null.
   const std::shared_ptr<const collision::Mesh>& collision_mesh(PartHandle part) const;
 
+  /// Adds a named camera (in the world frame) for rendering. Throws
+  /// SceneError for an empty or duplicate name.
+  void add_camera(const std::string& name, const Camera& camera);
+  /// Named cameras in the order added (an assembly file's own come first).
+  const std::vector<NamedCamera>& cameras() const { return cameras_; }
+
  private:
   struct Slot {
     std::uint32_t generation = 0;
@@ -136,6 +143,7 @@ class Scene {
   /// (name, index) sorted by name: lookups by binary search, iteration in name order.
   std::vector<std::pair<std::string, std::uint32_t>> by_name_;
   std::size_t count_ = 0;
+  std::vector<NamedCamera> cameras_;
 };
 
 /// X_AC = X_AB * X_BC.
@@ -171,7 +179,8 @@ struct AssemblyReport {
 /// Loads `path` as a scene: one part per mesh instance of every node, named
 /// as the importer names them (unique), placed at the node's pose in the
 /// file's root frame (a flat list: intermediate nodes are folded into the
-/// parts' poses), scaled to metres. Identical meshes are shared. Throws
+/// parts' poses), scaled to metres. Identical meshes are shared. The file's
+/// perspective cameras become the scene's named cameras. Throws
 /// ImportError naming the file for anything import_file refuses.
 Scene load_assembly(const std::filesystem::path& path, const AssemblyOptions& options = {},
                     AssemblyReport* report = nullptr);
