@@ -1,0 +1,167 @@
+#include "tri_distance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "dovetail/collision/tri_tri.h"
+
+namespace dovetail::collision::detail {
+
+namespace {
+
+Real clamp01(Real x) { return std::clamp(x, Real{0}, Real{1}); }
+
+/// Squared distance from v to the interior of triangle t when v projects
+/// into the (closed) triangle along its normal n = (t1 - t0) x (t2 - t0),
+/// with the projection in `on_t`; false when it projects outside (an edge
+/// pair is then at least as close) or the normal vanished in rounding.
+bool vertex_face(const Vec3& v, const TriangleVertices& t, const Vec3& n, Real n2, Vec3& on_t,
+                 Real& d2) {
+  if (!(n2 > 0)) return false;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3& s = t[k];
+    const Vec3& e = t[(k + 1) % 3];
+    if ((e - s).cross(v - s).dot(n) < 0) return false;
+  }
+  const Real h = n.dot(v - t[0]);
+  on_t = v - n * (h / n2);
+  d2 = h * h / n2;
+  return true;
+}
+
+}  // namespace
+
+Real segment_distance_squared(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1,
+                              Vec3& x, Vec3& y) {
+  const Vec3 d1 = p1 - p0;
+  const Vec3 d2 = q1 - q0;
+  const Vec3 r = p0 - q0;
+  const Real a = d1.dot(d1);
+  const Real e = d2.dot(d2);
+  const Real f = d2.dot(r);
+  Real s = 0, t = 0;
+  if (a > 0 && e > 0) {
+    const Real b = d1.dot(d2);
+    const Real c = d1.dot(r);
+    // The lines' closest point on the first segment, clamped; for (nearly)
+    // parallel lines every s is as good, and the steps below fix the rest.
+    const Real denom = a * e - b * b;
+    if (denom > 0x1.0p-48 * a * e) s = clamp01((b * f - c * e) / denom);
+    // The best t for that s; if it falls outside, clamp it and re-fit s.
+    t = (b * s + f) / e;
+    if (t < 0) {
+      t = 0;
+      s = clamp01(-c / a);
+    } else if (t > 1) {
+      t = 1;
+      s = clamp01((b - c) / a);
+    }
+  } else if (e > 0) {
+    t = clamp01(f / e);
+  } else if (a > 0) {
+    s = clamp01(-d1.dot(r) / a);
+  }
+  x = p0 + d1 * s;
+  y = q0 + d2 * t;
+  return (x - y).squaredNorm();
+}
+
+Vec3 closest_point_on_triangle(const Vec3& p, const TriangleVertices& t) {
+  const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
+  Vec3 best;
+  Real best_d2;
+  if (vertex_face(p, t, n, n.squaredNorm(), best, best_d2)) return best;
+  best_d2 = std::numeric_limits<Real>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    Vec3 x, y;
+    const Real d2 = segment_distance_squared(p, p, t[k], t[(k + 1) % 3], x, y);
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = y;
+    }
+  }
+  return best;
+}
+
+Real feature_distance_squared(const TriangleVertices& a, const TriangleVertices& b, Vec3& p,
+                              Vec3& q) {
+  Real best = std::numeric_limits<Real>::infinity();
+  Vec3 x, y;
+  // The nine edge pairs.
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const Real d2 = segment_distance_squared(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3], x, y);
+      if (d2 < best) {
+        best = d2;
+        p = x;
+        q = y;
+      }
+    }
+  }
+  // The six vertices against the other triangle's interior.
+  const Vec3 n_a = (a[1] - a[0]).cross(a[2] - a[0]);
+  const Vec3 n_b = (b[1] - b[0]).cross(b[2] - b[0]);
+  const Real n2_a = n_a.squaredNorm();
+  const Real n2_b = n_b.squaredNorm();
+  for (int k = 0; k < 3; ++k) {
+    Real d2;
+    if (vertex_face(b[k], a, n_a, n2_a, x, d2) && d2 < best) {
+      best = d2;
+      p = x;
+      q = b[k];
+    }
+    if (vertex_face(a[k], b, n_b, n2_b, y, d2) && d2 < best) {
+      best = d2;
+      p = a[k];
+      q = y;
+    }
+  }
+  return best;
+}
+
+namespace {
+
+/// A point where intersecting triangles meet: the feature pairs, and every
+/// edge of one triangle where it crosses the other's plane against its
+/// closest point on that triangle; the midpoint of the closest such pair.
+Vec3 intersection_witness(const TriangleVertices& a, const TriangleVertices& b) {
+  Vec3 p, q;
+  Real best = feature_distance_squared(a, b, p, q);
+  for (int side = 0; side < 2; ++side) {
+    const TriangleVertices& x = side == 0 ? a : b;
+    const TriangleVertices& y = side == 0 ? b : a;
+    const Vec3 n = (y[1] - y[0]).cross(y[2] - y[0]);
+    Real h[3];
+    for (int k = 0; k < 3; ++k) h[k] = n.dot(x[k] - y[0]);
+    for (int k = 0; k < 3; ++k) {
+      const int l = (k + 1) % 3;
+      if (h[k] == h[l] || (h[k] > 0 && h[l] > 0) || (h[k] < 0 && h[l] < 0)) continue;
+      const Vec3 on_x = x[k] + (x[l] - x[k]) * (h[k] / (h[k] - h[l]));
+      const Vec3 on_y = closest_point_on_triangle(on_x, y);
+      const Real d2 = (on_x - on_y).squaredNorm();
+      if (d2 < best) {
+        best = d2;
+        p = side == 0 ? on_x : on_y;
+        q = side == 0 ? on_y : on_x;
+      }
+    }
+  }
+  return (p + q) * 0.5;
+}
+
+}  // namespace
+
+TriangleDistance triangle_distance(const TriangleVertices& a, const TriangleVertices& b) {
+  TriangleDistance out;
+  if (triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2])) {
+    out.p = out.q = intersection_witness(a, b);
+    out.distance = 0;
+    return out;
+  }
+  out.distance = std::sqrt(feature_distance_squared(a, b, out.p, out.q));
+  if (out.distance == 0) out.distance = std::numeric_limits<Real>::denorm_min();
+  return out;
+}
+
+}  // namespace dovetail::collision::detail
