@@ -138,6 +138,23 @@ std::optional<std::vector<double>> Args::number_list(const std::string& name) co
   return numbers;
 }
 
+std::optional<double> Args::number(const std::string& name, double min) const {
+  const std::optional<std::string> text = value(name);
+  if (!text) return std::nullopt;
+  const char* first = text->data();
+  if (!text->empty() && (*text)[0] == '+') ++first;
+  double v = 0;
+  const auto [ptr, ec] = std::from_chars(first, text->data() + text->size(), v);
+  if (text->empty() || ec != std::errc() || ptr != text->data() + text->size() ||
+      !std::isfinite(v) || v < min) {
+    char bound[32];
+    std::snprintf(bound, sizeof bound, "%g", min);
+    throw UsageError(command_ + ": --" + name + " must be a finite number >= " + bound + ", not '" +
+                     *text + "'");
+  }
+  return v == 0 ? 0.0 : v;  // -0 reads as 0
+}
+
 collision::Method Args::method(collision::Method fallback) const {
   const std::optional<std::string> name = value("method");
   if (!name) return fallback;
@@ -258,6 +275,12 @@ JsonLine& JsonLine::add(std::string_view k, bool value) {
 JsonLine& JsonLine::add_raw(std::string_view k, std::string_view json) {
   key(k);
   body_ += json;
+  return *this;
+}
+
+JsonLine& JsonLine::add_all(const JsonLine& other) {
+  if (!body_.empty() && !other.body_.empty()) body_ += ",";
+  body_ += other.body_;
   return *this;
 }
 

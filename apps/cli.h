@@ -64,6 +64,8 @@ class Args {
                                       std::int64_t max) const;
   std::optional<std::uint64_t> unsigned_integer(const std::string& name) const;
   std::optional<std::vector<double>> number_list(const std::string& name) const;
+  /// A finite decimal number >= `min` (optional sign and exponent).
+  std::optional<double> number(const std::string& name, double min) const;
   /// --method, default `fallback`; UsageError listing the valid names.
   collision::Method method(collision::Method fallback) const;
 
@@ -119,6 +121,8 @@ class JsonLine {
   JsonLine& add(std::string_view key, bool value);
   /// A value that is already JSON (an array or object).
   JsonLine& add_raw(std::string_view key, std::string_view json);
+  /// Every key of `other`, in its order, after the keys so far.
+  JsonLine& add_all(const JsonLine& other);
   std::string str() const { return "{" + body_ + "}"; }
 
  private:

@@ -1,4 +1,5 @@
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -9,6 +10,8 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "dovetail/collision/contacts.h"
+#include "dovetail/collision/distance.h"
 #include "dovetail/engine/pose_list.h"
 #include "pose_queries.h"
 
@@ -18,23 +21,96 @@ namespace {
 
 constexpr const char* kHelp =
     R"(usage: dovetail query A B --poses FILE [--method M] [--out FLAGS] [--all-pairs] [--threads N]
+       dovetail query A B --poses FILE --distance [--method rss|brute] [--out FILE] [--threads N]
+       dovetail query A B --poses FILE --tolerance EPS [--method rss|brute] [--out FILE] [--threads N]
+       dovetail query A B --poses FILE --contacts [--contact-tolerance T] [--method M] [--out FILE]
+                      [--threads N]
 
 Tests mesh B against mesh A at every pose of a pose list.
 
   A, B           mesh files (any format assimp reads), each merged into one mesh
   --poses FILE   pose list: one pose of B in A's frame per line, `tx ty tz qw qx qy qz`
                  (extra columns ignored, `#` lines and blank lines skipped)
-  --method M     boxtree (default), dop6, dop14, dop18, dop26, aabb, obb, brute
-  --out FLAGS    write the verdicts there, one line per pose: 1 colliding, 0 not
-                 (default: standard output, before the summary)
+  --method M     boxtree (default), dop6, dop14, dop18, dop26, aabb, obb, brute;
+                 with --distance or --tolerance: rss (default) or brute
+  --out FLAGS    write the per-pose lines there (default: standard output, before
+                 the summary)
   --all-pairs    find every intersecting triangle pair, not just the first
-                 (the verdicts are the same; the summary adds pairs_total)
+                 (the verdicts are the same; the summary adds pairs_total);
+                 not with --distance or --tolerance, implied by --contacts
   --threads N    worker threads for the queries (default 1; 0 = all cores)
 
+One of these changes what each pose's line holds (at most one may be given):
+  (none)             1 colliding, 0 not
+  --distance         the minimum distance between the surfaces (0 when colliding),
+                     17 significant digits
+  --tolerance EPS    1 when the distance is at most EPS (a finite number >= 0), 0 not
+  --contacts         one JSON object: the contact patches of the all-pairs result
+  --contact-tolerance T
+                     with --contacts: a patch deeper than T is penetrating
+                     (default 1e-6)
+
 Prints a one-line JSON summary on standard output. A bad pose line stops the
-run with an error naming file and line; the verdicts of the poses before it
-are still written.
+run with an error naming file and line; the lines of the poses before it are
+still written.
 )";
+
+enum class Mode { kCollide, kDistance, kTolerance, kContacts };
+
+const char* mode_name(Mode mode) {
+  switch (mode) {
+    case Mode::kCollide:
+      return "collide";
+    case Mode::kDistance:
+      return "distance";
+    case Mode::kTolerance:
+      return "tolerance";
+    case Mode::kContacts:
+      return "contacts";
+  }
+  return "collide";
+}
+
+/// The mode the options ask for; UsageError for options that do not go together.
+Mode parse_mode(const Args& args) {
+  std::vector<std::string> given;
+  if (args.flag("distance")) given.emplace_back("--distance");
+  if (args.value("tolerance")) given.emplace_back("--tolerance");
+  if (args.flag("contacts")) given.emplace_back("--contacts");
+  if (given.size() > 1) {
+    throw UsageError("query: " + given[0] + " and " + given[1] +
+                     " cannot be combined: each chooses what a pose's line holds; give at most "
+                     "one of --distance, --tolerance, --contacts");
+  }
+  const Mode mode = args.flag("distance")     ? Mode::kDistance
+                    : args.value("tolerance") ? Mode::kTolerance
+                    : args.flag("contacts")   ? Mode::kContacts
+                                              : Mode::kCollide;
+  if ((mode == Mode::kDistance || mode == Mode::kTolerance) && args.flag("all-pairs")) {
+    throw UsageError("query: --all-pairs cannot be combined with " + given[0] +
+                     ", which reports no triangle pairs");
+  }
+  if (mode != Mode::kContacts && args.value("contact-tolerance")) {
+    throw UsageError("query: --contact-tolerance needs --contacts");
+  }
+  return mode;
+}
+
+/// --method for the distance modes: false for rss (the default), true for
+/// brute. A collision method has no distance query: a usage error, rather
+/// than silently measuring with another method than the one asked for.
+bool distance_method_is_brute(const Args& args, Mode mode) {
+  const std::optional<std::string> name = args.value("method");
+  if (!name || *name == "rss") return false;
+  if (*name == "brute") return true;
+  const std::string option = mode == Mode::kDistance ? "--distance" : "--tolerance";
+  if (collision::parse_method(*name)) {
+    throw UsageError("query: method '" + *name + "' has no distance query; " + option +
+                     " uses rss (the default) or brute");
+  }
+  throw UsageError("query: unknown method '" + *name + "' for " + option +
+                   "; valid methods: rss, brute");
+}
 
 double round_ms(double ms) { return std::round(ms * 1000.0) / 1000.0; }
 
@@ -48,17 +124,56 @@ void print_notes(const std::string& path, const LoadedMesh& loaded) {
   }
 }
 
+/// A distance model and how long the build took.
+struct BuiltDistanceModel {
+  std::shared_ptr<const collision::DistanceModel> model;
+  double build_ms = 0;
+};
+
+BuiltDistanceModel build_distance_timed(std::shared_ptr<const collision::Mesh> mesh) {
+  const auto start = std::chrono::steady_clock::now();
+  BuiltDistanceModel built;
+  built.model = collision::build_distance_model(std::move(mesh));
+  built.build_ms = ms_since(start);
+  return built;
+}
+
+/// Build times and memory of the two hierarchies (all 0 for brute-force distances).
+struct ModelSummary {
+  double build_ms_a = 0;
+  double build_ms_b = 0;
+  std::uint64_t bytes_a = 0;
+  std::uint64_t bytes_b = 0;
+};
+
 }  // namespace
 
 int query_command(std::span<const std::string> argv) {
-  const Args args("query", argv, {"poses", "method", "out", "threads"}, {"all-pairs"});
+  const Args args("query", argv,
+                  {"poses", "method", "out", "threads", "tolerance", "contact-tolerance"},
+                  {"all-pairs", "distance", "contacts"});
   if (args.help()) {
     std::fputs(kHelp, stdout);
     return kExitOk;
   }
   args.expect_positional(2, "two mesh files A and B");
   const std::string poses_path = args.required("poses");
-  const collision::Method method = args.method(collision::Method::kBoxtree);
+  const Mode mode = parse_mode(args);
+  const bool distance_mode = mode == Mode::kDistance || mode == Mode::kTolerance;
+  const bool distance_brute = distance_mode && distance_method_is_brute(args, mode);
+  if (!distance_mode && args.value("method") == "rss") {
+    throw UsageError(
+        "query: method 'rss' (the distance hierarchy) answers --distance and --tolerance only; "
+        "collision methods: " +
+        method_list());
+  }
+  // The collision method (not used by the distance modes, which have their own).
+  const collision::Method method =
+      distance_mode ? collision::Method::kBrute : args.method(collision::Method::kBoxtree);
+  const double tolerance = args.number("tolerance", 0.0).value_or(0.0);
+  collision::ContactRequest contact_request;
+  contact_request.touching_tolerance =
+      args.number("contact-tolerance", 0.0).value_or(contact_request.touching_tolerance);
   const int threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
   const std::optional<std::string> out_path = args.value("out");
   collision::CollideRequest request;
@@ -88,7 +203,7 @@ int query_command(std::span<const std::string> argv) {
   print_notes(path_b, b);
 
   // Every good pose up to the first bad line; the error is reported after the
-  // verdicts of those poses are written.
+  // lines of those poses are written.
   std::vector<collision::Transform> poses;
   std::optional<std::string> pose_error;
   try {
@@ -97,43 +212,105 @@ int query_command(std::span<const std::string> argv) {
     pose_error = e.what();
   }
 
-  const BuiltModel model_a = build_timed(method, a.mesh);
-  const BuiltModel model_b = build_timed(method, b.mesh);
-  const PoseQueryResult result =
-      run_pose_queries(*model_a.model, *model_b.model, poses, request, threads);
+  // Per-pose lines, the mode's own summary keys and the work done. `counts`
+  // come after query_ms_total, `extras` after threads.
+  std::string lines;
+  ModelSummary models;
+  JsonLine counts;
+  JsonLine extras;
+  collision::CollideStats stats;
+  double query_ms = 0;
+  if (distance_mode) {
+    DistanceInputs inputs{.mesh_a = a.mesh.get(), .mesh_b = b.mesh.get()};
+    BuiltDistanceModel model_a;
+    BuiltDistanceModel model_b;
+    if (!distance_brute) {
+      model_a = build_distance_timed(a.mesh);
+      model_b = build_distance_timed(b.mesh);
+      inputs.model_a = model_a.model.get();
+      inputs.model_b = model_b.model.get();
+      models = {model_a.build_ms, model_b.build_ms, model_a.model->info().bytes,
+                model_b.model->info().bytes};
+    }
+    if (mode == Mode::kDistance) {
+      const DistanceQueryResult result = run_distance_queries(inputs, poses, threads);
+      lines.reserve(20 * poses.size());
+      for (double d : result.distances) lines += format_distance(d) + "\n";
+      counts.add("colliding", result.colliding_count)
+          .add("distance_min", result.distance_min)
+          .add("distance_max", result.distance_max);
+      stats = result.stats;
+      query_ms = result.wall_ms;
+    } else {
+      const ToleranceQueryResult result = run_tolerance_queries(inputs, poses, tolerance, threads);
+      lines.reserve(2 * poses.size());
+      for (std::uint8_t w : result.within) lines += w != 0 ? "1\n" : "0\n";
+      counts.add("tolerance", tolerance).add("within", result.within_count);
+      stats = result.stats;
+      query_ms = result.wall_ms;
+    }
+  } else {
+    const BuiltModel model_a = build_timed(method, a.mesh);
+    const BuiltModel model_b = build_timed(method, b.mesh);
+    models = {model_a.build_ms, model_b.build_ms, model_a.model->info().bytes,
+              model_b.model->info().bytes};
+    if (mode == Mode::kContacts) {
+      const ContactQueryResult result =
+          run_contact_queries(*model_a.model, *model_b.model, poses, contact_request, threads);
+      for (const std::string& line : result.lines) lines += line + "\n";
+      counts.add("colliding", result.colliding_count);
+      extras.add("pairs_total", result.pairs_total)
+          .add("contact_tolerance", contact_request.touching_tolerance)
+          .add("patches_total", result.patches_total)
+          .add("patches_face", result.face_patches)
+          .add("patches_curve", result.curve_patches)
+          .add("patches_point", result.point_patches)
+          .add("patches_penetrating", result.penetrating_patches);
+      stats = result.stats;
+      query_ms = result.wall_ms;
+    } else {
+      const PoseQueryResult result =
+          run_pose_queries(*model_a.model, *model_b.model, poses, request, threads);
+      lines.reserve(2 * poses.size());
+      for (std::uint8_t c : result.colliding) lines += c != 0 ? "1\n" : "0\n";
+      counts.add("colliding", result.colliding_count);
+      if (request.all_pairs) extras.add("pairs_total", result.pairs_total);
+      stats = result.stats;
+      query_ms = result.wall_ms;
+    }
+  }
 
-  std::string flags;
-  flags.reserve(2 * poses.size());
-  for (std::uint8_t c : result.colliding) flags += c != 0 ? "1\n" : "0\n";
   if (out_path) {
-    out.write(flags.data(), static_cast<std::streamsize>(flags.size()));
+    out.write(lines.data(), static_cast<std::streamsize>(lines.size()));
     out.close();
     if (!out) throw InputError(*out_path + ": write failed: " + std::strerror(errno));
   } else {
-    std::fwrite(flags.data(), 1, flags.size(), stdout);
+    std::fwrite(lines.data(), 1, lines.size(), stdout);
   }
 
-  const collision::ModelInfo info_a = model_a.model->info();
-  const collision::ModelInfo info_b = model_b.model->info();
+  const std::string_view method_shown = !distance_mode   ? collision::method_name(method)
+                                        : distance_brute ? std::string_view("brute")
+                                                         : std::string_view("rss");
   JsonLine json;
-  json.add("method", collision::method_name(method))
+  json.add("method", method_shown)
+      .add("mode", mode_name(mode))
       .add("a", path_a)
       .add("b", path_b)
       .add("triangles_a", std::uint64_t{a.mesh->triangle_count()})
       .add("triangles_b", std::uint64_t{b.mesh->triangle_count()})
-      .add("build_ms", round_ms(model_a.build_ms + model_b.build_ms))
-      .add("build_ms_a", round_ms(model_a.build_ms))
-      .add("build_ms_b", round_ms(model_b.build_ms))
+      .add("build_ms", round_ms(models.build_ms_a + models.build_ms_b))
+      .add("build_ms_a", round_ms(models.build_ms_a))
+      .add("build_ms_b", round_ms(models.build_ms_b))
       .add("queries", std::uint64_t{poses.size()})
-      .add("query_ms_total", round_ms(result.wall_ms))
-      .add("colliding", result.colliding_count)
-      .add("model_bytes", std::uint64_t{info_a.bytes + info_b.bytes})
-      .add("model_bytes_a", std::uint64_t{info_a.bytes})
-      .add("model_bytes_b", std::uint64_t{info_b.bytes})
-      .add("volume_tests", result.stats.volume_tests)
-      .add("triangle_tests", result.stats.triangle_tests)
-      .add("threads", threads);
-  if (request.all_pairs) json.add("pairs_total", result.pairs_total);
+      .add("query_ms_total", round_ms(query_ms))
+      .add_all(counts)
+      .add("model_bytes", models.bytes_a + models.bytes_b)
+      .add("model_bytes_a", models.bytes_a)
+      .add("model_bytes_b", models.bytes_b)
+      .add("volume_tests", stats.volume_tests)
+      .add("triangle_tests", stats.triangle_tests)
+      .add("threads", threads)
+      .add_all(extras);
   if (pose_error) json.add("error", *pose_error);
   std::fputs((json.str() + "\n").c_str(), stdout);
 

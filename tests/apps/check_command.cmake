@@ -3,10 +3,11 @@
 #   cmake -DPROGRAM=<exe> -DARGS=<arg|arg|...> -DEXPECT_EXIT=<code>
 #         [-DEXPECT_STDOUT=<regex>] [-DEXPECT_STDERR=<regex>] [-DREJECT_STDOUT=<regex>]
 #         [-DEXPECT_FILE=<path> -DEXPECT_FILE_CONTENT=<exact text>]
+#         [-DEXPECT_FILE=<path> -DEXPECT_FILE_MATCHES=<regex>]
 #         [-DREMOVE_FIRST=<path>] -P check_command.cmake
 #
-# Arguments are separated by `|`. EXPECT_STDOUT / EXPECT_STDERR may hold several
-# regexes, all required, separated by `&&` (they become a CMake list, so a
+# Arguments are separated by `|`. EXPECT_STDOUT / EXPECT_STDERR / EXPECT_FILE_MATCHES
+# may hold several regexes, all required, separated by `&&` (they become a CMake list, so a
 # regex must not contain an unbalanced `[`).
 
 if(NOT DEFINED PROGRAM OR NOT DEFINED EXPECT_EXIT)
@@ -48,8 +49,16 @@ if(DEFINED EXPECT_FILE)
     string(APPEND problems "${EXPECT_FILE} was not written\n")
   else()
     file(READ "${EXPECT_FILE}" content)
-    if(NOT content STREQUAL "${EXPECT_FILE_CONTENT}")
+    if(DEFINED EXPECT_FILE_CONTENT AND NOT content STREQUAL "${EXPECT_FILE_CONTENT}")
       string(APPEND problems "${EXPECT_FILE} holds:\n${content}\nexpected:\n${EXPECT_FILE_CONTENT}\n")
+    endif()
+    if(DEFINED EXPECT_FILE_MATCHES)
+      string(REPLACE "&&" ";" wanted "${EXPECT_FILE_MATCHES}")
+      foreach(regex IN LISTS wanted)
+        if(NOT content MATCHES "${regex}")
+          string(APPEND problems "${EXPECT_FILE} does not match '${regex}'; it holds:\n${content}\n")
+        endif()
+      endforeach()
     endif()
   endif()
 endif()
