@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "dovetail/collision/convex.h"
+#include "dovetail/collision/distance.h"
 #include "dovetail/collision/task_system.h"
 #include "dovetail/collision/tri_tri.h"
 #include "hierarchy_common.h"
@@ -20,9 +21,11 @@ namespace {
 struct Shape {
   std::shared_ptr<const Mesh> mesh;
   std::shared_ptr<const CollisionModel> model;  ///< polygon level, built for the first exact pair
-  std::shared_ptr<const ConvexHull> hull;       ///< convex level and tight world boxes
-  bool hull_failed = false;                     ///< flat part: no hull, conservative boxes
-  Vec3 local_min, local_max;                    ///< bounds in the part's frame
+  /// Distance hierarchy, built for the first exact distance query.
+  std::shared_ptr<const DistanceModel> distance_model;
+  std::shared_ptr<const ConvexHull> hull;  ///< convex level and tight world boxes
+  bool hull_failed = false;                ///< flat part: no hull, conservative boxes
+  Vec3 local_min, local_max;               ///< bounds in the part's frame
   Real max_abs = 0;
   /// Triangles around each vertex (compressed): those of vertex v are
   /// vertex_triangles[vertex_offsets[v] .. vertex_offsets[v + 1]). Built with
@@ -143,6 +146,10 @@ struct CollisionWorld::Impl {
     } catch (const std::invalid_argument&) {
       shape.hull_failed = true;  // a flat part: conservative boxes, no convex level
     }
+  }
+
+  void ensure_distance_model(Shape& shape) {
+    if (!shape.distance_model) shape.distance_model = build_distance_model(shape.mesh);
   }
 
   void ensure_model(Shape& shape) {
@@ -324,6 +331,80 @@ struct CollisionWorld::Impl {
     constexpr std::size_t kHeavyProduct = std::size_t{1} << 20;
     return parts[w.a].shape->mesh->triangle_count() * parts[w.b].shape->mesh->triangle_count() >=
            kHeavyProduct;
+  }
+
+  /// Distance of parts a and b, computed with the smaller index as A (the
+  /// orientation of the pair's caches, as in step()) and returned in the
+  /// caller's order.
+  PartDistance distance(PartId id_a, PartId id_b, const PartDistanceRequest& request) {
+    if (id_a == id_b) throw std::invalid_argument("collision world: distance of a part to itself");
+    Part& first = part(id_a);
+    Part& second = part(id_b);
+    const bool swapped = id_b.index < id_a.index;
+    Part& a = swapped ? second : first;
+    Part& b = swapped ? first : second;
+    const LevelOfDetail level = request.level ? *request.level : level_of(a, b);
+    ensure_hull(*a.shape);
+    ensure_hull(*b.shape);
+    const bool hulls = a.shape->hull && b.shape->hull;
+    const Transform X_AB = relative(a.X_WP, b.X_WP);
+    PartDistance r;
+    if (level != LevelOfDetail::kExact && hulls) {
+      PairState& state = pair_states[pair_key(a.id.index, b.id.index)];
+      r.warm_started = request.warm_start && state.gjk.valid;
+      GjkCache cold;
+      GjkCache& cache = request.warm_start ? state.gjk : cold;
+      const GjkResult g = gjk(*a.shape->hull, *b.shape->hull, X_AB, &cache);
+      if (!request.warm_start) state.gjk = cold;
+      r.level = LevelOfDetail::kHull;
+      r.distance = g.distance;
+      r.intersecting = g.intersecting;
+      r.p_W = a.X_WP.apply(g.closest_a);
+      r.q_W = a.X_WP.apply(g.closest_b);
+      r.feature_a = g.feature_a;
+      r.feature_b = g.feature_b;
+      r.gjk_iterations = g.iterations;
+    } else {
+      ensure_distance_model(*a.shape);
+      ensure_distance_model(*b.shape);
+      const DistanceResult d = collision::distance(*a.shape->distance_model,
+                                                   *b.shape->distance_model, X_AB, request.exact);
+      r.level = LevelOfDetail::kExact;
+      r.distance = d.distance;
+      r.intersecting = d.distance == 0;
+      r.p_W = a.X_WP.apply(d.p_A);
+      r.q_W = a.X_WP.apply(d.q_A);
+      r.triangle_a = d.triangle_a;
+      r.triangle_b = d.triangle_b;
+      r.stats = d.stats;
+    }
+    if (swapped) {
+      std::swap(r.p_W, r.q_W);
+      std::swap(r.feature_a, r.feature_b);
+      std::swap(r.triangle_a, r.triangle_b);
+    }
+    return r;
+  }
+
+  bool within(PartId id_a, PartId id_b, Real eps, const PartDistanceRequest& request) {
+    if (!(eps >= 0)) throw std::invalid_argument("collision world: tolerance must be >= 0");
+    if (id_a == id_b) throw std::invalid_argument("collision world: distance of a part to itself");
+    Part& first = part(id_a);
+    Part& second = part(id_b);
+    Part& a = id_b.index < id_a.index ? second : first;
+    Part& b = id_b.index < id_a.index ? first : second;
+    const LevelOfDetail level = request.level ? *request.level : level_of(a, b);
+    ensure_hull(*a.shape);
+    ensure_hull(*b.shape);
+    if (level != LevelOfDetail::kExact && a.shape->hull && b.shape->hull) {
+      const PartDistance d = distance(a.id, b.id, request);
+      return d.intersecting || d.distance <= eps;
+    }
+    ensure_distance_model(*a.shape);
+    ensure_distance_model(*b.shape);
+    return within_tolerance(*a.shape->distance_model, *b.shape->distance_model,
+                            relative(a.X_WP, b.X_WP), eps)
+        .within;
   }
 
   void prepare() {
@@ -520,6 +601,14 @@ void CollisionWorld::set_pair_level(PartId a, PartId b, LevelOfDetail level) {
   impl_->levels[pair_key(a.index, b.index)] = level;
 }
 
+PartDistance CollisionWorld::distance(PartId a, PartId b, const PartDistanceRequest& request) {
+  return impl_->distance(a, b, request);
+}
+
+bool CollisionWorld::within(PartId a, PartId b, Real eps, const PartDistanceRequest& request) {
+  return impl_->within(a, b, eps, request);
+}
+
 void CollisionWorld::prepare() { impl_->prepare(); }
 
 const StepResult& CollisionWorld::step() { return impl_->step(); }
@@ -529,6 +618,7 @@ std::size_t CollisionWorld::model_bytes() const {
   std::size_t bytes = 0;
   for (const auto& [mesh, shape] : impl_->shapes) {
     if (shape->model) bytes += shape->model->info().bytes;
+    if (shape->distance_model) bytes += shape->distance_model->info().bytes;
     if (shape->hull) {
       bytes += shape->hull->vertices.size() * sizeof(Vec3) +
                shape->hull->faces.size() * sizeof(TriangleIndices) +

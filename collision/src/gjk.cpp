@@ -18,6 +18,7 @@
 /// never underestimates the distance by more than rounding.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "convex_internal.h"
@@ -29,6 +30,28 @@ namespace dovetail::collision {
 using detail::Nearest;
 using detail::Simplex;
 using detail::SimplexPoint;
+
+namespace {
+
+/// The distinct vertex indices among `count` (1 to 3) simplex points,
+/// ascending: the feature they span.
+HullFeature feature_of(const std::array<std::uint32_t, 3>& indices, int count) {
+  HullFeature feature;
+  int size = 0;
+  for (int k = 0; k < count; ++k) {
+    // Insert indices[k] into the sorted distinct prefix, unless already there.
+    int at = 0;
+    while (at < size && feature.vertices[at] < indices[k]) ++at;
+    if (at < size && feature.vertices[at] == indices[k]) continue;
+    for (int m = size; m > at; --m) feature.vertices[m] = feature.vertices[m - 1];
+    feature.vertices[at] = indices[k];
+    ++size;
+  }
+  feature.type = static_cast<FeatureType>(size);
+  return feature;
+}
+
+}  // namespace
 
 GjkResult gjk(const ConvexHull& a, const ConvexHull& b, const Transform& X_AB, GjkCache* cache) {
   GjkResult result;
@@ -114,12 +137,25 @@ GjkResult gjk(const ConvexHull& a, const ConvexHull& b, const Transform& X_AB, G
   result.closest_a = pa;
   result.closest_b = pb;
   result.distance = result.intersecting ? 0 : std::sqrt(current.vv);
+  // Closest features: the support pairs of a final simplex of one to three
+  // points (every one of them carries positive weight); none for a
+  // tetrahedron holding the origin.
+  if (simplex.size >= 1 && simplex.size <= 3) {
+    std::array<std::uint32_t, 3> ia{}, ib{};
+    for (int k = 0; k < simplex.size; ++k) {
+      ia[k] = simplex.p[k].ia;
+      ib[k] = simplex.p[k].ib;
+    }
+    result.feature_a = feature_of(ia, simplex.size);
+    result.feature_b = feature_of(ib, simplex.size);
+  }
   if (!result.closest_a.allFinite() || !result.closest_b.allFinite() ||
       !std::isfinite(result.distance)) {
     // Overflow in the arithmetic (coordinates near the double range): be conservative.
     result.intersecting = true;
     result.distance = 0;
     result.closest_a = result.closest_b = Vec3::Zero();
+    result.feature_a = result.feature_b = HullFeature{};
   }
 
   if (cache) {

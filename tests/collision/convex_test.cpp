@@ -483,6 +483,86 @@ Real brute_distance(const Placed& a, const Placed& b) {
   return best;
 }
 
+// Closest features: the feature's vertices placed in A's frame, and distances
+// to and between the convex hulls of up to three points.
+
+std::vector<Vec3> feature_points(const ConvexHull& h, const HullFeature& f, const Transform& X) {
+  std::vector<Vec3> p;
+  for (int k = 0; k < f.size(); ++k) p.push_back(X.apply(h.vertices[f.vertices[k]]));
+  return p;
+}
+
+Real point_to_feature(const Vec3& p, const std::vector<Vec3>& f) {
+  if (f.size() == 1) return (p - f[0]).norm();
+  if (f.size() == 2) return segment_distance(p, p, f[0], f[1]);
+  return (p - closest_on_triangle(p, f[0], f[1], f[2])).norm();
+}
+
+/// Distance between the convex hulls of two disjoint features: the nearest
+/// pair is a point of one against the other, or an edge against an edge.
+Real feature_distance(const std::vector<Vec3>& fa, const std::vector<Vec3>& fb) {
+  Real best = std::numeric_limits<Real>::infinity();
+  for (const Vec3& p : fa) best = std::min(best, point_to_feature(p, fb));
+  for (const Vec3& q : fb) best = std::min(best, point_to_feature(q, fa));
+  for (std::size_t i = 0; i + 1 < fa.size(); ++i) {
+    for (std::size_t i2 = i + 1; i2 < fa.size(); ++i2) {
+      for (std::size_t j = 0; j + 1 < fb.size(); ++j) {
+        for (std::size_t j2 = j + 1; j2 < fb.size(); ++j2) {
+          best = std::min(best, segment_distance(fa[i], fa[i2], fb[j], fb[j2]));
+        }
+      }
+    }
+  }
+  return best;
+}
+
+/// Checks GJK's closest features against its closest points: valid ascending
+/// indices, the closest points in the features' convex hulls, and for
+/// separated hulls the distance between the features equal to the distance.
+/// Returns false (and reports) on a violation.
+bool features_consistent(const ConvexHull& a, const ConvexHull& b, const Transform& X,
+                         const GjkResult& g) {
+  const Real tolerance = 1e-9 * (a.radius + b.radius);
+  const bool none_a = g.feature_a.type == FeatureType::kNone;
+  const bool none_b = g.feature_b.type == FeatureType::kNone;
+  if (none_a || none_b) {
+    if (none_a != none_b || !g.intersecting) {
+      std::printf("GJK features: kNone on one side only, or on separated hulls\n");
+      return false;
+    }
+    return true;
+  }
+  for (const auto& [h, f] : {std::pair{&a, &g.feature_a}, std::pair{&b, &g.feature_b}}) {
+    for (int k = 0; k < f->size(); ++k) {
+      if (f->vertices[k] >= h->vertices.size() || (k > 0 && f->vertices[k - 1] >= f->vertices[k])) {
+        std::printf("GJK features: bad vertex indices\n");
+        return false;
+      }
+    }
+  }
+  const std::vector<Vec3> fa = feature_points(a, g.feature_a, Transform::identity());
+  const std::vector<Vec3> fb = feature_points(b, g.feature_b, X);
+  const Real off_a = point_to_feature(g.closest_a, fa), off_b = point_to_feature(g.closest_b, fb);
+  if (off_a > tolerance || off_b > tolerance) {
+    std::printf("GJK features: closest point %.3g / %.3g from its feature\n", off_a, off_b);
+    return false;
+  }
+  if (g.intersecting) {
+    const Real band = kGjkContactTolerance * (a.extent + b.extent + X.t.cwiseAbs().maxCoeff());
+    if ((g.closest_a - g.closest_b).norm() > band * (1 + 1e-6) + tolerance) {
+      std::printf("GJK features: intersecting but closest points apart\n");
+      return false;
+    }
+    return true;
+  }
+  const Real d = feature_distance(fa, fb);
+  if (std::abs(d - g.distance) > tolerance) {
+    std::printf("GJK features: feature distance %.17g, distance %.17g\n", d, g.distance);
+    return false;
+  }
+  return true;
+}
+
 // ---------------------------------------------------------------------------
 // Agreement on many configurations
 
@@ -551,6 +631,13 @@ struct Tally {
   long gjk_band = 0;              ///< GJK intersecting, reference separated (touching band)
   long gjk_band_outside = 0;      ///< ... with brute-force distance above the band: must be 0
   long gjk_cap = 0, gjk_nonfinite = 0;
+  /// GJK warm-started from a cache carried from one configuration to the
+  /// next (a stale start on unrelated hulls and poses: the worst case).
+  GjkCache warm;
+  long warm_false_separated = 0, warm_band_outside = 0, warm_cap = 0, warm_nonfinite = 0;
+  long features_checked = 0, features_none = 0;
+  long features_wrong = 0;  ///< features_consistent failed: must be 0
+  int gjk_max_iterations = 0;
   int sp_max_iterations = 0;
   long sp_iterations = 0;
   Real sp_gave_up_farthest = 0;  ///< largest GJK distance / (radius A + radius B) of those
@@ -566,11 +653,23 @@ void check(const ConvexHull& a, const ConvexHull& b, const Transform& X, Tally& 
   SeparatingPlaneCache plane;
   const SeparatingPlaneResult sp = separating_plane_test(a, b, X, plane);
   const GjkResult g = gjk(a, b, X);
+  const GjkResult warm = gjk(a, b, X, &t.warm);
   t.sp_iterations += sp.iterations;
   t.sp_max_iterations = std::max(t.sp_max_iterations, sp.iterations);
-  if (!std::isfinite(g.distance) || !g.closest_a.allFinite() || !g.closest_b.allFinite())
-    ++t.gjk_nonfinite;
+  t.gjk_max_iterations = std::max({t.gjk_max_iterations, g.iterations, warm.iterations});
+  auto finite = [](const GjkResult& r) {
+    return std::isfinite(r.distance) && r.closest_a.allFinite() && r.closest_b.allFinite();
+  };
+  t.gjk_nonfinite += !finite(g);
+  t.warm_nonfinite += !finite(warm);
   t.gjk_cap += g.hit_iteration_cap;
+  t.warm_cap += warm.hit_iteration_cap;
+  for (const GjkResult* r : {&g, &warm}) {
+    ++t.features_checked;
+    t.features_none += r->feature_a.type == FeatureType::kNone;
+    t.features_wrong += !features_consistent(a, b, X, *r);
+  }
+  t.warm_false_separated += ref && !warm.intersecting;
   if (ref && sp.separated) ++t.sp_false_separated;
   if (!ref && !sp.separated) {
     EXPECT_TRUE(sp.gave_up);
@@ -585,12 +684,13 @@ void check(const ConvexHull& a, const ConvexHull& b, const Transform& X, Tally& 
     ++t.gjk_false_separated;
     std::printf("GJK separated an intersecting pair: distance %.17g\n", g.distance);
   }
-  if (!ref && g.intersecting) {
-    ++t.gjk_band;
+  if (!ref && (g.intersecting || warm.intersecting)) {
+    t.gjk_band += g.intersecting;
     const Real band = kGjkContactTolerance * (a.extent + b.extent + X.t.cwiseAbs().maxCoeff());
     const Real d = brute_distance(pa, pb);
     if (d > band * (1 + 1e-6)) {
-      ++t.gjk_band_outside;
+      t.gjk_band_outside += g.intersecting;
+      t.warm_band_outside += warm.intersecting;
       std::printf("GJK intersecting outside the band: distance %.17g band %.3g\n", d, band);
     }
   }
@@ -600,11 +700,16 @@ void report(const char* name, const Tally& t) {
   std::printf(
       "[ convex  ] %-28s %7ld configs %7ld intersecting | SP: false separated %ld, gave up on "
       "separated %ld (farthest %.2g, clear margin %ld), mean iterations %.2f, max %d | GJK: false "
-      "separated %ld, band %ld (outside band %ld), cap %ld, non-finite %ld\n",
+      "separated %ld, band %ld (outside band %ld), cap %ld, non-finite %ld | GJK from a stale "
+      "cache: false separated %ld, outside band %ld, cap %ld, non-finite %ld | GJK most "
+      "iterations %d (cap %d) | features: %ld results checked, %ld kNone, %ld wrong\n",
       name, t.configurations, t.intersecting, t.sp_false_separated, t.sp_gave_up_separated,
       t.sp_gave_up_farthest, t.sp_gave_up_clear,
       static_cast<double>(t.sp_iterations) / std::max(1L, t.configurations), t.sp_max_iterations,
-      t.gjk_false_separated, t.gjk_band, t.gjk_band_outside, t.gjk_cap, t.gjk_nonfinite);
+      t.gjk_false_separated, t.gjk_band, t.gjk_band_outside, t.gjk_cap, t.gjk_nonfinite,
+      t.warm_false_separated, t.warm_band_outside, t.warm_cap, t.warm_nonfinite,
+      t.gjk_max_iterations, kGjkMaxIterations, t.features_checked, t.features_none,
+      t.features_wrong);
 }
 
 void expect_clean(const Tally& t) {
@@ -614,6 +719,12 @@ void expect_clean(const Tally& t) {
   EXPECT_EQ(t.gjk_band_outside, 0);
   EXPECT_EQ(t.gjk_cap, 0);
   EXPECT_EQ(t.gjk_nonfinite, 0);
+  EXPECT_EQ(t.warm_false_separated, 0);
+  EXPECT_EQ(t.warm_band_outside, 0);
+  EXPECT_EQ(t.warm_cap, 0);
+  EXPECT_EQ(t.warm_nonfinite, 0);
+  EXPECT_LT(t.gjk_max_iterations, kGjkMaxIterations);
+  EXPECT_EQ(t.features_wrong, 0);
 }
 
 TEST(ConvexAgreement, RandomPoses) {
@@ -787,6 +898,182 @@ TEST(Gjk, DistanceMatchesBruteForce) {
     EXPECT_NEAR(g.distance, d, 1e-9 * (a.radius + b.radius)) << i;
     EXPECT_NEAR((g.closest_a - g.closest_b).norm(), g.distance, 1e-9 * (a.radius + b.radius));
   }
+  EXPECT_GT(separated, 1000);
+}
+
+// ---------------------------------------------------------------------------
+// Closest features
+
+/// Hull of a box's corners, each corner turned by R (in the hull's frame).
+ConvexHull turned_box(const Vec3& half, const Mat3& R) {
+  std::vector<Vec3> p;
+  for (int i = 0; i < 8; ++i) {
+    p.push_back(R * Vec3(i & 1 ? half.x() : -half.x(), i & 2 ? half.y() : -half.y(),
+                         i & 4 ? half.z() : -half.z()));
+  }
+  return compute_convex_hull(p, "box");
+}
+
+/// Indices of the hull vertices whose z is the extreme one (max or min), ascending.
+std::vector<std::uint32_t> extreme_z(const ConvexHull& h, bool highest) {
+  Real best =
+      highest ? -std::numeric_limits<Real>::infinity() : std::numeric_limits<Real>::infinity();
+  for (const Vec3& v : h.vertices) best = highest ? std::max(best, v.z()) : std::min(best, v.z());
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t i = 0; i < h.vertices.size(); ++i) {
+    if (h.vertices[i].z() == best) out.push_back(i);
+  }
+  return out;
+}
+
+std::vector<std::uint32_t> indices(const HullFeature& f) {
+  return {f.vertices.begin(), f.vertices.begin() + f.size()};
+}
+
+Transform translation(const Vec3& t) {
+  Transform X;
+  X.t = t;
+  return X;
+}
+
+// B's corner over the inside of A's top face, off its diagonals: A's feature
+// is a triangle of its top face, B's the corner; touching (gap 0) keeps them.
+TEST(GjkFeatures, VertexOverFace) {
+  const ConvexHull a = turned_box(Vec3(1, 1, 0.5), Mat3::Identity());
+  const Mat3 corner_down = rotation_between(Vec3(-1, -1, -1).normalized(), -Vec3::UnitZ());
+  const ConvexHull b = turned_box(Vec3(0.5, 0.5, 0.5), corner_down);
+  const std::vector<std::uint32_t> top = extreme_z(a, true), low = extreme_z(b, false);
+  ASSERT_EQ(top.size(), 4u);
+  ASSERT_EQ(low.size(), 1u);
+  for (const Real gap : {0.25, 1e-3, 1e-12, 0.0}) {
+    SCOPED_TRACE(gap);
+    const Transform X = translation(Vec3(0.3, -0.1, 0.5 + gap - b.vertices[low[0]].z()));
+    const GjkResult g = gjk(a, b, X);
+    EXPECT_EQ(g.intersecting, gap < 1e-9);
+    EXPECT_NEAR(g.distance, g.intersecting ? 0 : gap, 1e-12);
+    EXPECT_EQ(g.feature_b.type, FeatureType::kVertex);
+    EXPECT_EQ(indices(g.feature_b), low);
+    ASSERT_EQ(g.feature_a.type, FeatureType::kFace);
+    for (std::uint32_t i : indices(g.feature_a)) {
+      EXPECT_TRUE(std::find(top.begin(), top.end(), i) != top.end()) << i;
+    }
+    EXPECT_NEAR(g.closest_a.x(), 0.3, 1e-12);
+    EXPECT_NEAR(g.closest_a.y(), -0.1, 1e-12);
+    EXPECT_TRUE(features_consistent(a, b, X, g));
+  }
+}
+
+// A's top edge (along x) across B's bottom edge (along y): edge and edge,
+// exactly those two vertices on each side.
+TEST(GjkFeatures, EdgeAcrossEdge) {
+  const Mat3 about_x = Eigen::AngleAxis<Real>(kPi / 4, Vec3::UnitX()).toRotationMatrix();
+  const Mat3 about_y = Eigen::AngleAxis<Real>(kPi / 4, Vec3::UnitY()).toRotationMatrix();
+  const ConvexHull a = turned_box(Vec3(1, 0.5, 0.5), about_x);
+  const ConvexHull b = turned_box(Vec3(0.5, 1, 0.5), about_y);
+  const std::vector<std::uint32_t> top = extreme_z(a, true), low = extreme_z(b, false);
+  ASSERT_EQ(top.size(), 2u);
+  ASSERT_EQ(low.size(), 2u);
+  for (const Real gap : {0.5, 1e-6}) {
+    SCOPED_TRACE(gap);
+    const Real z = a.vertices[top[0]].z() + gap - b.vertices[low[0]].z();
+    // The edges cross above x = 0.2 on A's edge and 0.3 along B's.
+    const Transform X =
+        translation(Vec3(0.2 - b.vertices[low[0]].x(), a.vertices[top[0]].y() - 0.3, z));
+    const GjkResult g = gjk(a, b, X);
+    ASSERT_FALSE(g.intersecting);
+    EXPECT_NEAR(g.distance, gap, 1e-12);
+    EXPECT_EQ(g.feature_a.type, FeatureType::kEdge);
+    EXPECT_EQ(indices(g.feature_a), top);
+    EXPECT_EQ(g.feature_b.type, FeatureType::kEdge);
+    EXPECT_EQ(indices(g.feature_b), low);
+    EXPECT_TRUE(features_consistent(a, b, X, g));
+  }
+}
+
+// Parallel faces: a long bar across another (no corner of either above the
+// other's face). The closest points are not unique; each feature is an edge
+// (possibly a diagonal) or a triangle of the facing face, holding the
+// closest point, and the features are as far apart as the faces.
+TEST(GjkFeatures, ParallelFacesGiveEdgeOrFace) {
+  const ConvexHull a = turned_box(Vec3(2, 0.5, 0.5), Mat3::Identity());
+  const ConvexHull b = turned_box(Vec3(0.5, 2, 0.5), Mat3::Identity());
+  const std::vector<std::uint32_t> top = extreme_z(a, true), low = extreme_z(b, false);
+  int edges = 0, faces = 0;
+  Random r(43);
+  for (int i = 0; i < 200; ++i) {
+    const Real gap = i % 4 == 0 ? 1e-6 : r.uniform(0.01, 2);
+    const Transform X = translation(Vec3(r.uniform(-1.4, 1.4), r.uniform(-1.4, 1.4), 1 + gap));
+    const GjkResult g = gjk(a, b, X);
+    ASSERT_FALSE(g.intersecting);
+    EXPECT_NEAR(g.distance, gap, 1e-12);
+    for (const auto& [f, face] : {std::pair{&g.feature_a, &top}, std::pair{&g.feature_b, &low}}) {
+      ASSERT_TRUE(f->type == FeatureType::kEdge || f->type == FeatureType::kFace);
+      edges += f->type == FeatureType::kEdge;
+      faces += f->type == FeatureType::kFace;
+      for (std::uint32_t v : indices(*f)) {
+        EXPECT_TRUE(std::find(face->begin(), face->end(), v) != face->end()) << v;
+      }
+    }
+    EXPECT_TRUE(features_consistent(a, b, X, g));
+  }
+  std::printf("[ convex  ] parallel faces: %d edge and %d face features\n", edges, faces);
+}
+
+// A small box deep inside a large one: the final simplex is a tetrahedron
+// holding the origin, and there are no closest features.
+TEST(GjkFeatures, DeepOverlapHasNoFeatures) {
+  Random r(44);
+  const ConvexHull a = turned_box(Vec3(1, 1, 1), Mat3::Identity());
+  const ConvexHull b = turned_box(Vec3(0.2, 0.3, 0.1), r.rotation());
+  const GjkResult g = gjk(a, b, translation(Vec3(0.1, 0.05, -0.1)));
+  EXPECT_TRUE(g.intersecting);
+  EXPECT_EQ(g.feature_a.type, FeatureType::kNone);
+  EXPECT_EQ(g.feature_b.type, FeatureType::kNone);
+}
+
+// Random separated poses: the features hold the closest points, lie on the
+// supporting planes facing the other hull, and are as far apart as the hulls
+// (brute force), cold and warm-started alike.
+TEST(GjkFeatures, RandomPosesFeaturesAreClosest) {
+  Random r(45);
+  const Pool pool = make_pool(r);
+  int separated = 0;
+  int types[4] = {};
+  for (int i = 0; i < 3000; ++i) {
+    const ConvexHull& a = pool.hulls[r.integer(0, 47)];
+    const ConvexHull& b = pool.hulls[r.integer(0, 47)];
+    Transform X;
+    X.R = r.rotation();
+    X.t = a.center + r.direction() * (a.radius + b.radius) * r.uniform(0.3, 1.5) - X.R * b.center;
+    GjkCache cache;
+    const GjkResult g = gjk(a, b, X, &cache);
+    ASSERT_TRUE(features_consistent(a, b, X, g)) << i;
+    if (g.intersecting) continue;
+    ++separated;
+    ++types[static_cast<int>(g.feature_a.type)];
+    ++types[static_cast<int>(g.feature_b.type)];
+    const Real tolerance = 1e-9 * (a.radius + b.radius);
+    const Placed pa = place(a, Transform::identity()), pb = place(b, X);
+    const Real d = brute_distance(pa, pb);
+    EXPECT_NEAR(g.distance, d, tolerance);
+    EXPECT_NEAR(feature_distance(feature_points(a, g.feature_a, Transform::identity()),
+                                 feature_points(b, g.feature_b, X)),
+                d, tolerance);
+    // Every feature vertex on the supporting plane: n . x minimal over A, n . y maximal over B.
+    const Vec3 n = (g.closest_b - g.closest_a) / g.distance;
+    Real low_b = std::numeric_limits<Real>::infinity(), high_a = -low_b;
+    for (const Vec3& v : pa.v) high_a = std::max(high_a, n.dot(v));
+    for (const Vec3& v : pb.v) low_b = std::min(low_b, n.dot(v));
+    for (const Vec3& v : feature_points(a, g.feature_a, Transform::identity()))
+      EXPECT_NEAR(n.dot(v), high_a, tolerance);
+    for (const Vec3& v : feature_points(b, g.feature_b, X)) EXPECT_NEAR(n.dot(v), low_b, tolerance);
+    // Warm-started again at a nearby pose: still consistent.
+    Transform moved = X;
+    moved.t += 1e-3 * r.direction();
+    EXPECT_TRUE(features_consistent(a, b, moved, gjk(a, b, moved, &cache))) << i;
+  }
+  std::printf("[ convex  ] random poses: %d separated, features: %d vertices, %d edges, %d faces\n",
+              separated, types[1], types[2], types[3]);
   EXPECT_GT(separated, 1000);
 }
 

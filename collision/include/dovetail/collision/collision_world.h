@@ -3,7 +3,8 @@
 /// The collision pipeline: many moving parts, pruned at the object level
 /// (broad phase over world boxes), then by the convex level (a separating
 /// plane cached per pair), then decided exactly at the polygon level, with
-/// the pairs spread over worker threads.
+/// the pairs spread over worker threads; and distances between parts, on the
+/// shared hulls (warm-started GJK) or meshes (distance hierarchies).
 ///
 /// Why: this is what a frame of the simulation asks: "what touches what
 /// now, and what changed since the last frame". Each stage is cheaper than
@@ -15,11 +16,14 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "dovetail/collision/broadphase.h"
 #include "dovetail/collision/collide.h"
+#include "dovetail/collision/convex.h"
+#include "dovetail/collision/distance.h"
 #include "dovetail/collision/mesh.h"
 #include "dovetail/collision/model.h"
 
@@ -116,6 +120,46 @@ struct StepResult {
   StepStats stats;
 };
 
+/// What CollisionWorld::distance and within measure.
+struct PartDistanceRequest {
+  /// The level to measure at: kHull, GJK on the two parts' convex hulls (the
+  /// hulls of the convex level, warm-started from the pair's cache); kExact,
+  /// the triangle meshes (DistanceModel, distance.h). Unset: the pair's level
+  /// of detail (PartDef::level, set_pair_level), with kBox measured at kHull.
+  /// A part without a hull (flat) is always measured exactly. Ask for kHull
+  /// when both parts are convex: their hulls are then the parts themselves.
+  std::optional<LevelOfDetail> level{};
+  /// Allowed error of the exact distance (0: the exact minimum).
+  DistanceRequest exact{};
+  /// Start GJK from the pair's cache (the last call's or step's simplex).
+  /// False: a cold start; the cache is updated either way.
+  bool warm_start = true;
+};
+
+/// Distance between two parts, in the order they were passed (a, then b).
+struct PartDistance {
+  /// Smallest distance at the level used; 0 when the pair intersects there.
+  /// Hull level: the distance of the convex solids (0 also when one part is
+  /// inside the other). Exact level: the distance of the two surfaces, as in
+  /// distance.h (a part inside a closed housing is at its distance from the
+  /// walls).
+  Real distance = std::numeric_limits<Real>::infinity();
+  bool intersecting = false;  ///< distance is 0 (hull level: within GJK's touching band)
+  Vec3 p_W = Vec3::Zero();    ///< closest point on a, world frame
+  Vec3 q_W = Vec3::Zero();    ///< closest point on b, world frame
+  LevelOfDetail level = LevelOfDetail::kExact;  ///< how it was decided: kHull or kExact
+  /// Hull level: the closest features of a's and b's hulls (GjkResult).
+  HullFeature feature_a{};
+  HullFeature feature_b{};
+  int gjk_iterations = 0;     ///< hull level: GJK support-query pairs
+  bool warm_started = false;  ///< hull level: GJK started from the pair's cache
+  /// Exact level: the closest triangle pair (indices into each part's
+  /// Mesh::triangles); kNoTriangle at hull level.
+  std::uint32_t triangle_a = kNoTriangle;
+  std::uint32_t triangle_b = kNoTriangle;
+  CollideStats stats;  ///< exact level: volume and triangle pairs tested
+};
+
 /// A set of parts and the pipeline that finds their contacts.
 class CollisionWorld {
  public:
@@ -149,7 +193,24 @@ class CollisionWorld {
   const StepResult& step();
   const StepResult& last_step() const;
 
-  /// Bytes of the hierarchies and hulls built so far (shared ones counted once).
+  /// Distance between parts a and b at their current poses (see
+  /// PartDistanceRequest for the level). Hull level: GJK on the shared hulls,
+  /// warm-started from a GjkCache kept per pair across calls and steps. Exact
+  /// level: a query on DistanceModels built once per mesh on first need and
+  /// shared like the collision hierarchies. Deterministic: the same calls
+  /// give the same bits for any thread count, and distance(b, a) gives
+  /// distance(a, b) with the roles swapped. Not to be called concurrently
+  /// with other calls on the world. Throws std::invalid_argument for an
+  /// unknown or removed id, or a == b.
+  PartDistance distance(PartId a, PartId b, const PartDistanceRequest& request = {});
+  /// Is the distance between parts a and b at most `eps` (>= 0)? Exact
+  /// level: within_tolerance (stops at the first triangle pair within eps);
+  /// hull level: GJK (intersecting, or a distance of at most eps). Throws
+  /// std::invalid_argument as distance() does, and for eps < 0 or NaN.
+  bool within(PartId a, PartId b, Real eps, const PartDistanceRequest& request = {});
+
+  /// Bytes of the hierarchies (collision and distance) and hulls built so far
+  /// (shared ones counted once).
   std::size_t model_bytes() const;
 
  private:

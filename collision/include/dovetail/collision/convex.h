@@ -134,13 +134,45 @@ inline constexpr Real kGjkContactTolerance = 1e-9;
 /// trouble, reported in GjkResult::hit_iteration_cap.
 inline constexpr int kGjkMaxIterations = 128;
 
+/// Kind of a closest feature: how many hull vertices span it.
+enum class FeatureType : std::uint8_t {
+  kNone = 0,    ///< no closest feature (the hulls overlap; see GjkResult)
+  kVertex = 1,  ///< one vertex
+  kEdge = 2,    ///< the segment between two vertices
+  kFace = 3,    ///< the triangle of three vertices
+};
+
+/// A closest feature of one hull: the hull vertices (indices into
+/// ConvexHull::vertices, in the hull's own frame) that carry weight in the
+/// closest point, ascending. The closest point is a convex combination of
+/// them, and all of them lie on the hull's supporting plane facing the other
+/// hull (up to GJK's tolerance). Where the hull has a polygonal face (coplanar
+/// triangles), an edge may be a diagonal of that face and a face any three of
+/// its vertices, not necessarily one of ConvexHull::faces.
+struct HullFeature {
+  FeatureType type = FeatureType::kNone;
+  std::array<std::uint32_t, 3> vertices{};  ///< the first size() entries are used
+  int size() const { return static_cast<int>(type); }
+  friend bool operator==(const HullFeature&, const HullFeature&) = default;
+};
+
 /// Outcome of GJK on two hulls.
 struct GjkResult {
   bool intersecting = false;      ///< distance within the touching band (see kGjkContactTolerance)
   Real distance = 0;              ///< 0 when intersecting
   Vec3 closest_a = Vec3::Zero();  ///< on A, in A's frame (when intersecting: a point of A near B)
   Vec3 closest_b = Vec3::Zero();  ///< on B, in A's frame
-  int iterations = 0;             ///< support-query pairs evaluated
+  /// Closest features of A and B, from the final simplex's support pairs with
+  /// repeated vertices merged (a simplex whose A indices are {5, 5, 7} gives
+  /// the edge (5, 7) on A). closest_a lies in the convex hull of feature_a's
+  /// vertices, closest_b in that of feature_b's placed by X_AB.apply.
+  /// Intersecting within the touching band (a final simplex of one to three
+  /// points), they are the features in contact, defined as for separated
+  /// hulls. When the final simplex is a tetrahedron holding the origin (the
+  /// hulls overlap beyond the band), or on non-finite input, both are kNone.
+  HullFeature feature_a;
+  HullFeature feature_b;
+  int iterations = 0;  ///< support-query pairs evaluated
   bool hit_iteration_cap = false;
 };
 
