@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "predicates_inline.h"
+#include "tri_distance.h"
 
 namespace dovetail::collision::detail {
 
@@ -233,37 +234,8 @@ void coplanar_piece(const TriangleVertices& t_a, const TriangleVertices& t_b, Re
 
 /// Closest distance between segments [p0, p1] and [q0, q1] (either may be a point).
 Real segment_distance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
-  const Vec3 d1 = p1 - p0;
-  const Vec3 d2 = q1 - q0;
-  const Vec3 r = p0 - q0;
-  const Real a = d1.squaredNorm();
-  const Real e = d2.squaredNorm();
-  const Real f = d2.dot(r);
-  Real s = 0;
-  Real t = 0;
-  if (a == 0 && e == 0) return r.norm();
-  if (a == 0) {
-    t = std::clamp(f / e, Real{0}, Real{1});
-  } else {
-    const Real c = d1.dot(r);
-    if (e == 0) {
-      s = std::clamp(-c / a, Real{0}, Real{1});
-    } else {
-      const Real b = d1.dot(d2);
-      const Real denom = a * e - b * b;
-      s = denom > 0 ? std::clamp((b * f - c * e) / denom, Real{0}, Real{1}) : Real{0};
-      t = (b * s + f) / e;
-      // Clamp t and recompute s for the clamped t.
-      if (t < 0) {
-        t = 0;
-        s = std::clamp(-c / a, Real{0}, Real{1});
-      } else if (t > 1) {
-        t = 1;
-        s = std::clamp((b - c) / a, Real{0}, Real{1});
-      }
-    }
-  }
-  return ((p0 + s * d1) - (q0 + t * d2)).norm();
+  Vec3 x, y;
+  return std::sqrt(segment_distance_squared(p0, p1, q0, q1, x, y));
 }
 
 /// Distance from `p` to the polygon of `piece` when p projects inside it, else infinity.
