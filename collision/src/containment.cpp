@@ -201,11 +201,31 @@ Located locate_in(const Mesh& mesh, const std::vector<Vec3>& vertices, const Vec
   return locate(vertices, mesh.triangles, shell, count, p);
 }
 
-Inside inside_of(const Located& l) {
-  return l.location == PointLocation::kInside ? Inside::kYes : Inside::kNo;
+/// One vertex of each shell of `part` (the first vertex of the shell's
+/// first triangle): with the surfaces apart, a shell lies wholly on one side
+/// of the other part's surface, so its vertex speaks for it.
+std::vector<std::uint32_t> shell_vertices(const Mesh& part) {
+  const auto [shell, count] = shells(part);
+  std::vector<std::uint32_t> vertex(count, UINT32_MAX);
+  for (std::size_t t = 0; t < shell.size(); ++t) {
+    if (vertex[shell[t]] == UINT32_MAX) vertex[shell[t]] = part.triangles[t][0];
+  }
+  return vertex;
 }
-Inside enclosed_by(const Located& l) {
-  return l.location != PointLocation::kOnSurface && l.in_some_shell ? Inside::kYes : Inside::kNo;
+
+/// Whether every shell of the part whose vertices are `part_vertices` (in
+/// `solid`'s frame) lies in the solid of `solid`, and whether every one lies
+/// inside some shell of it (in its solid or a cavity it encloses).
+std::pair<Inside, Inside> shells_inside(const Mesh& solid, const std::vector<Vec3>& solid_vertices,
+                                        const Mesh& part, const std::vector<Vec3>& part_vertices) {
+  const auto [shell, count] = shells(solid);
+  bool all_inside = true, all_enclosed = true;
+  for (const std::uint32_t v : shell_vertices(part)) {
+    const Located l = locate(solid_vertices, solid.triangles, shell, count, part_vertices[v]);
+    all_inside = all_inside && l.location == PointLocation::kInside;
+    all_enclosed = all_enclosed && l.location != PointLocation::kOnSurface && l.in_some_shell;
+  }
+  return {all_inside ? Inside::kYes : Inside::kNo, all_enclosed ? Inside::kYes : Inside::kNo};
 }
 
 }  // namespace
@@ -245,22 +265,21 @@ ContainmentResult contains(const CollisionModel& outer, const CollisionModel& in
     if (inner_closed) result.outer_in_inner = result.outer_enclosed_by_inner = Inside::kNo;
     return result;
   }
-  // Disjoint surfaces: one vertex of a part decides for the whole part. Both
-  // parts are taken in outer's frame, inner's vertices mapped by the same
-  // Transform::apply as the collision query, so the points are those it tested.
+  // Disjoint surfaces: one vertex of each shell decides for that shell, and a
+  // part is inside only when all its shells are. Both parts are taken in
+  // outer's frame, inner's vertices mapped by the same Transform::apply as
+  // the collision query, so the points are those it tested.
   std::vector<Vec3> inner_in_outer_frame(mi.vertices.size());
   for (std::size_t i = 0; i < mi.vertices.size(); ++i) {
     inner_in_outer_frame[i] = X_outer_inner.apply(mi.vertices[i]);
   }
   if (outer_closed) {
-    const Located l = locate_in(mo, mo.vertices, inner_in_outer_frame[mi.triangles[0][0]]);
-    result.inner_in_outer = inside_of(l);
-    result.inner_enclosed_by_outer = enclosed_by(l);
+    std::tie(result.inner_in_outer, result.inner_enclosed_by_outer) =
+        shells_inside(mo, mo.vertices, mi, inner_in_outer_frame);
   }
   if (inner_closed) {
-    const Located l = locate_in(mi, inner_in_outer_frame, mo.vertices[mo.triangles[0][0]]);
-    result.outer_in_inner = inside_of(l);
-    result.outer_enclosed_by_inner = enclosed_by(l);
+    std::tie(result.outer_in_inner, result.outer_enclosed_by_inner) =
+        shells_inside(mi, inner_in_outer_frame, mo, mo.vertices);
   }
   return result;
 }

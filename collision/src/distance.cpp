@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "hierarchy_common.h"
 #include "rss_tree.h"
@@ -35,13 +36,28 @@ std::shared_ptr<const DistanceModel> build_distance_model(std::shared_ptr<const 
   return std::shared_ptr<const DistanceModel>(new DistanceModel(std::move(mesh), std::move(tree)));
 }
 
+namespace {
+
+/// A tolerance or an allowed error: a number >= 0 (NaN is refused too).
+void check_non_negative(Real value, const char* what) {
+  if (!(value >= 0)) {
+    throw std::invalid_argument(std::string(what) + " must be a number >= 0, got " +
+                                std::to_string(value));
+  }
+}
+
+}  // namespace
+
 DistanceResult distance(const DistanceModel& a, const DistanceModel& b, const Transform& X_AB,
                         const DistanceRequest& request) {
+  check_non_negative(request.relative_error, "distance: relative_error");
+  check_non_negative(request.absolute_error, "distance: absolute_error");
   return a.tree().distance(a.mesh(), b.tree(), b.mesh(), X_AB, request);
 }
 
 ToleranceResult within_tolerance(const DistanceModel& a, const DistanceModel& b,
                                  const Transform& X_AB, Real tolerance) {
+  check_non_negative(tolerance, "within_tolerance: the tolerance");
   return a.tree().within(a.mesh(), b.tree(), b.mesh(), X_AB, tolerance);
 }
 
@@ -129,6 +145,7 @@ DistanceResult distance_brute(const Mesh& a, const Mesh& b, const Transform& X_A
 
 ToleranceResult within_tolerance_brute(const Mesh& a, const Mesh& b, const Transform& X_AB,
                                        Real tolerance) {
+  check_non_negative(tolerance, "within_tolerance_brute: the tolerance");
   ToleranceResult result;
   const BrutePairs pairs(a, b, X_AB);
   pairs.run([&] { return tolerance; },

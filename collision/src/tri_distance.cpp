@@ -32,39 +32,54 @@ bool vertex_face(const Vec3& v, const TriangleVertices& t, const Vec3& n, Real n
 
 }  // namespace
 
+namespace {
+
+/// Parameter in [0, 1] of the point of segment [o, o + d] closest to p.
+Real closest_parameter(const Vec3& p, const Vec3& o, const Vec3& d) {
+  const Real dd = d.dot(d);
+  return dd > 0 ? clamp01((p - o).dot(d) / dd) : Real{0};
+}
+
+}  // namespace
+
 Real segment_distance_squared(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1,
                               Vec3& x, Vec3& y) {
+  // The distance is a convex function of the two parameters: its minimum is
+  // where the lines are closest when that lies inside both segments, and on
+  // the boundary (an endpoint against the other segment) otherwise. Every
+  // candidate is a pair of points of the segments, never closer than the
+  // true distance.
   const Vec3 d1 = p1 - p0;
   const Vec3 d2 = q1 - q0;
-  const Vec3 r = p0 - q0;
-  const Real a = d1.dot(d1);
-  const Real e = d2.dot(d2);
-  const Real f = d2.dot(r);
-  Real s = 0, t = 0;
-  if (a > 0 && e > 0) {
-    const Real b = d1.dot(d2);
-    const Real c = d1.dot(r);
-    // The lines' closest point on the first segment, clamped; for (nearly)
-    // parallel lines every s is as good, and the steps below fix the rest.
-    const Real denom = a * e - b * b;
-    if (denom > 0x1.0p-48 * a * e) s = clamp01((b * f - c * e) / denom);
-    // The best t for that s; if it falls outside, clamp it and re-fit s.
-    t = (b * s + f) / e;
-    if (t < 0) {
-      t = 0;
-      s = clamp01(-c / a);
-    } else if (t > 1) {
-      t = 1;
-      s = clamp01((b - c) / a);
+  Real best = std::numeric_limits<Real>::infinity();
+  const auto consider = [&](const Vec3& u, const Vec3& v) {
+    const Real d2_uv = (u - v).squaredNorm();
+    if (d2_uv < best) {
+      best = d2_uv;
+      x = u;
+      y = v;
     }
-  } else if (e > 0) {
-    t = clamp01(f / e);
-  } else if (a > 0) {
-    s = clamp01(-d1.dot(r) / a);
+  };
+  // The lines' closest points from the cross product n = d1 x d2, which keeps
+  // its relative accuracy for nearly parallel lines (a e - b^2 would not).
+  const Vec3 n = d1.cross(d2);
+  const Real n2 = n.squaredNorm();
+  if (n2 > 0) {
+    const Vec3 w = q0 - p0;
+    const Real s = w.cross(d2).dot(n) / n2;
+    const Real t = w.cross(d1).dot(n) / n2;
+    if (s >= 0 && s <= 1 && t >= 0 && t <= 1) {
+      // One refinement each way on the rounded parameters.
+      const Vec3 on_q = q0 + d2 * closest_parameter(p0 + d1 * s, q0, d2);
+      consider(p0 + d1 * closest_parameter(on_q, p0, d1), on_q);
+      return best;
+    }
   }
-  x = p0 + d1 * s;
-  y = q0 + d2 * t;
-  return (x - y).squaredNorm();
+  consider(p0, q0 + d2 * closest_parameter(p0, q0, d2));
+  consider(p1, q0 + d2 * closest_parameter(p1, q0, d2));
+  consider(p0 + d1 * closest_parameter(q0, p0, d1), q0);
+  consider(p0 + d1 * closest_parameter(q1, p0, d1), q1);
+  return best;
 }
 
 Vec3 closest_point_on_triangle(const Vec3& p, const TriangleVertices& t) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <memory>
 #include <vector>
 
@@ -113,6 +115,35 @@ TEST(Containment, SmallSphereInsideLargeSphere) {
   EXPECT_TRUE(crossing.surfaces_intersect);
   EXPECT_EQ(crossing.inner_in_outer, Inside::kNo);
   EXPECT_EQ(crossing.outer_in_inner, Inside::kNo);
+}
+
+TEST(Containment, EveryShellOfAPartMustBeInside) {
+  // Inner is two separate boxes in one mesh (as a merged file gives): it is
+  // inside the sphere only when both are, whichever comes first in the mesh.
+  const Mesh sphere = make_sphere(2, 3);
+  const auto two_boxes = [](const Vec3& first, const Vec3& second) {
+    const Mesh box = make_box(Vec3(0.2, 0.2, 0.2));
+    std::vector<Vec3> v;
+    std::vector<TriangleIndices> t;
+    for (const Vec3& offset : {first, second}) {
+      const auto base = static_cast<std::uint32_t>(v.size());
+      for (const Vec3& p : box.vertices) v.push_back(p + offset);
+      for (const TriangleIndices& f : box.triangles) t.push_back({f[0] + base, f[1] + base, f[2] + base});
+    }
+    return make_mesh(std::move(v), std::move(t), "two boxes");
+  };
+  const Vec3 in(0.5, 0, 0), in_too(0.5, 0.8, 0), out(5, 0, 0);
+  for (const auto& [first, second, expected] :
+       {std::tuple{in, in_too, Inside::kYes}, std::tuple{in, out, Inside::kNo},
+        std::tuple{out, in, Inside::kNo}}) {
+    const ContainmentResult r = contains(sphere, two_boxes(first, second), Transform());
+    EXPECT_FALSE(r.surfaces_intersect);
+    EXPECT_EQ(r.inner_in_outer, expected) << first.transpose() << " / " << second.transpose();
+    EXPECT_EQ(r.inner_enclosed_by_outer, expected);
+  }
+  // And the other way round: the sphere is not inside two small boxes.
+  const ContainmentResult swapped = contains(two_boxes(in, out), sphere, Transform());
+  EXPECT_EQ(swapped.outer_in_inner, Inside::kNo);
 }
 
 TEST(Containment, PartInsideAHollowHousing) {

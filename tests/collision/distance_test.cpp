@@ -192,6 +192,31 @@ TEST(DistanceTriangles, SegmentsParallelAndDegenerate) {
   EXPECT_NEAR(d2, 1.0, 1e-12);
 }
 
+TEST(DistanceTriangles, NearlyParallelCrossingEdges) {
+  // Edges crossing at a small angle, one a small height above the other: the
+  // distance is that height, found where they cross, not at an endpoint
+  // (which is about angle x length away). A regression test: the lines'
+  // closest points must come from a form that stays accurate at small angles.
+  const TriangleVertices a{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 0, -1)};
+  const TriangleVertices b{Vec3(0.2, -1.5e-8, 1e-9), Vec3(0.8, 1.5e-8, 1e-9), Vec3(0.5, 0.5, 1)};
+  const detail::TriangleDistance d = detail::triangle_distance(a, b);
+  EXPECT_NEAR(d.distance, 1e-9, 1e-18);
+  EXPECT_NEAR(d.p.x(), 0.5, 1e-7);
+  // Skew segments over a range of small angles and heights, distance known.
+  for (const Real angle : {1e-4, 1e-6, 1e-7, 3e-8, 1e-8, 1e-10}) {
+    for (const Real height : {1e-3, 1e-6, 1e-9, 1e-12}) {
+      const Vec3 half(0.3 * std::cos(angle), 0.3 * std::sin(angle), 0);
+      const Vec3 centre(0.45, 0, height);
+      Vec3 x, y;
+      const Real d2 = detail::segment_distance_squared(Vec3(0, 0, 0), Vec3(1, 0, 0), centre - half,
+                                                       centre + half, x, y);
+      EXPECT_NEAR(std::sqrt(d2), height, 1e-15 + 1e-9 * height)
+          << "angle " << angle << " height " << height;
+      EXPECT_NEAR((x - y).norm(), std::sqrt(d2), 1e-15);
+    }
+  }
+}
+
 // ------------------------------------------------------------- the RSS bound
 
 TEST(DistanceRss, LowerBoundNeverExceedsSampledDistance) {
@@ -305,10 +330,6 @@ std::vector<SampledPose> poses_for(const Scene& scene, int directions, std::uint
   return contact_distance_poses(*ma, *mb, settings);
 }
 
-bool close_relative(Real x, Real y, Real rel) {
-  return std::abs(x - y) <= rel * std::max(std::abs(x), std::abs(y));
-}
-
 TEST(DistanceMeshes, EqualsBruteForceAndZeroExactlyWhenColliding) {
   int total = 0, colliding = 0, mismatches = 0;
   std::uint64_t tree_pairs = 0, brute_pairs = 0;
@@ -328,8 +349,8 @@ TEST(DistanceMeshes, EqualsBruteForceAndZeroExactlyWhenColliding) {
       colliding += hit;
       tree_pairs += tree.stats.triangle_tests;
       brute_pairs += brute.stats.triangle_tests;
-      const bool ok = close_relative(tree.distance, brute.distance, 1e-12) &&
-                      close_relative(tree3.distance, brute.distance, 1e-12) &&
+      // The same triangle pairs give the same bits: equal, not merely close.
+      const bool ok = tree.distance == brute.distance && tree3.distance == brute.distance &&
                       (tree.distance == 0) == hit && (brute.distance == 0) == hit;
       if (!ok && ++mismatches <= 5) {
         ADD_FAILURE() << scene.name << " gap " << pose.gap << ": tree " << tree.distance
@@ -374,8 +395,8 @@ TEST(DistanceMeshes, ToleranceVerdictEqualsBruteDistance) {
         const bool expected = d <= eps;
         ++total;
         within += t.within;
-        // Exact ties are decided the same way too; only near-ties may differ.
-        if (t.within != expected && !close_relative(d, eps, 1e-12) && ++mismatches <= 5) {
+        // Exact ties (eps == d) are decided the same way too.
+        if (t.within != expected && ++mismatches <= 5) {
           ADD_FAILURE() << scene.name << " gap " << pose.gap << " eps " << eps << " distance " << d
                         << " within " << t.within;
         }
@@ -436,6 +457,18 @@ TEST(DistanceMeshes, InfoAndArguments) {
   EXPECT_THROW(build_distance_model(mesh, {.max_leaf_size = 8}), std::invalid_argument);
   // A mesh against itself at the identity: every triangle touches itself.
   EXPECT_EQ(distance(*model, *model, Transform::identity()).distance, 0);
+  // Negative or NaN tolerances and allowed errors are refused, not guessed at.
+  {
+    const auto box = std::make_shared<const Mesh>(make_box(Vec3(1, 1, 1)));
+    const auto m = build_distance_model(box);
+    const Transform X;
+    for (const Real bad : {-1.0, std::nan("")}) {
+      EXPECT_THROW(within_tolerance(*m, *m, X, bad), std::invalid_argument);
+      EXPECT_THROW(within_tolerance_brute(*box, *box, X, bad), std::invalid_argument);
+      EXPECT_THROW(distance(*m, *m, X, {.relative_error = bad}), std::invalid_argument);
+      EXPECT_THROW(distance(*m, *m, X, {.absolute_error = bad}), std::invalid_argument);
+    }
+  }
 }
 
 }  // namespace

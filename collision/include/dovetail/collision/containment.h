@@ -4,9 +4,10 @@
 ///
 /// Why: a part dropped inside a housing, or swallowed whole by a grasp
 /// volume, has no intersecting triangles, so the collision query reports
-/// nothing. When the surfaces do not meet, one part is inside the other
-/// exactly when one of its points is, and that is decided exactly: ray
-/// parity with orient3d signs only. See docs/proximity.md, "Containment".
+/// nothing. When the surfaces do not meet, each connected shell of a part is
+/// inside the other exactly when one of its points is, and that is decided
+/// exactly: ray parity with orient3d signs only. See docs/proximity.md,
+/// "Containment".
 
 #include <cstddef>
 

@@ -107,14 +107,15 @@ struct ToleranceResult {
 /// simultaneous traversal of both hierarchies that visits the closer pair of
 /// volumes first and prunes pairs that cannot beat the best distance so far.
 /// Equal to distance_brute (the same triangle pairs give the same bits)
-/// unless `request` allows an error.
+/// unless `request` allows an error. Throws std::invalid_argument for a
+/// negative or NaN allowed error.
 DistanceResult distance(const DistanceModel& a, const DistanceModel& b, const Transform& X_AB,
                         const DistanceRequest& request = {});
 
 /// Is the distance between A and B at most `tolerance` (>= 0)? Stops at the
 /// first triangle pair within the tolerance and prunes every pair of volumes
 /// farther apart than it. The verdict equals distance_brute(...).distance <=
-/// tolerance.
+/// tolerance. Throws std::invalid_argument for a negative or NaN tolerance.
 ToleranceResult within_tolerance(const DistanceModel& a, const DistanceModel& b,
                                  const Transform& X_AB, Real tolerance);
 
@@ -124,7 +125,8 @@ ToleranceResult within_tolerance(const DistanceModel& a, const DistanceModel& b,
 DistanceResult distance_brute(const Mesh& a, const Mesh& b, const Transform& X_AB);
 
 /// Tolerance query over every triangle pair, stopping at the first pair
-/// within `tolerance` (the reference for within_tolerance).
+/// within `tolerance` (the reference for within_tolerance). Throws like
+/// within_tolerance.
 ToleranceResult within_tolerance_brute(const Mesh& a, const Mesh& b, const Transform& X_AB,
                                        Real tolerance);
 
