@@ -408,25 +408,44 @@ struct CollisionWorld::Impl {
   }
 
   void prepare() {
-    std::vector<Shape*> todo;
-    std::vector<char> needs_model;
-    std::unordered_map<Shape*, std::size_t> index;
+    std::vector<Shape*> shapes_in_use;
+    std::unordered_map<const Shape*, std::size_t> index;
     for (const Part& p : parts) {
-      if (!p.alive) continue;
-      const auto [it, inserted] = index.emplace(p.shape.get(), todo.size());
-      if (inserted) {
-        todo.push_back(p.shape.get());
-        needs_model.push_back(0);
+      if (p.alive && index.emplace(p.shape.get(), shapes_in_use.size()).second) {
+        shapes_in_use.push_back(p.shape.get());
       }
-      if (p.level == LevelOfDetail::kExact) needs_model[it->second] = 1;
     }
     // Distinct shapes are independent: each task builds one shape's data.
-    tasks->parallel_for(todo.size(), 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        ensure_hull(*todo[i]);
-        if (needs_model[i] || todo[i]->hull_failed) ensure_model(*todo[i]);
+    const auto build = [&](const std::vector<Shape*>& todo, auto&& what) {
+      tasks->parallel_for(todo.size(), 1, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) what(*todo[i]);
+      });
+    };
+    build(shapes_in_use, [&](Shape& shape) { ensure_hull(shape); });
+
+    // Models for every part that step() could take to the polygon level: a
+    // part at the exact level, a part of a pair set to the exact level, and,
+    // when some part is flat (no hull, so its pairs are decided exactly),
+    // every part, since any may meet that one.
+    std::vector<char> needs_model(shapes_in_use.size(), 0);
+    bool any_flat = false;
+    for (const Part& p : parts) {
+      if (!p.alive) continue;
+      any_flat = any_flat || p.shape->hull_failed;
+      if (p.level == LevelOfDetail::kExact) needs_model[index.at(p.shape.get())] = 1;
+    }
+    for (const auto& [key, level] : levels) {
+      if (level != LevelOfDetail::kExact) continue;
+      for (const std::uint64_t i : {key >> 32, key & 0xffffffffu}) {
+        const Part& p = parts[i];
+        if (p.alive) needs_model[index.at(p.shape.get())] = 1;
       }
-    });
+    }
+    std::vector<Shape*> todo;
+    for (std::size_t i = 0; i < shapes_in_use.size(); ++i) {
+      if (needs_model[i] || any_flat) todo.push_back(shapes_in_use[i]);
+    }
+    build(todo, [&](Shape& shape) { ensure_model(shape); });
   }
 
   const StepResult& step() {

@@ -72,11 +72,15 @@ class PairTraversal {
   /// A first-hit query that searches the hinted subtree pair first (when it
   /// still overlaps) and the whole trees only when that finds nothing.
   void run_hinted(TraversalHint& hint, std::size_t node_count_a, std::size_t node_count_b) {
-    if (hint.valid && hint.node_a < node_count_a && hint.node_b < node_count_b) {
+    // A hint at the roots would only repeat the traversal below.
+    const bool at_roots = hint.node_a == 0 && hint.node_b == 0;
+    if (hint.valid && !at_roots && hint.node_a < node_count_a && hint.node_b < node_count_b) {
       const Entry e{hint.node_a, p_.enclose_a(hint.node_a), hint.node_b, p_.enclose_b(hint.node_b)};
       if (overlapping(e)) run_from(e);
       if (tester_.done()) return;
     }
+    // Kept after a miss: parts that part briefly often meet again there, and
+    // a stale hint costs at most its subtree pair, never a second traversal.
     run();
   }
 

@@ -225,6 +225,43 @@ TEST(CollisionWorld, InstancesShareOneHierarchy) {
   EXPECT_EQ(one.model_bytes(), many.model_bytes());
 }
 
+TEST(CollisionWorld, PrepareBuildsWhatTheStepsWouldBuild) {
+  // After prepare(), stepping through every contact builds nothing more (the
+  // hierarchies' bytes stay the same), for hull-level parts raised to exact
+  // by a pair level, and for a hull-level part meeting a flat part (no hull,
+  // so their pair is decided exactly).
+  const auto sphere = share(make_sphere(0.5, 2));
+  const auto box = share(make_box(Vec3(0.4, 0.3, 0.2)));
+  const auto sheet = share(make_wavy_sheet(0.6, 0.0, 1.0, 6));
+  const auto expect_nothing_more = [](CollisionWorld& world, PartId moving, const Vec3& meet) {
+    world.prepare();
+    const std::size_t prepared = world.model_bytes();
+    Transform X;
+    X.t = meet;
+    world.set_pose(moving, X);
+    EXPECT_FALSE(world.step().colliding.empty());
+    EXPECT_GT(prepared, 0u);
+    EXPECT_EQ(world.model_bytes(), prepared);
+  };
+  {
+    CollisionWorld world;
+    Transform X;
+    const PartId a = world.add_part({.mesh = sphere, .X_WP = X, .level = LevelOfDetail::kHull});
+    X.t.x() = 3;
+    const PartId b = world.add_part({.mesh = box, .X_WP = X, .level = LevelOfDetail::kHull});
+    world.set_pair_level(a, b, LevelOfDetail::kExact);
+    expect_nothing_more(world, a, Vec3(2.7, 0, 0));
+  }
+  {
+    CollisionWorld world;
+    Transform X;
+    const PartId a = world.add_part({.mesh = sphere, .X_WP = X, .level = LevelOfDetail::kHull});
+    X.t.x() = 3;
+    world.add_part({.mesh = sheet, .X_WP = X, .movable = false});
+    expect_nothing_more(world, a, Vec3(3, 0, 0.2));
+  }
+}
+
 }  // namespace
 }  // namespace dovetail::collision
 

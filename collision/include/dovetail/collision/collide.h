@@ -25,9 +25,9 @@ struct TrianglePair {
 /// subtree pair holds no intersection any more. A hit is a proof either way,
 /// so the verdict never depends on the hint; only the work does.
 struct TraversalHint {
-  std::uint32_t node_a = 0;
-  std::uint32_t node_b = 0;
-  bool valid = false;
+  std::uint32_t node_a = 0;  ///< node of A's hierarchy (its own numbering)
+  std::uint32_t node_b = 0;  ///< node of B's hierarchy
+  bool valid = false;        ///< false until a first-hit query has found a hit
 };
 
 /// What a query should find.

@@ -184,9 +184,11 @@ class CollisionWorld {
   void set_pair_level(PartId a, PartId b, LevelOfDetail level);
 
   /// Builds now, over the task system's threads, the hulls of all parts and
-  /// the polygon-level hierarchies of all parts that can reach an exact pair,
-  /// instead of on first need during step(). Optional: results are the same
-  /// either way; it keeps one-off set-up cost out of the stepping loop.
+  /// the polygon-level hierarchies of all parts that can reach an exact pair
+  /// (by their own level, a pair level, or a flat partner), instead of on
+  /// first need during step(). Optional: results are the same either way; it
+  /// keeps one-off set-up cost out of the stepping loop. Parts added, or
+  /// levels changed, afterwards are built on first need again.
   void prepare();
 
   /// Runs the pipeline on the current poses.

@@ -152,6 +152,7 @@ enum class FeatureType : std::uint8_t {
 struct HullFeature {
   FeatureType type = FeatureType::kNone;
   std::array<std::uint32_t, 3> vertices{};  ///< the first size() entries are used
+  /// Number of vertices: 0 for kNone, 1 vertex, 2 edge, 3 face.
   int size() const { return static_cast<int>(type); }
   friend bool operator==(const HullFeature&, const HullFeature&) = default;
 };
