@@ -8,6 +8,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -133,35 +134,57 @@ Affine node_to_root(const aiNode& node) {
   return X_RN;
 }
 
-/// The file's perspective cameras in its root frame. Assimp gives the field
-/// of view as the full horizontal angle (its glTF importer: yfov x aspect),
-/// so the vertical one follows from the aspect ratio.
-void collect_cameras(const aiScene& scene, ImportReport& report) {
+/// The file's perspective cameras in its root frame, named uniquely (`_2`,
+/// `_3`, ... for repeated names; `camera` for an empty one).
+///
+/// Two quirks of assimp 5.2's glTF importer are undone here: it gives the
+/// field of view as yfov x aspect ratio (so the vertical one is that over
+/// the aspect ratio), and it copies the camera node's translation into the
+/// camera's own position (assimp issue 5054), although the node transform
+/// places the camera too.
+void collect_cameras(const fs::path& path, const aiScene& scene, ImportReport& report) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const bool gltf = extension == ".gltf" || extension == ".glb";
+  std::set<std::string> used;
   for (unsigned i = 0; i < scene.mNumCameras; ++i) {
     const aiCamera& camera = *scene.mCameras[i];
-    const std::string name = camera.mName.C_Str();
+    const std::string base =
+        camera.mName.length > 0 ? std::string(camera.mName.C_Str()) : std::string("camera");
+    std::string name = base;
+    for (std::size_t k = 2; used.count(name) != 0; ++k) {
+      name = base;
+      name += '_';
+      name += std::to_string(k);
+    }
     if (!(camera.mHorizontalFOV > 0)) {
       report.notes.push_back("skipped orthographic camera '" + name + "'");
       continue;
     }
     const aiNode* node = scene.mRootNode->FindNode(camera.mName);
     const Affine X_RN = node != nullptr ? node_to_root(*node) : Affine::Identity();
-    const Vec3 eye = apply(X_RN, camera.mPosition);
+    aiVector3D position = camera.mPosition;
+    if (gltf && node != nullptr) {
+      const aiMatrix4x4& m = node->mTransformation;
+      if (position == aiVector3D(m.a4, m.b4, m.c4)) position = aiVector3D(0, 0, 0);
+    }
+    const Vec3 eye = apply(X_RN, position);
     const collision::Mat3 R = X_RN.leftCols<3>();
     const Vec3 look = R * Vec3(camera.mLookAt.x, camera.mLookAt.y, camera.mLookAt.z);
     const Vec3 up = R * Vec3(camera.mUp.x, camera.mUp.y, camera.mUp.z);
     const double aspect = camera.mAspect > 0 ? camera.mAspect : 1.0;
-    const double fov_y = 2 * std::atan(std::tan(0.5 * camera.mHorizontalFOV) / aspect);
     Camera out;
     out.eye = eye;
     out.target = eye + look.normalized();
     out.up = up;
-    out.fov_y_degrees = fov_y * 180 / std::numbers::pi;
+    out.fov_y_degrees = camera.mHorizontalFOV / aspect * 180 / std::numbers::pi;
     if (!out.eye.allFinite() || !out.target.allFinite() || !out.up.allFinite() ||
         !(out.up.squaredNorm() > 0) || !(out.fov_y_degrees > 0 && out.fov_y_degrees < 180)) {
       report.notes.push_back("skipped camera '" + name + "' with a degenerate pose or field of view");
       continue;
     }
+    used.insert(name);
     report.cameras.emplace_back(name, out);
   }
 }
@@ -395,7 +418,7 @@ ImportReport import_scene(const fs::path& path, const aiScene& scene, const Impo
     part.name = path.filename().string();
     part.mesh = validate(std::move(geometry), path.string(), options.limits, part.validation);
     report.parts.push_back(std::move(part));
-    collect_cameras(scene, report);
+    collect_cameras(path, scene, report);
     return report;
   }
 
@@ -415,7 +438,7 @@ ImportReport import_scene(const fs::path& path, const aiScene& scene, const Impo
         validate(std::move(geometry), path.string() + "#" + name, options.limits, part.validation);
     report.parts.push_back(std::move(part));
   }
-  collect_cameras(scene, report);
+  collect_cameras(path, scene, report);
   return report;
 }
 

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <numbers>
 #include <set>
 #include <string>
 #include <vector>
@@ -614,6 +615,30 @@ TEST(MeshImport, RelativePathsWork) {
 TEST(MeshImport, CheckedInTestData) {
   EXPECT_EQ(import_mesh(kData / "cube.obj").triangle_count(), 12u);
   EXPECT_EQ(import_mesh(kData / "tetrahedron.obj").triangle_count(), 4u);
+}
+
+}  // namespace
+}  // namespace dovetail::engine
+
+namespace dovetail::engine {
+namespace {
+
+TEST(MeshImport, GltfCamerasArePosedByTheirNodeOnly) {
+  // camera_plate.gltf: a perspective camera "wide" (yfov 0.8 rad, aspect 1.5)
+  // on a node translated to (0.5, 0.5, 3) and turned 90 degrees about y, so
+  // it looks along -x; an orthographic camera "flat", skipped with a note.
+  const ImportReport report = import_file(fs::path(DOVETAIL_TEST_DATA) / "camera_plate.gltf");
+  ASSERT_EQ(report.cameras.size(), 1u);
+  const auto& [name, camera] = report.cameras[0];
+  EXPECT_EQ(name, "wide");
+  // The node's translation once (assimp 5.2 also copies it into the camera).
+  EXPECT_NEAR((camera.eye - collision::Vec3(0.5, 0.5, 3)).norm(), 0, 1e-6);
+  const collision::Vec3 look = (camera.target - camera.eye).normalized();
+  EXPECT_NEAR((look - collision::Vec3(-1, 0, 0)).norm(), 0, 1e-6);
+  EXPECT_NEAR((camera.up.normalized() - collision::Vec3(0, 1, 0)).norm(), 0, 1e-6);
+  EXPECT_NEAR(camera.fov_y_degrees, 0.8 * 180 / std::numbers::pi, 1e-4);
+  ASSERT_FALSE(report.notes.empty());
+  EXPECT_NE(report.notes.back().find("orthographic camera 'flat'"), std::string::npos);
 }
 
 }  // namespace
