@@ -44,10 +44,15 @@ void fit_rss(const std::vector<Vec3>& points, const Vec3& u_fit, const Vec3& v_f
   const Vec3 u = to_vec(out.axis[0]);
   const Vec3 v = to_vec(out.axis[1]);
   const Vec3 n = u.cross(v).normalized();
+  // Projections relative to a point of the set: u and v are only nearly
+  // orthonormal after rounding, and coordinates relative to the origin would
+  // carry that error (about 1e-7 of the distance) into the centre.
+  const Vec3 origin = points.front();
   Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
   Vec3 hi = -lo;
   for (const Vec3& p : points) {
-    const Vec3 c(p.dot(u), p.dot(v), p.dot(n));
+    const Vec3 d = p - origin;
+    const Vec3 c(d.dot(u), d.dot(v), d.dot(n));
     lo = lo.cwiseMin(c);
     hi = hi.cwiseMax(c);
   }
@@ -56,7 +61,7 @@ void fit_rss(const std::vector<Vec3>& points, const Vec3& u_fit, const Vec3& v_f
   Real best_volume = std::numeric_limits<Real>::infinity();
   for (const Real fraction : {0.0, 0.25, 0.5, 0.75, 1.0}) {
     const Real shrink = fraction * half.z();
-    const Vec3 centre = u * mid.x() + v * mid.y() + n * mid.z();
+    const Vec3 centre = origin + u * mid.x() + v * mid.y() + n * mid.z();
     const float hu = to_float_up(std::max(Real{0}, half.x() - shrink));
     const float hv = to_float_up(std::max(Real{0}, half.y() - shrink));
     // The radius that covers every point from this rectangle.

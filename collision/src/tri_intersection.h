@@ -5,10 +5,10 @@
 ///
 /// Why: the triangle test (tri_tri.h) only answers yes or no. Contacts need
 /// where and how the two surfaces meet: a segment where they cross or touch
-/// transversally, a polygon where they lie in one plane. The verdict stays
-/// with the exact test; this code only measures pairs that test reported, so
-/// rounding here can shrink or grow a piece by a few ulps but never invents
-/// or loses a pair.
+/// transversally, a polygon where they lie in one plane. This code only
+/// measures the pair it is given, so rounding here can shrink or grow a piece
+/// by a few ulps; which pairs are measured is decided elsewhere (the exact
+/// test, plus the nearly coplanar pairs contacts.cpp adds on purpose).
 
 #include <array>
 #include <vector>

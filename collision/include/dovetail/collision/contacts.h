@@ -59,7 +59,10 @@ struct ContactPatch {
   Real depth = 0;
   bool penetrating = false;  ///< depth > touching_tolerance
   ContactKind kind = ContactKind::kPoint;
-  std::vector<TrianglePair> pairs;  ///< the patch's triangle pairs, sorted
+  /// The patch's triangle pairs, sorted: the intersecting pairs it was built
+  /// from, plus nearly coplanar face pairs (within coplanar_tolerance) next
+  /// to them that the exact test separates by a few ulps.
+  std::vector<TrianglePair> pairs;
 };
 
 /// Contact patches of meshes `a` and `b`, B at pose X_AB in A's frame, from
