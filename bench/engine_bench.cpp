@@ -43,8 +43,8 @@ double median(std::vector<double> v) {
 
 struct RunResult {
   double polygon_pairs = 0, colliding_pairs = 0, volume_tests = 0;  ///< per frame
-  double wall_s = 0;     ///< the stepping loop
-  double prepare_s = 0;  ///< building hulls and hierarchies before the loop
+  double wall_s = 0;                                                ///< the stepping loop
+  double prepare_s = 0;    ///< building hulls and hierarchies before the loop
   double collision_s = 0;  ///< of wall_s, in the collision pipeline
   std::uint64_t frames = 0;
   std::size_t contact_events = 0;
@@ -55,7 +55,8 @@ struct RunResult {
 template <typename Move>
 RunResult run(engine::Simulation& sim, double seconds, Move&& move) {
   const auto frames = static_cast<std::uint64_t>(std::llround(seconds / sim.settings().time_step));
-  sim.set_frame_hook([&](engine::Simulation&, std::uint64_t frame, double time) { move(frame, time); });
+  sim.set_frame_hook(
+      [&](engine::Simulation&, std::uint64_t frame, double time) { move(frame, time); });
   RunResult r;
   const auto tp = Clock::now();
   sim.prepare();
@@ -67,7 +68,8 @@ RunResult run(engine::Simulation& sim, double seconds, Move&& move) {
     r.colliding_pairs += static_cast<double>(fr.collision.colliding_pairs) / frames;
     r.volume_tests += static_cast<double>(fr.collision.polygon.volume_tests) / frames;
     for (const engine::Event& e : fr.events) {
-      r.contact_events += e.kind == engine::EventKind::kContactBegin || e.kind == engine::EventKind::kContactEnd;
+      r.contact_events +=
+          e.kind == engine::EventKind::kContactBegin || e.kind == engine::EventKind::kContactEnd;
     }
   }
   r.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
@@ -77,7 +79,8 @@ RunResult run(engine::Simulation& sim, double seconds, Move&& move) {
   return r;
 }
 
-void print(const char* name, std::size_t parts, double seconds, const std::vector<RunResult>& runs) {
+void print(const char* name, std::size_t parts, double seconds,
+           const std::vector<RunResult>& runs) {
   std::vector<double> walls, prepares, collisions;
   for (const RunResult& r : runs) {
     walls.push_back(r.wall_s);
@@ -85,13 +88,17 @@ void print(const char* name, std::size_t parts, double seconds, const std::vecto
     collisions.push_back(r.collision_s);
   }
   const double wall = median(walls);
-  std::printf("%-28s %6zu parts  %5.1f s simulated  %8.3f s wall  %8.0f frames/s  %7.1fx real time  %5zu contact events  hash %016llx\n",
-              name, parts, seconds, wall, runs[0].frames / wall, seconds / wall, runs[0].contact_events,
-              static_cast<unsigned long long>(runs[0].state_hash));
+  std::printf(
+      "%-28s %6zu parts  %5.1f s simulated  %8.3f s wall  %8.0f frames/s  %7.1fx real time  %5zu "
+      "contact events  hash %016llx\n",
+      name, parts, seconds, wall, runs[0].frames / wall, seconds / wall, runs[0].contact_events,
+      static_cast<unsigned long long>(runs[0].state_hash));
   std::printf("%-28s per frame: %.1f polygon-level pairs, %.1f in contact, %.0f volume tests\n", "",
               runs[0].polygon_pairs, runs[0].colliding_pairs, runs[0].volume_tests);
-  std::printf("%-28s collision pipeline %.3f s of the wall time; set-up before the loop (hulls and hierarchies) %.3f s\n",
-              "", median(collisions), median(prepares));
+  std::printf(
+      "%-28s collision pipeline %.3f s of the wall time; set-up before the loop (hulls and "
+      "hierarchies) %.3f s\n",
+      "", median(collisions), median(prepares));
 }
 
 void engine_assembly(const std::string& path, double seconds, int runs) {
@@ -119,7 +126,8 @@ void engine_assembly(const std::string& path, double seconds, int runs) {
       hi = hi.cwiseMax(X.apply(b.min)).cwiseMax(X.apply(b.max));
     }
     const Real size = (hi - lo).norm();
-    std::vector<engine::PartHandle> moving(with_mesh.begin(), with_mesh.begin() + std::min<std::size_t>(4, with_mesh.size()));
+    std::vector<engine::PartHandle> moving(
+        with_mesh.begin(), with_mesh.begin() + std::min<std::size_t>(4, with_mesh.size()));
     std::vector<Transform> start;
     for (engine::PartHandle p : moving) {
       scene.set_movable(p, true);
@@ -129,7 +137,8 @@ void engine_assembly(const std::string& path, double seconds, int runs) {
     engine::Simulation sim(std::move(scene), {.collision_threads = 1});
     results.push_back(run(sim, seconds, [&](std::uint64_t, double t) {
       for (std::size_t i = 0; i < moving.size(); ++i) {
-        // Each part sweeps back and forth along a different axis through the assembly, turning slowly.
+        // Each part sweeps back and forth along a different axis through the assembly, turning
+        // slowly.
         Transform X = start[i];
         const Real phase = 2 * std::numbers::pi * (0.2 * t + 0.25 * static_cast<Real>(i));
         X.t[i % 3] += 0.3 * size * std::sin(phase);
@@ -148,11 +157,13 @@ void synthetic(std::size_t n, double seconds, int runs) {
   for (int s = 0; s < 20; ++s) {
     std::vector<Vec3> p;
     for (int i = 0; i < 30; ++i) {
-      const Real z = 2 * uniform() - 1, phi = 2 * std::numbers::pi * uniform(), r = std::sqrt(1 - z * z);
+      const Real z = 2 * uniform() - 1, phi = 2 * std::numbers::pi * uniform(),
+                 r = std::sqrt(1 - z * z);
       p.emplace_back(0.05 * r * std::cos(phi), 0.05 * r * std::sin(phi), 0.05 * z);
     }
     const collision::ConvexHull hull = collision::compute_convex_hull(p, "polytope");
-    shapes.push_back(std::make_shared<const collision::Mesh>(collision::make_mesh(hull.vertices, hull.faces, "polytope")));
+    shapes.push_back(std::make_shared<const collision::Mesh>(
+        collision::make_mesh(hull.vertices, hull.faces, "polytope")));
   }
   // Parts of radius 0.05 m filling 5% of a cube, on a jittered grid, moving at 0.5 m/s.
   const Real half = 0.5 * std::cbrt(n * (4.0 / 3.0 * std::numbers::pi * 0.05 * 0.05 * 0.05) / 0.05);
@@ -166,13 +177,15 @@ void synthetic(std::size_t n, double seconds, int runs) {
     std::vector<Vec3> velocity(n);
     std::vector<engine::PartHandle> handles;
     for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 cell(static_cast<Real>(i % side), static_cast<Real>((i / side) % side), static_cast<Real>(i / (side * side)));
+      const Vec3 cell(static_cast<Real>(i % side), static_cast<Real>((i / side) % side),
+                      static_cast<Real>(i / (side * side)));
       pose[i] = starts[i];
       pose[i].t = Vec3::Constant(-half) + (2 * half / side) * (cell + Vec3::Constant(0.5));
       velocity[i] = motion[i].t;
       std::string name = "p";
       name += std::to_string(i);
-      handles.push_back(scene.add_part({.name = name, .X_PC = pose[i], .render_mesh = shapes[i % shapes.size()]}));
+      handles.push_back(scene.add_part(
+          {.name = name, .X_PC = pose[i], .render_mesh = shapes[i % shapes.size()]}));
     }
     engine::Simulation sim(std::move(scene), {.collision_threads = 1});
     const Real dt = sim.settings().time_step;
@@ -200,10 +213,14 @@ int main(int argc, char** argv) {
   std::string only;  // "engine" or "synthetic": run one scene
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i];
-    if (arg == "--seconds") seconds = std::stod(argv[i + 1]);
-    else if (arg == "--runs") runs = std::stoi(argv[i + 1]);
-    else if (arg == "--assembly") assembly = argv[i + 1];
-    else if (arg == "--only") only = argv[i + 1];
+    if (arg == "--seconds")
+      seconds = std::stod(argv[i + 1]);
+    else if (arg == "--runs")
+      runs = std::stoi(argv[i + 1]);
+    else if (arg == "--assembly")
+      assembly = argv[i + 1];
+    else if (arg == "--only")
+      only = argv[i + 1];
     else {
       std::fprintf(stderr, "engine_bench: unknown option %s\n", arg.c_str());
       return 2;

@@ -40,7 +40,8 @@ void build_vertex_triangles(Shape& shape) {
   for (const TriangleIndices& t : mesh.triangles) {
     for (std::uint32_t v : t) ++shape.vertex_offsets[v + 1];
   }
-  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) shape.vertex_offsets[v + 1] += shape.vertex_offsets[v];
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+    shape.vertex_offsets[v + 1] += shape.vertex_offsets[v];
   shape.vertex_triangles.resize(shape.vertex_offsets.back());
   std::vector<std::uint32_t> fill(shape.vertex_offsets.begin(), shape.vertex_offsets.end() - 1);
   for (std::uint32_t i = 0; i < mesh.triangles.size(); ++i) {
@@ -243,7 +244,8 @@ struct CollisionWorld::Impl {
     if (!request.all_pairs && w.state->has_witness) {
       std::uint64_t tests = 0;
       if (follow_witness(*a.shape, *b.shape, X_AB, w.state->witness, tests)) {
-        w.result = CollideResult{.colliding = true, .pairs = {w.state->witness}, .stats = {0, tests}};
+        w.result =
+            CollideResult{.colliding = true, .pairs = {w.state->witness}, .stats = {0, tests}};
         w.colliding = true;
         return;
       }

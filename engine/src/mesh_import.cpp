@@ -181,7 +181,8 @@ void collect_cameras(const fs::path& path, const aiScene& scene, ImportReport& r
     out.fov_y_degrees = camera.mHorizontalFOV / aspect * 180 / std::numbers::pi;
     if (!out.eye.allFinite() || !out.target.allFinite() || !out.up.allFinite() ||
         !(out.up.squaredNorm() > 0) || !(out.fov_y_degrees > 0 && out.fov_y_degrees < 180)) {
-      report.notes.push_back("skipped camera '" + name + "' with a degenerate pose or field of view");
+      report.notes.push_back("skipped camera '" + name +
+                             "' with a degenerate pose or field of view");
       continue;
     }
     used.insert(name);

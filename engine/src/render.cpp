@@ -241,9 +241,9 @@ Camera find_camera(const RenderScene& scene, const std::string& name, double asp
   for (const auto& entry : scene.cameras) known += (known.empty() ? "" : ", ") + entry.first;
   std::string views;
   for (const std::string& v : builtin_views()) views += (views.empty() ? "" : ", ") + v;
-  throw RenderError("no camera named '" + name + "' (cameras of the scene: " +
-                    (known.empty() ? std::string("none") : known) + "; views: " + views +
-                    "; or 'auto')");
+  throw RenderError("no camera named '" + name +
+                    "' (cameras of the scene: " + (known.empty() ? std::string("none") : known) +
+                    "; views: " + views + "; or 'auto')");
 }
 
 }  // namespace
@@ -300,7 +300,8 @@ const std::vector<std::string>& builtin_views() {
   return names;
 }
 
-std::optional<Camera> view_camera(const RenderScene& scene, double aspect, const std::string& view) {
+std::optional<Camera> view_camera(const RenderScene& scene, double aspect,
+                                  const std::string& view) {
   for (const BuiltinView& v : kViews) {
     if (view == v.name) return framed_camera(scene, aspect, v.direction, v.up);
   }

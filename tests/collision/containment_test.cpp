@@ -2,9 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include <tuple>
-
 #include <memory>
+#include <tuple>
 #include <vector>
 
 #include "dovetail/collision/model.h"
@@ -128,7 +127,8 @@ TEST(Containment, EveryShellOfAPartMustBeInside) {
     for (const Vec3& offset : {first, second}) {
       const auto base = static_cast<std::uint32_t>(v.size());
       for (const Vec3& p : box.vertices) v.push_back(p + offset);
-      for (const TriangleIndices& f : box.triangles) t.push_back({f[0] + base, f[1] + base, f[2] + base});
+      for (const TriangleIndices& f : box.triangles)
+        t.push_back({f[0] + base, f[1] + base, f[2] + base});
     }
     return make_mesh(std::move(v), std::move(t), "two boxes");
   };

@@ -249,7 +249,8 @@ TEST_F(EngineRender, FileCameraAndBuiltInViewsShowTheEngine) {
     const Image image = render(*scene_, settings);
     const auto background = to_bytes(settings.background);
     std::size_t foreground = 0;
-    for (std::size_t p = 0; p < image.rgba.size() / 4; ++p) foreground += rgb_at(image, p) != background;
+    for (std::size_t p = 0; p < image.rgba.size() / 4; ++p)
+      foreground += rgb_at(image, p) != background;
     EXPECT_GT(foreground, 160u * 120u / 10) << name;
     if (name != "nodes[81]") {
       // Framed like auto: the corners show the background.

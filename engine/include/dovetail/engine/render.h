@@ -57,8 +57,8 @@ struct RenderScene {
 
 /// How to draw.
 struct RenderSettings {
-  int width = 1024;    ///< pixels, 1 to kMaxImageSize
-  int height = 768;    ///< pixels, 1 to kMaxImageSize
+  int width = 1024;  ///< pixels, 1 to kMaxImageSize
+  int height = 768;  ///< pixels, 1 to kMaxImageSize
   /// Empty or "auto": auto_camera; otherwise a camera of the scene, or a
   /// built-in view (see view_camera).
   std::string camera;
