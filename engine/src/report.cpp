@@ -39,21 +39,6 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
   if (!out) throw std::runtime_error(path.string() + ": cannot be written");
 }
 
-void hash_bytes(std::uint64_t& hash, const void* data, std::size_t size) {
-  const auto* bytes = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < size; ++i) {
-    hash ^= bytes[i];
-    hash *= 0x100000001b3ull;
-  }
-}
-
-void hash_double(std::uint64_t& hash, double value) {
-  std::uint64_t bits = std::bit_cast<std::uint64_t>(value);
-  unsigned char bytes[8];
-  for (int i = 0; i < 8; ++i) bytes[i] = static_cast<unsigned char>(bits >> (8 * i));
-  hash_bytes(hash, bytes, 8);
-}
-
 double seconds_now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -62,14 +47,24 @@ double seconds_now() {
 
 std::uint64_t state_hash(const Scene& scene) {
   std::uint64_t hash = kFnvOffset;
+  const auto word = [&hash](std::uint64_t w) {
+    hash = (hash ^ w) * 0x100000001b3ull;
+    hash ^= hash >> 32;
+  };
   for (const PartHandle part : scene.parts()) {
     const std::string& name = scene.name(part);
-    hash_bytes(hash, name.data(), name.size() + 1);  // with the terminating 0
+    for (std::size_t i = 0; i <= name.size(); i += 8) {
+      std::uint64_t w = 0;
+      for (std::size_t k = 0; k < 8 && i + k < name.size(); ++k) {
+        w |= std::uint64_t{static_cast<unsigned char>(name[i + k])} << (8 * k);
+      }
+      word(w);
+    }
     const Transform X_WP = scene.world_pose(part);
     for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) hash_double(hash, X_WP.R(r, c));
+      for (int c = 0; c < 3; ++c) word(std::bit_cast<std::uint64_t>(X_WP.R(r, c)));
     }
-    for (int k = 0; k < 3; ++k) hash_double(hash, X_WP.t(k));
+    for (int k = 0; k < 3; ++k) word(std::bit_cast<std::uint64_t>(X_WP.t(k)));
   }
   return hash;
 }

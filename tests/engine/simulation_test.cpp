@@ -218,17 +218,23 @@ TEST(Simulation, StateHashFollowsPosesBitForBit) {
   EXPECT_EQ(b.last_frame().state_hash, b.state_hash());
 }
 
-TEST(Simulation, StateHashIsTheDocumentedFnv1a) {
+TEST(Simulation, StateHashIsTheDocumentedWordHash) {
   // Recomputed from the definition in docs/engine.md, independently of the engine.
   Scene scene = test_scene();
   std::uint64_t expected = 0xcbf29ce484222325ull;
-  auto feed = [&](unsigned char byte) {
-    expected ^= byte;
-    expected *= 0x100000001b3ull;
+  auto feed = [&](std::uint64_t word) {
+    expected = (expected ^ word) * 0x100000001b3ull;
+    expected ^= expected >> 32;
   };
-  for (const char* name : {"ball", "block", "rider", "slider"}) {
-    for (const char* c = name; *c != 0; ++c) feed(static_cast<unsigned char>(*c));
-    feed(0);
+  for (const std::string name : {"ball", "block", "rider", "slider"}) {
+    // The name and a 0 byte, in little-endian 8-byte words, zero-padded.
+    std::string bytes = name + '\0';
+    bytes.resize((bytes.size() + 7) / 8 * 8, '\0');
+    for (std::size_t i = 0; i < bytes.size(); i += 8) {
+      std::uint64_t word = 0;
+      for (int k = 7; k >= 0; --k) word = (word << 8) | static_cast<unsigned char>(bytes[i + k]);
+      feed(word);
+    }
     const Transform X_WP = scene.world_pose(name);
     std::vector<double> values;
     for (int r = 0; r < 3; ++r) {
@@ -238,7 +244,7 @@ TEST(Simulation, StateHashIsTheDocumentedFnv1a) {
     for (const double v : values) {
       std::uint64_t bits = 0;
       std::memcpy(&bits, &v, sizeof(bits));
-      for (int i = 0; i < 8; ++i) feed(static_cast<unsigned char>(bits >> (8 * i)));
+      feed(bits);
     }
   }
   EXPECT_EQ(state_hash(scene), expected);

@@ -60,12 +60,15 @@ struct Report {
   std::string timings_json() const;
 };
 
-/// FNV-1a 64-bit offset basis.
+/// FNV-1a 64-bit offset basis, the state hash's starting value.
 inline constexpr std::uint64_t kFnvOffset = 0xcbf29ce484222325ull;
 
-/// Hash of all part poses bit for bit: FNV-1a over, for each part in name
-/// order, its name, a 0 byte, and the 12 doubles of its world pose (R row by
-/// row, then t) as little-endian IEEE-754 bytes.
+/// Hash of all part poses bit for bit, word by word: starting from
+/// kFnvOffset, each 64-bit word w gives h = (h ^ w) * 0x100000001b3, then
+/// h ^= h >> 32. The words are, for each part in name order, its name and a
+/// 0 byte as little-endian 8-byte words (the last zero-padded), then the 12
+/// doubles of its world pose (R row by row, then t) as IEEE-754 bit patterns.
+/// Each step is a bijection of h, so a change in any one bit changes it.
 std::uint64_t state_hash(const Scene& scene);
 
 /// Shows progress of a run on stderr: a bar redrawn in place on a terminal,
