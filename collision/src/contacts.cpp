@@ -114,8 +114,9 @@ bool nearly_coplanar(const detail::TriangleVertices& t_a, const detail::Triangle
 /// reported pairs, pairs one triangle step apart are tried, and every pair
 /// found with an overlap of positive area spreads the search further.
 void add_nearly_coplanar_pairs(const Mesh& a, const Mesh& b, const Transform& X_AB, Real tolerance,
-                               const VertexTriangles& around_a, const VertexTriangles& around_b,
                                std::vector<TrianglePair>& pairs, std::vector<PairPiece>& pieces) {
+  const VertexTriangles around_a(a);
+  const VertexTriangles around_b(b);
   const auto key = [](std::uint32_t ta, std::uint32_t tb) {
     return (static_cast<std::uint64_t>(ta) << 32) | tb;
   };
@@ -145,48 +146,6 @@ void add_nearly_coplanar_pairs(const Mesh& a, const Mesh& b, const Transform& X_
   }
 }
 
-/// One part of the pair for the depth estimate: its mesh, adjacency, and the
-/// map of its vertices into A's frame (identity for A).
-struct Side {
-  const Mesh& mesh;
-  const VertexTriangles& around;
-  const Transform& X_AP;
-  Vec3 vertex(std::uint32_t v) const { return X_AP.apply(mesh.vertices[v]); }
-};
-
-/// How far `side` reaches past the patch plane (point p, unit normal n)
-/// towards `direction` (+n for A's vertices, which reach into B; -n for
-/// B's), found by walking the part's mesh from the patch's triangles
-/// (`seeds`) through vertices more than `threshold` past the plane and
-/// within `radius` of p. For two spheres the two reaches are the caps cut
-/// off by the intersection circle's plane, and add up to the overlap along
-/// the normal. Local: only the region connected to the patch is walked.
-Real reach_past_plane(const Side& side, const std::vector<std::uint32_t>& seeds, const Vec3& p,
-                      const Vec3& direction, Real radius, Real threshold) {
-  Real reach = 0;
-  std::unordered_set<std::uint32_t> seen;
-  std::vector<std::uint32_t> stack;
-  const auto visit = [&](std::uint32_t v) {
-    if (!seen.insert(v).second) return;
-    const Vec3 x = side.vertex(v);
-    const Real h = (x - p).dot(direction);
-    if (h <= threshold || (x - p).squaredNorm() > radius * radius) return;
-    reach = std::max(reach, h);
-    stack.push_back(v);
-  };
-  for (const std::uint32_t t : seeds) {
-    for (const std::uint32_t v : side.mesh.triangles[t]) visit(v);
-  }
-  while (!stack.empty()) {
-    const std::uint32_t v = stack.back();
-    stack.pop_back();
-    for (std::uint32_t k = side.around.offsets[v]; k < side.around.offsets[v + 1]; ++k) {
-      for (const std::uint32_t w : side.mesh.triangles[side.around.triangles[k]]) visit(w);
-    }
-  }
-  return reach;
-}
-
 Vec3 normalized_or(const Vec3& v, Real total_weight, const Vec3& fallback) {
   const Real n = v.norm();
   return n > 1e-9 * total_weight && n > 0 ? Vec3(v / n) : fallback;
@@ -195,8 +154,7 @@ Vec3 normalized_or(const Vec3& v, Real total_weight, const Vec3& fallback) {
 /// Patch of the pieces `members` (indices into `pieces`).
 ContactPatch make_patch(const std::vector<PairPiece>& pieces,
                         const std::vector<std::size_t>& members,
-                        std::span<const TrianglePair> pairs, const Side& side_a, const Side& side_b,
-                        Real merge, const ContactRequest& request) {
+                        std::span<const TrianglePair> pairs, const ContactRequest& request) {
   ContactPatch patch;
   Real area = 0;
   Real length = 0;
@@ -252,13 +210,9 @@ ContactPatch make_patch(const std::vector<PairPiece>& pieces,
     patch.normal = normalized_or(sum, count, fallback);
   }
 
-  // Depth, two estimates, the larger taken. (1) The deepest vertex of one
-  // triangle of a pair behind the other's face (inside the other part,
-  // projecting onto the face), over the pairs whose face turns towards the
-  // patch normal: exact for flat faces pushed into flat faces. (2) How far
-  // each part reaches past the patch's plane into the other, walking its
-  // mesh from the patch: the caps of curved parts whose deepest vertices
-  // belong to triangles that cross nothing.
+  // Depth: the deepest vertex of one triangle of a pair behind the other's
+  // face (inside the other part, projecting onto the face), over the pairs
+  // whose face turns towards the patch normal.
   patch.depth = 0;
   for (std::size_t m : members) {
     const PairPiece& pp = pieces[m];
@@ -269,19 +223,6 @@ ContactPatch make_patch(const std::vector<PairPiece>& pieces,
       patch.depth = std::max(patch.depth, depth_behind(pp.t_b, pp.piece.n_b, pp.t_a));
     }
   }
-  Real extent = 0;
-  std::vector<std::uint32_t> seeds_a, seeds_b;
-  for (std::size_t m : members) {
-    for (const Vec3& x : pieces[m].piece.points) {
-      extent = std::max(extent, (x - patch.point).norm());
-    }
-    seeds_a.push_back(pairs[m].a);
-    seeds_b.push_back(pairs[m].b);
-  }
-  const Real radius = 2 * extent + patch.depth + merge;
-  const Real caps = reach_past_plane(side_a, seeds_a, patch.point, patch.normal, radius, merge) +
-                    reach_past_plane(side_b, seeds_b, patch.point, -patch.normal, radius, merge);
-  patch.depth = std::max(patch.depth, caps);
   patch.penetrating = patch.depth > request.touching_tolerance;
   return patch;
 }
@@ -326,9 +267,7 @@ std::vector<ContactPatch> compute_contacts(const Mesh& a, const Mesh& b, const T
   const Real merge = std::max(request.merge_distance, 1e-9 * scale);
   for (PairPiece& p : pieces)
     p.piece = detail::intersect_triangles(p.t_a, p.t_b, coplanar_tolerance);
-  const VertexTriangles around_a(a);
-  const VertexTriangles around_b(b);
-  add_nearly_coplanar_pairs(a, b, X_AB, coplanar_tolerance, around_a, around_b, pairs, pieces);
+  add_nearly_coplanar_pairs(a, b, X_AB, coplanar_tolerance, pairs, pieces);
   for (PairPiece& p : pieces) {
     p.lo = p.hi = p.piece.points.front();
     for (const Vec3& x : p.piece.points) {
@@ -372,11 +311,8 @@ std::vector<ContactPatch> compute_contacts(const Mesh& a, const Mesh& b, const T
   }
   std::vector<ContactPatch> patches;
   patches.reserve(groups.size());
-  const Transform identity;
-  const Side side_a{a, around_a, identity};
-  const Side side_b{b, around_b, X_AB};
   for (const std::vector<std::size_t>& g : groups) {
-    patches.push_back(make_patch(pieces, g, pairs, side_a, side_b, merge, request));
+    patches.push_back(make_patch(pieces, g, pairs, request));
   }
   std::sort(patches.begin(), patches.end(), [](const ContactPatch& x, const ContactPatch& y) {
     return x.pairs.front() < y.pairs.front();

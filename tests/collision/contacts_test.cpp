@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "dovetail/collision/model.h"
-#include "dovetail/collision/pose_sampling.h"
 #include "dovetail/collision/primitives.h"
 
 namespace dovetail::collision {
@@ -254,36 +253,6 @@ TEST(Contacts, TouchingAndPenetratingAreToldApart) {
   EXPECT_EQ(sunk[0].kind, ContactKind::kCurve);
   EXPECT_NEAR(sunk[0].length, 8.0, 1e-12);
   expect_near(sunk[0].point, Vec3(0.5, -0.25, 1), 1e-12);
-}
-
-TEST(Contacts, DepthOfCurvedOverlapsIsTheOverlapAlongTheNormal) {
-  // Two unit spheres overlapping by d along x, and a unit sphere sunk d into
-  // a box's top: one patch each, penetrating, depth d (the spheres' poles are
-  // vertices on the axes, so the tessellation adds no error there).
-  const auto sphere = model(make_sphere(1.0, 3));
-  const auto box = model(make_box(Vec3(2, 2, 1)));
-  for (const Real d : {0.1, 0.5, 1.0}) {
-    const std::vector<ContactPatch> spheres =
-        compute_contacts(*sphere, *sphere, translation(2 - d, 0, 0));
-    ASSERT_EQ(spheres.size(), 1u) << d;
-    EXPECT_NEAR(spheres[0].depth, d, 1e-12) << d;
-    EXPECT_TRUE(spheres[0].penetrating);
-    EXPECT_NEAR(spheres[0].normal.x(), 1, 1e-9);
-    const std::vector<ContactPatch> sunk =
-        compute_contacts(*box, *sphere, translation(0.1, 0.2, 2 - d));
-    ASSERT_EQ(sunk.size(), 1u) << d;
-    EXPECT_NEAR(sunk[0].depth, d, 1e-12) << d;
-    EXPECT_NEAR(sunk[0].normal.z(), 1, 1e-9);
-  }
-  // Turned spheres: within the tessellation's error (the chord sag of a
-  // 5,120-triangle unit sphere, under 0.01), never wildly off.
-  for (const Transform& X : random_poses(20, 0.0, 17)) {
-    Transform turned = X;
-    turned.t = Vec3(1.7, 0, 0);
-    const std::vector<ContactPatch> patches = compute_contacts(*sphere, *sphere, turned);
-    ASSERT_EQ(patches.size(), 1u);
-    EXPECT_NEAR(patches[0].depth, 0.3, 0.01);
-  }
 }
 
 TEST(Contacts, VertexOnFaceIsAPointPatch) {

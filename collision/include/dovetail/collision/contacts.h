@@ -54,10 +54,8 @@ struct ContactPatch {
   Vec3 normal = Vec3::UnitZ();
   Real area = 0;    ///< overlap area of opposed coplanar faces (0 unless kFace)
   Real length = 0;  ///< total length of the patch's segments
-  /// Local overlap of the two parts along `normal` (0 when touching): the
-  /// deepest vertex behind the other part's patch faces, or how far both
-  /// parts reach past the patch's plane into each other, walking each mesh
-  /// from the patch, whichever is larger (docs/proximity.md, "Depth estimate").
+  /// Local overlap of the two surfaces along `normal`: how far the patch's
+  /// triangles of A reach past the patch's triangles of B (0 when touching).
   Real depth = 0;
   bool penetrating = false;  ///< depth > touching_tolerance
   ContactKind kind = ContactKind::kPoint;
