@@ -80,7 +80,7 @@ class PairTraversal {
       if (tester_.done()) return;
     }
     // Kept after a miss: parts that part briefly often meet again there, and
-    // a stale hint costs at most its subtree pair, never a second traversal.
+    // a stale hint costs at most one more search of its subtree pair.
     run();
   }
 

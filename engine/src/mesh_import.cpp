@@ -137,19 +137,34 @@ Affine node_to_root(const aiNode& node) {
 /// The file's perspective cameras in its root frame, named uniquely (`_2`,
 /// `_3`, ... for repeated names; `camera` for an empty one).
 ///
-/// Two quirks of assimp 5.2's glTF importer are undone here: it gives the
-/// field of view as yfov x aspect ratio (so the vertical one is that over
-/// the aspect ratio), and it copies the camera node's translation into the
-/// camera's own position (assimp issue 5054), although the node transform
-/// places the camera too.
+/// Assimp gives a horizontal field of view, from which the vertical one
+/// follows with the aspect ratio. Two quirks of assimp 5.2's glTF importer
+/// are undone: its "horizontal" angle is yfov x aspect ratio (so the
+/// vertical one is that over the aspect ratio), and it copies the camera
+/// node's translation into the camera's own position (assimp issue 5054),
+/// although the node transform places the camera too.
 void collect_cameras(const fs::path& path, const aiScene& scene, ImportReport& report) {
   std::string extension = path.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   const bool gltf = extension == ".gltf" || extension == ".glb";
+  // Assimp ties a camera to the node of the same name. With repeated names
+  // the k-th camera of a name takes the k-th node of that name, depth first.
+  std::map<std::string, std::vector<const aiNode*>> nodes_named;
+  std::vector<const aiNode*> stack{scene.mRootNode};
+  while (!stack.empty()) {
+    const aiNode* node = stack.back();
+    stack.pop_back();
+    nodes_named[node->mName.C_Str()].push_back(node);
+    for (unsigned k = node->mNumChildren; k > 0; --k) stack.push_back(node->mChildren[k - 1]);
+  }
+  std::map<std::string, std::size_t> taken;
   std::set<std::string> used;
   for (unsigned i = 0; i < scene.mNumCameras; ++i) {
     const aiCamera& camera = *scene.mCameras[i];
+    const std::vector<const aiNode*>& candidates = nodes_named[camera.mName.C_Str()];
+    const std::size_t nth = taken[camera.mName.C_Str()]++;
+    const aiNode* node = nth < candidates.size() ? candidates[nth] : nullptr;
     const std::string base =
         camera.mName.length > 0 ? std::string(camera.mName.C_Str()) : std::string("camera");
     std::string name = base;
@@ -162,7 +177,6 @@ void collect_cameras(const fs::path& path, const aiScene& scene, ImportReport& r
       report.notes.push_back("skipped orthographic camera '" + name + "'");
       continue;
     }
-    const aiNode* node = scene.mRootNode->FindNode(camera.mName);
     const Affine X_RN = node != nullptr ? node_to_root(*node) : Affine::Identity();
     aiVector3D position = camera.mPosition;
     if (gltf && node != nullptr) {
@@ -178,7 +192,11 @@ void collect_cameras(const fs::path& path, const aiScene& scene, ImportReport& r
     out.eye = eye;
     out.target = eye + look.normalized();
     out.up = up;
-    out.fov_y_degrees = camera.mHorizontalFOV / aspect * 180 / std::numbers::pi;
+    // assimp 5.2: the glTF importer hands over yfov x aspect; the others a
+    // true horizontal angle.
+    const double fov_y = gltf ? camera.mHorizontalFOV / aspect
+                              : 2 * std::atan(std::tan(0.5 * camera.mHorizontalFOV) / aspect);
+    out.fov_y_degrees = fov_y * 180 / std::numbers::pi;
     if (!out.eye.allFinite() || !out.target.allFinite() || !out.up.allFinite() ||
         !(out.up.squaredNorm() > 0) || !(out.fov_y_degrees > 0 && out.fov_y_degrees < 180)) {
       report.notes.push_back("skipped camera '" + name +

@@ -641,5 +641,15 @@ TEST(MeshImport, GltfCamerasArePosedByTheirNodeOnly) {
   EXPECT_NE(report.notes.back().find("orthographic camera 'flat'"), std::string::npos);
 }
 
+TEST(MeshImport, ColladaCameraKeepsItsVerticalFieldOfView) {
+  // duck_triangulate.dae declares yfov 37.8492 degrees at aspect 1.5; assimp
+  // hands over a true horizontal angle for Collada (unlike its glTF importer).
+  const fs::path duck = fs::path(DOVETAIL_ASSIMP_MODELS) / "Collada/duck_triangulate.dae";
+  const ImportReport report = import_file(duck);
+  ASSERT_EQ(report.cameras.size(), 1u);
+  EXPECT_EQ(report.cameras[0].first, "camera1");
+  EXPECT_NEAR(report.cameras[0].second.fov_y_degrees, 37.8492, 1e-3);
+}
+
 }  // namespace
 }  // namespace dovetail::engine
