@@ -5,8 +5,12 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <unordered_set>
 
+#include "dovetail/collision/containment.h"
+#include "dovetail/collision/predicates.h"
+#include "tri_distance.h"
 #include "tri_intersection.h"
 
 namespace dovetail::collision {
@@ -114,9 +118,8 @@ bool nearly_coplanar(const detail::TriangleVertices& t_a, const detail::Triangle
 /// reported pairs, pairs one triangle step apart are tried, and every pair
 /// found with an overlap of positive area spreads the search further.
 void add_nearly_coplanar_pairs(const Mesh& a, const Mesh& b, const Transform& X_AB, Real tolerance,
+                               const VertexTriangles& around_a, const VertexTriangles& around_b,
                                std::vector<TrianglePair>& pairs, std::vector<PairPiece>& pieces) {
-  const VertexTriangles around_a(a);
-  const VertexTriangles around_b(b);
   const auto key = [](std::uint32_t ta, std::uint32_t tb) {
     return (static_cast<std::uint64_t>(ta) << 32) | tb;
   };
@@ -146,6 +149,177 @@ void add_nearly_coplanar_pairs(const Mesh& a, const Mesh& b, const Transform& X_
   }
 }
 
+/// Closed segment [v, w] against closed triangle t: do they share a point?
+/// Exact signs; a segment in the triangle's plane counts as crossing.
+bool segment_meets_triangle(const Vec3& v, const Vec3& w, const detail::TriangleVertices& t) {
+  const int sv = orient3d(t[0], t[1], t[2], v);
+  const int sw = orient3d(t[0], t[1], t[2], w);
+  if (sv * sw > 0) return false;
+  if (sv == 0 && sw == 0) return true;
+  const int o0 = orient3d(v, w, t[0], t[1]);
+  const int o1 = orient3d(v, w, t[1], t[2]);
+  const int o2 = orient3d(v, w, t[2], t[0]);
+  return (o0 >= 0 && o1 >= 0 && o2 >= 0) || (o0 <= 0 && o1 <= 0 && o2 <= 0);
+}
+
+/// How deep one part ("part") reaches into the other ("other") near a
+/// patch: the largest distance to the other's surface of a vertex of the
+/// part that lies inside the other and is connected to the patch through
+/// such vertices. Everything is taken in A's frame.
+///
+/// Why this way: the inside of the other, near a patch, is bounded by the
+/// intersection curve, which runs through the patch's triangles. Walking the
+/// part's mesh along edges that do not cross the other's surface never
+/// leaves the side it started on, so one exact point-in-solid test per
+/// group of starting vertices decides a whole region, and only vertices
+/// really inside are measured (a part overhanging an edge, or a pin hanging
+/// free in a hole, adds nothing).
+class InsideReach {
+ public:
+  InsideReach(const Mesh& part, const VertexTriangles& around, const Transform& X_AP,
+              const Mesh& other, const Transform& X_AO,
+              std::vector<std::pair<std::uint32_t, std::uint32_t>> crossings)
+      : part_(part),
+        around_(around),
+        X_AP_(X_AP),
+        other_(other),
+        X_AO_(X_AO),
+        X_OA_(X_AO.inverse()),
+        crossings_(std::move(crossings)) {
+    std::sort(crossings_.begin(), crossings_.end());
+  }
+
+  /// The reach from the part's triangles `seeds` (the patch's), towards the
+  /// other's triangles `patch_other` (for a first bound). 0 when the other is
+  /// open (it has no inside).
+  Real reach(const std::vector<std::uint32_t>& seeds,
+             const std::vector<std::uint32_t>& patch_other) {
+    if (!locator_) locator_.emplace(other_);
+    if (!locator_->closed()) return 0;
+    // Starting vertices, grouped along the patch triangles' uncut edges.
+    std::vector<std::uint32_t> start;
+    for (const std::uint32_t t : seeds) {
+      for (const std::uint32_t v : part_.triangles[t]) start.push_back(v);
+    }
+    std::sort(start.begin(), start.end());
+    start.erase(std::unique(start.begin(), start.end()), start.end());
+    std::unordered_set<std::uint32_t> decided;
+    std::vector<std::uint32_t> inside;
+    for (const std::uint32_t s : start) {
+      if (decided.count(s) != 0) continue;
+      std::vector<std::uint32_t> group = walk({s}, &start);
+      decided.insert(group.begin(), group.end());
+      if (locator_->locate(X_OA_.apply(vertex(s))) != PointLocation::kOutside) {
+        for (const std::uint32_t v : walk(group, nullptr)) inside.push_back(v);
+      }
+    }
+    return deepest(inside, patch_other);
+  }
+
+ private:
+  Vec3 vertex(std::uint32_t v) const { return X_AP_.apply(part_.vertices[v]); }
+  detail::TriangleVertices other_triangle(std::uint32_t t) const {
+    const TriangleIndices& f = other_.triangles[t];
+    return {X_AO_.apply(other_.vertices[f[0]]), X_AO_.apply(other_.vertices[f[1]]),
+            X_AO_.apply(other_.vertices[f[2]])};
+  }
+
+  /// Does the edge (v, w) of the part cross the other's surface? Only the
+  /// other's triangles that meet a part triangle at this edge can.
+  bool cut(std::uint32_t v, std::uint32_t w) const {
+    const Vec3 pv = vertex(v), pw = vertex(w);
+    for (std::uint32_t k = around_.offsets[v]; k < around_.offsets[v + 1]; ++k) {
+      const std::uint32_t t = around_.triangles[k];
+      const TriangleIndices& f = part_.triangles[t];
+      if (f[0] != w && f[1] != w && f[2] != w) continue;
+      auto it = std::lower_bound(crossings_.begin(), crossings_.end(), std::pair{t, 0u});
+      for (; it != crossings_.end() && it->first == t; ++it) {
+        if (segment_meets_triangle(pv, pw, other_triangle(it->second))) return true;
+      }
+    }
+    return false;
+  }
+
+  /// The vertices reachable from `from` along uncut edges; with `within`,
+  /// only through vertices of that sorted set.
+  std::vector<std::uint32_t> walk(const std::vector<std::uint32_t>& from,
+                                  const std::vector<std::uint32_t>* within) const {
+    std::unordered_set<std::uint32_t> seen(from.begin(), from.end());
+    std::vector<std::uint32_t> stack = from, out = from;
+    while (!stack.empty()) {
+      const std::uint32_t v = stack.back();
+      stack.pop_back();
+      for (std::uint32_t k = around_.offsets[v]; k < around_.offsets[v + 1]; ++k) {
+        for (const std::uint32_t w : part_.triangles[around_.triangles[k]]) {
+          if (seen.count(w) != 0) continue;
+          if (within && !std::binary_search(within->begin(), within->end(), w)) continue;
+          if (cut(v, w)) continue;
+          seen.insert(w);
+          stack.push_back(w);
+          out.push_back(w);
+        }
+      }
+    }
+    return out;
+  }
+
+  /// Largest distance of `vertices` to the other's surface: vertices in
+  /// order of a cheap upper bound (the distance to the patch's triangles of
+  /// the other), measured exactly until no bound can beat the best.
+  Real deepest(const std::vector<std::uint32_t>& vertices,
+               const std::vector<std::uint32_t>& patch_other) {
+    if (vertices.empty()) return 0;
+    std::vector<std::pair<Real, std::uint32_t>> bounded;
+    for (const std::uint32_t v : vertices) {
+      const Vec3 p = vertex(v);
+      Real bound = std::numeric_limits<Real>::infinity();
+      for (const std::uint32_t t : patch_other) {
+        const Vec3 q = detail::closest_point_on_triangle(p, other_triangle(t));
+        bound = std::min(bound, (p - q).norm());
+      }
+      bounded.emplace_back(bound, v);
+    }
+    std::sort(bounded.begin(), bounded.end(), [](const auto& x, const auto& y) {
+      return x.first > y.first || (x.first == y.first && x.second < y.second);
+    });
+    Real best = 0;
+    for (const auto& [bound, v] : bounded) {
+      if (bound <= best) break;
+      best = std::max(best, distance_to_other(vertex(v), bound));
+    }
+    return best;
+  }
+
+  /// Distance from p to the other's surface, known to be at most `bound`.
+  Real distance_to_other(const Vec3& p, Real bound) {
+    if (boxes_.empty()) {
+      for (std::uint32_t t = 0; t < other_.triangles.size(); ++t) {
+        const detail::TriangleVertices tri = other_triangle(t);
+        boxes_.push_back(
+            {tri[0].cwiseMin(tri[1]).cwiseMin(tri[2]), tri[0].cwiseMax(tri[1]).cwiseMax(tri[2])});
+      }
+    }
+    Real best = bound;
+    for (std::uint32_t t = 0; t < other_.triangles.size(); ++t) {
+      const Vec3 outside = (boxes_[t].min - p).cwiseMax(p - boxes_[t].max).cwiseMax(0);
+      if (outside.norm() >= best) continue;
+      const Vec3 q = detail::closest_point_on_triangle(p, other_triangle(t));
+      best = std::min(best, (p - q).norm());
+    }
+    return best;
+  }
+
+  const Mesh& part_;
+  const VertexTriangles& around_;
+  const Transform& X_AP_;
+  const Mesh& other_;
+  const Transform& X_AO_;
+  const Transform X_OA_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossings_;  ///< (part tri, other tri)
+  std::optional<PointLocator> locator_;                             ///< the other's, on first need
+  std::vector<Bounds> boxes_;  ///< the other's triangles' bounds in A's frame, on first need
+};
+
 Vec3 normalized_or(const Vec3& v, Real total_weight, const Vec3& fallback) {
   const Real n = v.norm();
   return n > 1e-9 * total_weight && n > 0 ? Vec3(v / n) : fallback;
@@ -154,7 +328,8 @@ Vec3 normalized_or(const Vec3& v, Real total_weight, const Vec3& fallback) {
 /// Patch of the pieces `members` (indices into `pieces`).
 ContactPatch make_patch(const std::vector<PairPiece>& pieces,
                         const std::vector<std::size_t>& members,
-                        std::span<const TrianglePair> pairs, const ContactRequest& request) {
+                        std::span<const TrianglePair> pairs, InsideReach& b_in_a,
+                        InsideReach& a_in_b, const ContactRequest& request) {
   ContactPatch patch;
   Real area = 0;
   Real length = 0;
@@ -210,9 +385,13 @@ ContactPatch make_patch(const std::vector<PairPiece>& pieces,
     patch.normal = normalized_or(sum, count, fallback);
   }
 
-  // Depth: the deepest vertex of one triangle of a pair behind the other's
-  // face (inside the other part, projecting onto the face), over the pairs
-  // whose face turns towards the patch normal.
+  // Depth, the larger of two estimates. (1) The deepest vertex of one
+  // triangle of a pair behind the other's face (inside the other part,
+  // projecting onto the face), over the pairs whose face turns towards the
+  // patch normal: exact for flat faces pushed into flat faces, and needs no
+  // closed mesh. (2) For closed parts, the deepest vertex of either part
+  // inside the other, connected to the patch (InsideReach): the caps of
+  // curved overlaps, whose deepest vertices cross nothing.
   patch.depth = 0;
   for (std::size_t m : members) {
     const PairPiece& pp = pieces[m];
@@ -222,6 +401,19 @@ ContactPatch make_patch(const std::vector<PairPiece>& pieces,
     if (-pp.piece.n_b.dot(patch.normal) >= kFacingCosine) {
       patch.depth = std::max(patch.depth, depth_behind(pp.t_b, pp.piece.n_b, pp.t_a));
     }
+  }
+  if (patch.kind != ContactKind::kFace) {
+    std::vector<std::uint32_t> triangles_a, triangles_b;
+    for (std::size_t m : members) {
+      triangles_a.push_back(pairs[m].a);
+      triangles_b.push_back(pairs[m].b);
+    }
+    for (auto* list : {&triangles_a, &triangles_b}) {
+      std::sort(list->begin(), list->end());
+      list->erase(std::unique(list->begin(), list->end()), list->end());
+    }
+    patch.depth = std::max({patch.depth, b_in_a.reach(triangles_b, triangles_a),
+                            a_in_b.reach(triangles_a, triangles_b)});
   }
   patch.penetrating = patch.depth > request.touching_tolerance;
   return patch;
@@ -267,7 +459,9 @@ std::vector<ContactPatch> compute_contacts(const Mesh& a, const Mesh& b, const T
   const Real merge = std::max(request.merge_distance, 1e-9 * scale);
   for (PairPiece& p : pieces)
     p.piece = detail::intersect_triangles(p.t_a, p.t_b, coplanar_tolerance);
-  add_nearly_coplanar_pairs(a, b, X_AB, coplanar_tolerance, pairs, pieces);
+  const VertexTriangles around_a(a);
+  const VertexTriangles around_b(b);
+  add_nearly_coplanar_pairs(a, b, X_AB, coplanar_tolerance, around_a, around_b, pairs, pieces);
   for (PairPiece& p : pieces) {
     p.lo = p.hi = p.piece.points.front();
     for (const Vec3& x : p.piece.points) {
@@ -311,8 +505,16 @@ std::vector<ContactPatch> compute_contacts(const Mesh& a, const Mesh& b, const T
   }
   std::vector<ContactPatch> patches;
   patches.reserve(groups.size());
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> b_crossing_a, a_crossing_b;
+  for (const TrianglePair& p : pairs) {
+    b_crossing_a.emplace_back(p.b, p.a);
+    a_crossing_b.emplace_back(p.a, p.b);
+  }
+  const Transform identity;
+  InsideReach b_in_a(b, around_b, X_AB, a, identity, std::move(b_crossing_a));
+  InsideReach a_in_b(a, around_a, identity, b, X_AB, std::move(a_crossing_b));
   for (const std::vector<std::size_t>& g : groups) {
-    patches.push_back(make_patch(pieces, g, pairs, request));
+    patches.push_back(make_patch(pieces, g, pairs, b_in_a, a_in_b, request));
   }
   std::sort(patches.begin(), patches.end(), [](const ContactPatch& x, const ContactPatch& y) {
     return x.pairs.front() < y.pairs.front();

@@ -252,6 +252,15 @@ bool point_inside(const Mesh& mesh, const Vec3& p_M) {
   return locate_point(mesh, p_M) != PointLocation::kOutside;
 }
 
+PointLocator::PointLocator(const Mesh& mesh) : mesh_(mesh), closed_(is_closed(mesh)) {
+  std::tie(shell_, shell_count_) = shells(mesh);
+}
+
+PointLocation PointLocator::locate(const Vec3& p_M) const {
+  return dovetail::collision::locate(mesh_.vertices, mesh_.triangles, shell_, shell_count_, p_M)
+      .location;
+}
+
 ContainmentResult contains(const CollisionModel& outer, const CollisionModel& inner,
                            const Transform& X_outer_inner) {
   ContainmentResult result;

@@ -255,6 +255,63 @@ TEST(Contacts, TouchingAndPenetratingAreToldApart) {
   expect_near(sunk[0].point, Vec3(0.5, -0.25, 1), 1e-12);
 }
 
+/// Two closed boxes as one mesh (two shells), the second offset by `offset`.
+Mesh two_boxes(const Vec3& half_1, const Vec3& offset_1, const Vec3& half_2, const Vec3& offset_2) {
+  std::vector<Vec3> v;
+  std::vector<TriangleIndices> t;
+  for (const auto& [half, offset] : {std::pair{half_1, offset_1}, std::pair{half_2, offset_2}}) {
+    const Mesh box = make_box(half);
+    const auto base = static_cast<std::uint32_t>(v.size());
+    for (const Vec3& p : box.vertices) v.push_back(p + offset);
+    for (const TriangleIndices& f : box.triangles)
+      t.push_back({f[0] + base, f[1] + base, f[2] + base});
+  }
+  return make_mesh(std::move(v), std::move(t), "two boxes");
+}
+
+TEST(Contacts, DepthOfCurvedAndShallowOverlaps) {
+  // Curved overlaps, whose deepest vertices belong to triangles that cross
+  // nothing: the deepest vertex inside the other part counts.
+  const auto sphere = model(make_sphere(1.0, 3));
+  const auto box = model(make_box(Vec3(2, 2, 1)));
+  for (const Real d : {0.1, 0.5, 1.0}) {
+    const std::vector<ContactPatch> spheres =
+        compute_contacts(*sphere, *sphere, translation(2 - d, 0, 0));
+    ASSERT_EQ(spheres.size(), 1u) << d;
+    // The pole's distance to the other's faceted surface: just under d.
+    EXPECT_LE(spheres[0].depth, d + 1e-12) << d;
+    EXPECT_GE(spheres[0].depth, 0.99 * d) << d;
+    const std::vector<ContactPatch> sunk =
+        compute_contacts(*box, *sphere, translation(0.1, 0.2, 2 - d));
+    ASSERT_EQ(sunk.size(), 1u) << d;
+    EXPECT_NEAR(sunk[0].depth, d, 1e-12) << d;
+  }
+  // Shallow overlaps with parts of a mesh past the contact that are not
+  // inside the other part, which must not count: a box sunk 0.01 while
+  // overhanging an edge (a tilted patch normal); a T pressed 0.01 into a
+  // housing with its pin hanging free in the hole; a sphere of radius 1.05
+  // in the square hole of half-width 1 (0.05 into each wall).
+  const std::vector<ContactPatch> overhang =
+      compute_contacts(*box, *model(make_box(Vec3(1, 1, 0.5))), translation(1.5, 0, 1.49));
+  ASSERT_EQ(overhang.size(), 1u);
+  EXPECT_NEAR(overhang[0].depth, 0.01, 1e-12);
+  const auto housing = model(housing_with_square_hole());
+  const auto tee =
+      model(two_boxes(Vec3(1.5, 1.5, 0.1), Vec3(0, 0, 1.09), Vec3(0.5, 0.5, 0.6), Vec3(0, 0, 0.6)));
+  const std::vector<ContactPatch> pressed = compute_contacts(*housing, *tee, Transform());
+  ASSERT_FALSE(pressed.empty());
+  for (const ContactPatch& p : pressed) EXPECT_NEAR(p.depth, 0.01, 1e-12);
+  const std::vector<ContactPatch> seated =
+      compute_contacts(*housing, *model(make_sphere(1.05, 3)), translation(0, 0, 0.5));
+  ASSERT_EQ(seated.size(), 4u);
+  for (const ContactPatch& p : seated) EXPECT_NEAR(p.depth, 0.05, 1e-9);
+  // Exactly touching stays at 0.
+  const std::vector<ContactPatch> resting =
+      compute_contacts(*box, *model(make_box(Vec3(0.5, 0.5, 0.5))), translation(0, 0, 1.5));
+  ASSERT_EQ(resting.size(), 1u);
+  EXPECT_EQ(resting[0].depth, 0);
+}
+
 TEST(Contacts, VertexOnFaceIsAPointPatch) {
   // An octahedron standing on one vertex on A's top face.
   std::vector<Vec3> v = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};

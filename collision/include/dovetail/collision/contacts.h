@@ -54,8 +54,11 @@ struct ContactPatch {
   Vec3 normal = Vec3::UnitZ();
   Real area = 0;    ///< overlap area of opposed coplanar faces (0 unless kFace)
   Real length = 0;  ///< total length of the patch's segments
-  /// Local overlap of the two surfaces along `normal`: how far the patch's
-  /// triangles of A reach past the patch's triangles of B (0 when touching).
+  /// Local penetration estimate (0 when touching): the deepest vertex of a
+  /// patch triangle behind the other's patch face, or, for closed parts, the
+  /// deepest vertex of either part inside the other in a region connected to
+  /// the patch, measured to the other's surface (docs/proximity.md, "Depth
+  /// estimate").
   Real depth = 0;
   bool penetrating = false;  ///< depth > touching_tolerance
   ContactKind kind = ContactKind::kPoint;

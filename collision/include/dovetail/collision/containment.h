@@ -10,6 +10,8 @@
 /// "Containment".
 
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "dovetail/collision/mesh.h"
 #include "dovetail/collision/model.h"
@@ -41,6 +43,23 @@ PointLocation locate_point(const Mesh& mesh, const Vec3& p_M);
 
 /// locate_point(mesh, p_M) != kOutside: the closed solid contains the point.
 bool point_inside(const Mesh& mesh, const Vec3& p_M);
+
+/// locate_point for many points against one mesh: the mesh's closedness and
+/// shells are found once, in the constructor. `mesh` must outlive it.
+class PointLocator {
+ public:
+  explicit PointLocator(const Mesh& mesh);
+  /// is_closed(mesh).
+  bool closed() const { return closed_; }
+  /// locate_point(mesh, p_M).
+  PointLocation locate(const Vec3& p_M) const;
+
+ private:
+  const Mesh& mesh_;
+  bool closed_ = false;
+  std::vector<std::uint32_t> shell_;  ///< shell of each triangle
+  std::size_t shell_count_ = 0;
+};
 
 /// Three-valued answer: an open mesh has no inside.
 enum class Inside { kNo, kYes, kUnknown };
