@@ -6,6 +6,7 @@
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "dovetail/collision/containment.h"
@@ -162,18 +163,114 @@ bool segment_meets_triangle(const Vec3& v, const Vec3& w, const detail::Triangle
   return (o0 >= 0 && o1 >= 0 && o2 >= 0) || (o0 <= 0 && o1 <= 0 && o2 <= 0);
 }
 
-/// How deep one part ("part") reaches into the other ("other") near a
-/// patch: the largest distance to the other's surface of a vertex of the
-/// part that lies inside the other and is connected to the patch through
-/// such vertices. Everything is taken in A's frame.
+/// Nearest distance from a point to a set of triangles (all in one frame),
+/// through a bounding-box tree built once: median splits, four triangles a leaf.
+class TriangleDistanceTree {
+ public:
+  explicit TriangleDistanceTree(std::vector<detail::TriangleVertices> triangles)
+      : triangles_(std::move(triangles)), order_(triangles_.size()) {
+    std::iota(order_.begin(), order_.end(), std::uint32_t{0});
+    centroids_.reserve(triangles_.size());
+    for (const detail::TriangleVertices& t : triangles_)
+      centroids_.push_back((t[0] + t[1] + t[2]) / 3.0);
+    if (!triangles_.empty()) build(0, static_cast<std::uint32_t>(order_.size()));
+  }
+
+  /// Distance from p to the nearest triangle.
+  Real nearest(const Vec3& p) const {
+    Real best = std::numeric_limits<Real>::infinity();
+    if (nodes_.empty()) return best;
+    std::vector<std::uint32_t> stack{0};
+    while (!stack.empty()) {
+      const Node& node = nodes_[stack.back()];
+      stack.pop_back();
+      if (box_distance(node, p) >= best) continue;
+      if (node.right == 0) {
+        for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+          const detail::TriangleVertices& t = triangles_[order_[k]];
+          best = std::min(best, (p - detail::closest_point_on_triangle(p, t)).norm());
+        }
+        continue;
+      }
+      // The nearer child pushed last, so it is searched first.
+      const std::uint32_t left = node.first, right = node.right;
+      const bool right_nearer = box_distance(nodes_[left], p) > box_distance(nodes_[right], p);
+      stack.push_back(right_nearer ? left : right);
+      stack.push_back(right_nearer ? right : left);
+    }
+    return best;
+  }
+
+ private:
+  struct Node {
+    Vec3 lo, hi;
+    std::uint32_t first = 0;  ///< leaf: first slot; inner: left child
+    std::uint32_t count = 0;  ///< leaf: triangles
+    std::uint32_t right = 0;  ///< inner: right child; 0 for a leaf
+  };
+
+  static Real box_distance(const Node& node, const Vec3& p) {
+    return (node.lo - p).cwiseMax(p - node.hi).cwiseMax(0).norm();
+  }
+
+  std::uint32_t build(std::uint32_t begin, std::uint32_t end) {
+    const auto index = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.emplace_back();
+    Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity()), hi = -lo;
+    Vec3 c_lo = lo, c_hi = hi;
+    for (std::uint32_t k = begin; k < end; ++k) {
+      for (const Vec3& v : triangles_[order_[k]]) {
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+      }
+      const Vec3 c = centroid(order_[k]);
+      c_lo = c_lo.cwiseMin(c);
+      c_hi = c_hi.cwiseMax(c);
+    }
+    nodes_[index].lo = lo;
+    nodes_[index].hi = hi;
+    if (end - begin <= 4) {
+      nodes_[index].first = begin;
+      nodes_[index].count = end - begin;
+      return index;
+    }
+    int axis = 0;
+    (c_hi - c_lo).maxCoeff(&axis);
+    const std::uint32_t mid = begin + (end - begin) / 2;
+    std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+                     [&](std::uint32_t x, std::uint32_t y) {
+                       const Real cx = centroid(x)[axis], cy = centroid(y)[axis];
+                       return cx < cy || (cx == cy && x < y);
+                     });
+    const std::uint32_t left = build(begin, mid);
+    const std::uint32_t right = build(mid, end);
+    nodes_[index].first = left;
+    nodes_[index].right = right;
+    return index;
+  }
+
+  const Vec3& centroid(std::uint32_t t) const { return centroids_[t]; }
+
+  std::vector<detail::TriangleVertices> triangles_;
+  std::vector<Vec3> centroids_;
+  std::vector<std::uint32_t> order_;
+  std::vector<Node> nodes_;
+};
+
+/// How deep one part ("part") reaches into the other ("other"): for the
+/// regions of the part's surface inside the other, the largest distance of
+/// a vertex to the other's surface. Everything is taken in A's frame, B's
+/// vertices mapped by the same Transform::apply as the collision query.
 ///
-/// Why this way: the inside of the other, near a patch, is bounded by the
-/// intersection curve, which runs through the patch's triangles. Walking the
+/// Why this way: the part's surface is cut into regions by the intersection
+/// curves, which run through the intersecting triangle pairs. Walking the
 /// part's mesh along edges that do not cross the other's surface never
-/// leaves the side it started on, so one exact point-in-solid test per
-/// group of starting vertices decides a whole region, and only vertices
-/// really inside are measured (a part overhanging an edge, or a pin hanging
-/// free in a hole, adds nothing).
+/// leaves a region, so one exact point-in-solid test decides a whole region,
+/// and only vertices really inside are measured (a part overhanging an edge,
+/// or a pin hanging free in a hole, adds nothing). Regions are labelled once
+/// per call and shared by every patch that touches them. This relies on the
+/// pairs being all intersecting pairs: a region whose deepest vertex is not
+/// inside after all (missing pairs let a walk cross the surface) counts 0.
 class InsideReach {
  public:
   InsideReach(const Mesh& part, const VertexTriangles& around, const Transform& X_AP,
@@ -184,36 +281,28 @@ class InsideReach {
         X_AP_(X_AP),
         other_(other),
         X_AO_(X_AO),
-        X_OA_(X_AO.inverse()),
         crossings_(std::move(crossings)) {
     std::sort(crossings_.begin(), crossings_.end());
   }
 
-  /// The reach from the part's triangles `seeds` (the patch's), towards the
-  /// other's triangles `patch_other` (for a first bound). 0 when the other is
-  /// open (it has no inside).
-  Real reach(const std::vector<std::uint32_t>& seeds,
-             const std::vector<std::uint32_t>& patch_other) {
-    if (!locator_) locator_.emplace(other_);
-    if (!locator_->closed()) return 0;
-    // Starting vertices, grouped along the patch triangles' uncut edges.
+  /// The deepest reach of the inside regions that the part's triangles
+  /// `seeds` (a patch's) touch; nullopt when the other is open (it has no
+  /// inside).
+  std::optional<Real> reach(const std::vector<std::uint32_t>& seeds) {
+    if (!locator_) locator_.emplace(other_, X_AO_);
+    if (!locator_->closed()) return std::nullopt;
     std::vector<std::uint32_t> start;
     for (const std::uint32_t t : seeds) {
       for (const std::uint32_t v : part_.triangles[t]) start.push_back(v);
     }
     std::sort(start.begin(), start.end());
     start.erase(std::unique(start.begin(), start.end()), start.end());
-    std::unordered_set<std::uint32_t> decided;
-    std::vector<std::uint32_t> inside;
-    for (const std::uint32_t s : start) {
-      if (decided.count(s) != 0) continue;
-      std::vector<std::uint32_t> group = walk({s}, &start);
-      decided.insert(group.begin(), group.end());
-      if (locator_->locate(X_OA_.apply(vertex(s))) != PointLocation::kOutside) {
-        for (const std::uint32_t v : walk(group, nullptr)) inside.push_back(v);
-      }
+    Real deepest = 0;
+    for (const std::uint32_t v : start) {
+      if (!label_.contains(v)) label_group(v, start);
+      deepest = std::max(deepest, regions_[label_.at(v)]);
     }
-    return deepest(inside, patch_other);
+    return deepest;
   }
 
  private:
@@ -240,73 +329,65 @@ class InsideReach {
     return false;
   }
 
-  /// The vertices reachable from `from` along uncut edges; with `within`,
-  /// only through vertices of that sorted set.
-  std::vector<std::uint32_t> walk(const std::vector<std::uint32_t>& from,
-                                  const std::vector<std::uint32_t>* within) const {
-    std::unordered_set<std::uint32_t> seen(from.begin(), from.end());
-    std::vector<std::uint32_t> stack = from, out = from;
+  /// The vertices reachable from `from` along uncut edges that had no label,
+  /// with `within` (sorted) only through its vertices; labelled `region`.
+  std::vector<std::uint32_t> walk(std::vector<std::uint32_t> from, std::uint32_t region,
+                                  const std::vector<std::uint32_t>* within) {
+    // `from` may be labelled already (a group walked again without `within`).
+    std::vector<std::uint32_t> members;
+    for (const std::uint32_t v : from) {
+      if (label_.emplace(v, region).second) members.push_back(v);
+    }
+    std::vector<std::uint32_t> stack = std::move(from);
     while (!stack.empty()) {
       const std::uint32_t v = stack.back();
       stack.pop_back();
       for (std::uint32_t k = around_.offsets[v]; k < around_.offsets[v + 1]; ++k) {
         for (const std::uint32_t w : part_.triangles[around_.triangles[k]]) {
-          if (seen.count(w) != 0) continue;
+          if (label_.contains(w)) continue;
           if (within && !std::binary_search(within->begin(), within->end(), w)) continue;
           if (cut(v, w)) continue;
-          seen.insert(w);
+          label_.emplace(w, region);
+          members.push_back(w);
           stack.push_back(w);
-          out.push_back(w);
         }
       }
     }
-    return out;
+    return members;
   }
 
-  /// Largest distance of `vertices` to the other's surface: vertices in
-  /// order of a cheap upper bound (the distance to the patch's triangles of
-  /// the other), measured exactly until no bound can beat the best.
-  Real deepest(const std::vector<std::uint32_t>& vertices,
-               const std::vector<std::uint32_t>& patch_other) {
-    if (vertices.empty()) return 0;
-    std::vector<std::pair<Real, std::uint32_t>> bounded;
-    for (const std::uint32_t v : vertices) {
-      const Vec3 p = vertex(v);
-      Real bound = std::numeric_limits<Real>::infinity();
-      for (const std::uint32_t t : patch_other) {
-        const Vec3 q = detail::closest_point_on_triangle(p, other_triangle(t));
-        bound = std::min(bound, (p - q).norm());
-      }
-      bounded.emplace_back(bound, v);
-    }
-    std::sort(bounded.begin(), bounded.end(), [](const auto& x, const auto& y) {
-      return x.first > y.first || (x.first == y.first && x.second < y.second);
-    });
-    Real best = 0;
-    for (const auto& [bound, v] : bounded) {
-      if (bound <= best) break;
-      best = std::max(best, distance_to_other(vertex(v), bound));
-    }
-    return best;
-  }
-
-  /// Distance from p to the other's surface, known to be at most `bound`.
-  Real distance_to_other(const Vec3& p, Real bound) {
-    if (boxes_.empty()) {
+  /// Labels the group of patch vertices around `start` (joined along uncut
+  /// edges among `start_set`), decides it with one point-in-solid test, and,
+  /// when it is inside, walks and measures its whole region. An outside
+  /// group is not walked further: the rest of the part may be large.
+  void label_group(std::uint32_t start, const std::vector<std::uint32_t>& start_set) {
+    const auto region = static_cast<std::uint32_t>(regions_.size());
+    regions_.push_back(0);
+    std::vector<std::uint32_t> group = walk({start}, region, &start_set);
+    if (locator_->locate(vertex(start)) == PointLocation::kOutside) return;
+    // Inside: the rest of the region, then its deepest vertex.
+    for (const std::uint32_t v : walk(group, region, nullptr)) group.push_back(v);
+    if (!tree_) {
+      std::vector<detail::TriangleVertices> triangles;
+      triangles.reserve(other_.triangles.size());
       for (std::uint32_t t = 0; t < other_.triangles.size(); ++t) {
-        const detail::TriangleVertices tri = other_triangle(t);
-        boxes_.push_back(
-            {tri[0].cwiseMin(tri[1]).cwiseMin(tri[2]), tri[0].cwiseMax(tri[1]).cwiseMax(tri[2])});
+        triangles.push_back(other_triangle(t));
+      }
+      tree_.emplace(std::move(triangles));
+    }
+    Real reach = 0;
+    std::uint32_t deepest_vertex = start;
+    for (const std::uint32_t v : group) {
+      const Real d = tree_->nearest(vertex(v));
+      if (d > reach) {
+        reach = d;
+        deepest_vertex = v;
       }
     }
-    Real best = bound;
-    for (std::uint32_t t = 0; t < other_.triangles.size(); ++t) {
-      const Vec3 outside = (boxes_[t].min - p).cwiseMax(p - boxes_[t].max).cwiseMax(0);
-      if (outside.norm() >= best) continue;
-      const Vec3 q = detail::closest_point_on_triangle(p, other_triangle(t));
-      best = std::min(best, (p - q).norm());
-    }
-    return best;
+    // A consistency check that costs one more test: a walk that crossed
+    // the surface through a pair missing from the input measured outside.
+    if (locator_->locate(vertex(deepest_vertex)) == PointLocation::kOutside) reach = 0;
+    regions_[region] = reach;
   }
 
   const Mesh& part_;
@@ -314,10 +395,11 @@ class InsideReach {
   const Transform& X_AP_;
   const Mesh& other_;
   const Transform& X_AO_;
-  const Transform X_OA_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> crossings_;  ///< (part tri, other tri)
-  std::optional<PointLocator> locator_;                             ///< the other's, on first need
-  std::vector<Bounds> boxes_;  ///< the other's triangles' bounds in A's frame, on first need
+  std::optional<PointLocator> locator_;       ///< the other's, in A's frame, on first need
+  std::optional<TriangleDistanceTree> tree_;  ///< the other's triangles, on first need
+  std::unordered_map<std::uint32_t, std::uint32_t> label_;  ///< vertex -> region
+  std::vector<Real> regions_;                               ///< reach of each region
 };
 
 Vec3 normalized_or(const Vec3& v, Real total_weight, const Vec3& fallback) {
@@ -385,36 +467,40 @@ ContactPatch make_patch(const std::vector<PairPiece>& pieces,
     patch.normal = normalized_or(sum, count, fallback);
   }
 
-  // Depth, the larger of two estimates. (1) The deepest vertex of one
-  // triangle of a pair behind the other's face (inside the other part,
-  // projecting onto the face), over the pairs whose face turns towards the
-  // patch normal: exact for flat faces pushed into flat faces, and needs no
-  // closed mesh. (2) For closed parts, the deepest vertex of either part
-  // inside the other, connected to the patch (InsideReach): the caps of
-  // curved overlaps, whose deepest vertices cross nothing.
-  patch.depth = 0;
+  // Depth: how deep B reaches into A and A into B, the larger. Into a
+  // closed part: the deepest vertex of the other inside it, in a region
+  // connected to the patch (InsideReach), measured to its surface; this sees
+  // the caps of curved overlaps, whose deepest vertices cross nothing. Into
+  // an open part (no inside): the deepest vertex of a patch triangle behind
+  // its patch face (projecting onto the face), over the pairs whose face
+  // turns towards the patch normal: exact for flat faces pushed into flat
+  // faces, but blind to caps and, through a thin wall, to the far side.
+  std::vector<std::uint32_t> triangles_a, triangles_b;
   for (std::size_t m : members) {
-    const PairPiece& pp = pieces[m];
-    if (pp.piece.n_a.dot(patch.normal) >= kFacingCosine) {
-      patch.depth = std::max(patch.depth, depth_behind(pp.t_a, pp.piece.n_a, pp.t_b));
-    }
-    if (-pp.piece.n_b.dot(patch.normal) >= kFacingCosine) {
-      patch.depth = std::max(patch.depth, depth_behind(pp.t_b, pp.piece.n_b, pp.t_a));
-    }
+    triangles_a.push_back(pairs[m].a);
+    triangles_b.push_back(pairs[m].b);
   }
-  if (patch.kind != ContactKind::kFace) {
-    std::vector<std::uint32_t> triangles_a, triangles_b;
+  for (auto* list : {&triangles_a, &triangles_b}) {
+    std::sort(list->begin(), list->end());
+    list->erase(std::unique(list->begin(), list->end()), list->end());
+  }
+  const auto behind_faces = [&](bool b_behind_a) {
+    Real depth = 0;
     for (std::size_t m : members) {
-      triangles_a.push_back(pairs[m].a);
-      triangles_b.push_back(pairs[m].b);
+      const PairPiece& pp = pieces[m];
+      if (b_behind_a && pp.piece.n_a.dot(patch.normal) >= kFacingCosine) {
+        depth = std::max(depth, depth_behind(pp.t_a, pp.piece.n_a, pp.t_b));
+      }
+      if (!b_behind_a && -pp.piece.n_b.dot(patch.normal) >= kFacingCosine) {
+        depth = std::max(depth, depth_behind(pp.t_b, pp.piece.n_b, pp.t_a));
+      }
     }
-    for (auto* list : {&triangles_a, &triangles_b}) {
-      std::sort(list->begin(), list->end());
-      list->erase(std::unique(list->begin(), list->end()), list->end());
-    }
-    patch.depth = std::max({patch.depth, b_in_a.reach(triangles_b, triangles_a),
-                            a_in_b.reach(triangles_a, triangles_b)});
-  }
+    return depth;
+  };
+  const std::optional<Real> b_into_a = b_in_a.reach(triangles_b);
+  const std::optional<Real> a_into_b = a_in_b.reach(triangles_a);
+  patch.depth = std::max(b_into_a ? *b_into_a : behind_faces(true),
+                         a_into_b ? *a_into_b : behind_faces(false));
   patch.penetrating = patch.depth > request.touching_tolerance;
   return patch;
 }

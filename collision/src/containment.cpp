@@ -252,12 +252,19 @@ bool point_inside(const Mesh& mesh, const Vec3& p_M) {
   return locate_point(mesh, p_M) != PointLocation::kOutside;
 }
 
-PointLocator::PointLocator(const Mesh& mesh) : mesh_(mesh), closed_(is_closed(mesh)) {
-  std::tie(shell_, shell_count_) = shells(mesh);
+PointLocator::PointLocator(const Mesh& mesh, const Transform& X_FM)
+    : mesh_(mesh), closed_(is_closed(mesh)) {
+  vertices_F_.reserve(mesh.vertices.size());
+  for (const Vec3& v : mesh.vertices) vertices_F_.push_back(X_FM.apply(v));
+  // Inside or outside is the parity over all triangles; which shell a
+  // crossing belongs to matters only for "enclosed by a shell", which a
+  // location does not report, so every triangle counts as one shell.
+  shell_.assign(mesh.triangles.size(), 0);
+  shell_count_ = 1;
 }
 
-PointLocation PointLocator::locate(const Vec3& p_M) const {
-  return dovetail::collision::locate(mesh_.vertices, mesh_.triangles, shell_, shell_count_, p_M)
+PointLocation PointLocator::locate(const Vec3& p_F) const {
+  return dovetail::collision::locate(vertices_F_, mesh_.triangles, shell_, shell_count_, p_F)
       .location;
 }
 

@@ -3,12 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numbers>
+#include <random>
 #include <vector>
 
+#include "dovetail/collision/containment.h"
 #include "dovetail/collision/model.h"
 #include "dovetail/collision/primitives.h"
+#include "tri_distance.h"
 
 namespace dovetail::collision {
 namespace {
@@ -310,6 +314,75 @@ TEST(Contacts, DepthOfCurvedAndShallowOverlaps) {
       compute_contacts(*box, *model(make_box(Vec3(0.5, 0.5, 0.5))), translation(0, 0, 1.5));
   ASSERT_EQ(resting.size(), 1u);
   EXPECT_EQ(resting[0].depth, 0);
+}
+
+/// Independent reference for the depth of closed parts: the largest distance
+/// to the other's surface of a vertex of either part inside the other
+/// (every vertex tested, every triangle measured), in A's frame.
+Real deepest_vertex_inside(const Mesh& a, const Mesh& b, const Transform& X_AB) {
+  const auto one_way = [](const Mesh& part, const Transform& X_AP, const Mesh& other,
+                          const Transform& X_AO) {
+    std::vector<Vec3> other_A;
+    for (const Vec3& v : other.vertices) other_A.push_back(X_AO.apply(v));
+    const Mesh placed = make_mesh(other_A, other.triangles, "placed");
+    Real best = 0;
+    for (const Vec3& v : part.vertices) {
+      const Vec3 p = X_AP.apply(v);
+      if (!point_inside(placed, p)) continue;
+      Real nearest = std::numeric_limits<Real>::infinity();
+      for (const TriangleIndices& f : placed.triangles) {
+        const detail::TriangleVertices t{placed.vertices[f[0]], placed.vertices[f[1]],
+                                         placed.vertices[f[2]]};
+        nearest = std::min(nearest, (p - detail::closest_point_on_triangle(p, t)).norm());
+      }
+      best = std::max(best, nearest);
+    }
+    return best;
+  };
+  return std::max(one_way(b, X_AB, a, Transform()), one_way(a, Transform(), b, X_AB));
+}
+
+TEST(Contacts, DepthEqualsTheDeepestVertexInsideOnTurnedBoxes) {
+  // A unit box at random rotations with one corner on a slab's top face and
+  // the lowest corner inside, the others out or nearly on the face: the
+  // depth must be the independent reference's (a corner within rounding of
+  // the face once read as the whole box's height).
+  const Mesh box = make_box(Vec3(0.5, 0.5, 0.5));
+  const Mesh slab = make_box(Vec3(5, 5, 0.5));
+  const auto box_model = model(box), slab_model = model(slab);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  int compared = 0;
+  for (int i = 0; i < 150; ++i) {
+    Transform X_AB;  // the slab in the box's frame
+    const Vec3 axis = Vec3(u(rng), u(rng), u(rng)).normalized();
+    X_AB.R = Eigen::AngleAxisd(std::numbers::pi * u(rng), axis).toRotationMatrix();
+    std::vector<std::pair<Real, int>> heights;  // the box's corners over the slab
+    for (int k = 0; k < 8; ++k) heights.push_back({(X_AB.R.transpose() * box.vertices[k]).z(), k});
+    std::sort(heights.begin(), heights.end());
+    X_AB.t = box.vertices[heights[1].second] - X_AB.R * Vec3(0.1 * u(rng), 0.1 * u(rng), 0.5);
+    const std::vector<ContactPatch> patches = compute_contacts(*box_model, *slab_model, X_AB);
+    if (patches.empty()) continue;
+    Real depth = 0;
+    for (const ContactPatch& p : patches) depth = std::max(depth, p.depth);
+    EXPECT_NEAR(depth, deepest_vertex_inside(box, slab, X_AB), 1e-9) << "case " << i;
+    ++compared;
+  }
+  EXPECT_GT(compared, 100);
+  // A corner one ulp below the other's face: the same depth both ways round.
+  const Real face = -0.5 + 0.7;
+  Mesh tetra = make_mesh({Vec3(0, 0, std::nextafter(face, -1.0)), Vec3(0.5, 0, 0.21),
+                          Vec3(-0.5, 0.5, -0.8), Vec3(-0.5, -0.5, -0.8)},
+                         {{0, 2, 1}, {0, 3, 2}, {0, 1, 3}, {1, 2, 3}}, "tetra");
+  ASSERT_TRUE(is_closed(tetra));
+  const auto t_model = model(tetra);
+  const auto top = model(make_box(Vec3(2, 2, 0.5)));
+  const std::vector<ContactPatch> one = compute_contacts(*t_model, *top, translation(0, 0, 0.7));
+  const std::vector<ContactPatch> other = compute_contacts(*top, *t_model, translation(0, 0, -0.7));
+  ASSERT_EQ(one.size(), 1u);
+  ASSERT_EQ(other.size(), 1u);
+  EXPECT_NEAR(one[0].depth, 0.01, 1e-12);
+  EXPECT_NEAR(other[0].depth, 0.01, 1e-12);
 }
 
 TEST(Contacts, VertexOnFaceIsAPointPatch) {

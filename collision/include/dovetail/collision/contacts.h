@@ -54,11 +54,11 @@ struct ContactPatch {
   Vec3 normal = Vec3::UnitZ();
   Real area = 0;    ///< overlap area of opposed coplanar faces (0 unless kFace)
   Real length = 0;  ///< total length of the patch's segments
-  /// Local penetration estimate (0 when touching): the deepest vertex of a
-  /// patch triangle behind the other's patch face, or, for closed parts, the
-  /// deepest vertex of either part inside the other in a region connected to
-  /// the patch, measured to the other's surface (docs/proximity.md, "Depth
-  /// estimate").
+  /// Local penetration estimate (0 when touching): how deep either part
+  /// reaches into the other near the patch. Into a closed part: the deepest
+  /// vertex of the other inside it, in a region connected to the patch,
+  /// measured to its surface; into an open part: the deepest vertex behind
+  /// its patch faces (docs/proximity.md, "Depth estimate").
   Real depth = 0;
   bool penetrating = false;  ///< depth > touching_tolerance
   ContactKind kind = ContactKind::kPoint;
@@ -69,8 +69,9 @@ struct ContactPatch {
 };
 
 /// Contact patches of meshes `a` and `b`, B at pose X_AB in A's frame, from
-/// their intersecting triangle pairs (as CollisionModel::collide with
-/// all_pairs reports them; any order, duplicates ignored). Patches are
+/// their intersecting triangle pairs: all of them, as CollisionModel::collide
+/// with all_pairs reports them (any order, duplicates ignored); the depth
+/// estimate relies on the list being complete. Patches are
 /// ordered by their smallest pair, so the result is deterministic. Empty
 /// when `pairs` is.
 std::vector<ContactPatch> compute_contacts(const Mesh& a, const Mesh& b, const Transform& X_AB,

@@ -44,20 +44,24 @@ PointLocation locate_point(const Mesh& mesh, const Vec3& p_M);
 /// locate_point(mesh, p_M) != kOutside: the closed solid contains the point.
 bool point_inside(const Mesh& mesh, const Vec3& p_M);
 
-/// locate_point for many points against one mesh: the mesh's closedness and
-/// shells are found once, in the constructor. `mesh` must outlive it.
+/// locate_point for many points against one mesh: the mesh's closedness is
+/// found once, in the constructor. The mesh is placed in a frame
+/// F by X_FM (its vertices mapped by X_FM.apply, as the collision query maps
+/// B's), and points are given in F, so a point and the surface it is tested
+/// against are rounded the same way the collision query rounded them.
 class PointLocator {
  public:
-  explicit PointLocator(const Mesh& mesh);
+  explicit PointLocator(const Mesh& mesh, const Transform& X_FM = {});
   /// is_closed(mesh).
   bool closed() const { return closed_; }
-  /// locate_point(mesh, p_M).
-  PointLocation locate(const Vec3& p_M) const;
+  /// Where p_F lies against the placed mesh (locate_point in frame F).
+  PointLocation locate(const Vec3& p_F) const;
 
  private:
   const Mesh& mesh_;
+  std::vector<Vec3> vertices_F_;
   bool closed_ = false;
-  std::vector<std::uint32_t> shell_;  ///< shell of each triangle
+  std::vector<std::uint32_t> shell_;  ///< all 0: a location needs no shells
   std::size_t shell_count_ = 0;
 };
 
