@@ -12,6 +12,7 @@
 #include "dovetail/collision/task_system.h"
 #include "dovetail/collision/tri_tri.h"
 #include "hierarchy_common.h"
+#include "vertex_triangles.h"
 
 namespace dovetail::collision {
 
@@ -27,27 +28,10 @@ struct Shape {
   bool hull_failed = false;                ///< flat part: no hull, conservative boxes
   Vec3 local_min, local_max;               ///< bounds in the part's frame
   Real max_abs = 0;
-  /// Triangles around each vertex (compressed): those of vertex v are
-  /// vertex_triangles[vertex_offsets[v] .. vertex_offsets[v + 1]). Built with
-  /// the model; used to follow a moving contact from one triangle to the next.
-  std::vector<std::uint32_t> vertex_offsets, vertex_triangles;
+  /// Triangles around each vertex. Built with the model in pairs mode; used
+  /// to follow a moving contact from one triangle to the next.
+  detail::VertexTriangles around;
 };
-
-/// Fills the vertex-to-triangle table of a shape.
-void build_vertex_triangles(Shape& shape) {
-  const Mesh& mesh = *shape.mesh;
-  shape.vertex_offsets.assign(mesh.vertices.size() + 1, 0);
-  for (const TriangleIndices& t : mesh.triangles) {
-    for (std::uint32_t v : t) ++shape.vertex_offsets[v + 1];
-  }
-  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
-    shape.vertex_offsets[v + 1] += shape.vertex_offsets[v];
-  shape.vertex_triangles.resize(shape.vertex_offsets.back());
-  std::vector<std::uint32_t> fill(shape.vertex_offsets.begin(), shape.vertex_offsets.end() - 1);
-  for (std::uint32_t i = 0; i < mesh.triangles.size(); ++i) {
-    for (std::uint32_t v : mesh.triangles[i]) shape.vertex_triangles[fill[v]++] = i;
-  }
-}
 
 struct Part {
   PartId id;
@@ -156,7 +140,8 @@ struct CollisionWorld::Impl {
   void ensure_model(Shape& shape) {
     if (shape.model) return;
     shape.model = build_model(settings.method, shape.mesh);
-    if (settings.contacts == ContactDetail::kPairs) build_vertex_triangles(shape);
+    if (settings.contacts == ContactDetail::kPairs)
+      shape.around = detail::VertexTriangles(*shape.mesh);
   }
 
   /// The part's world box: extremal hull vertices found by walking from last
@@ -282,16 +267,16 @@ struct CollisionWorld::Impl {
     if (pair_intersects(*a.mesh, *b.mesh, X_AB, witness)) return true;
     const TrianglePair last = witness;
     for (std::uint32_t v : a.mesh->triangles[last.a]) {
-      for (std::uint32_t k = a.vertex_offsets[v]; k < a.vertex_offsets[v + 1]; ++k) {
-        const TrianglePair candidate{a.vertex_triangles[k], last.b};
+      for (std::uint32_t k = a.around.offsets[v]; k < a.around.offsets[v + 1]; ++k) {
+        const TrianglePair candidate{a.around.triangles[k], last.b};
         if (candidate.a == last.a) continue;
         ++tests;
         if (pair_intersects(*a.mesh, *b.mesh, X_AB, candidate)) return witness = candidate, true;
       }
     }
     for (std::uint32_t v : b.mesh->triangles[last.b]) {
-      for (std::uint32_t k = b.vertex_offsets[v]; k < b.vertex_offsets[v + 1]; ++k) {
-        const TrianglePair candidate{last.a, b.vertex_triangles[k]};
+      for (std::uint32_t k = b.around.offsets[v]; k < b.around.offsets[v + 1]; ++k) {
+        const TrianglePair candidate{last.a, b.around.triangles[k]};
         if (candidate.b == last.b) continue;
         ++tests;
         if (pair_intersects(*a.mesh, *b.mesh, X_AB, candidate)) return witness = candidate, true;

@@ -13,10 +13,13 @@
 #include "dovetail/collision/predicates.h"
 #include "tri_distance.h"
 #include "tri_intersection.h"
+#include "vertex_triangles.h"
 
 namespace dovetail::collision {
 
 namespace {
+
+using detail::VertexTriangles;
 
 /// Union-find over piece indices, smaller root kept (so a patch's root is its first pair).
 class DisjointSets {
@@ -73,32 +76,6 @@ Real depth_behind(const detail::TriangleVertices& face, const Vec3& n,
   }
   return depth;
 }
-
-/// Triangles around each vertex, in compressed rows.
-struct VertexTriangles {
-  std::vector<std::uint32_t> offsets;
-  std::vector<std::uint32_t> triangles;
-
-  explicit VertexTriangles(const Mesh& mesh) : offsets(mesh.vertices.size() + 1, 0) {
-    for (const TriangleIndices& f : mesh.triangles) {
-      for (std::uint32_t v : f) ++offsets[v + 1];
-    }
-    std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-    triangles.resize(offsets.back());
-    std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-      for (std::uint32_t v : mesh.triangles[t]) triangles[fill[v]++] = t;
-    }
-  }
-
-  /// Calls visit(t) for every triangle sharing a vertex with `f` (f's own included).
-  template <typename Visit>
-  void around(const TriangleIndices& f, Visit&& visit) const {
-    for (std::uint32_t v : f) {
-      for (std::uint32_t k = offsets[v]; k < offsets[v + 1]; ++k) visit(triangles[k]);
-    }
-  }
-};
 
 /// Quick test before the piece: every vertex of each triangle within `tolerance` of the other's
 /// plane.
