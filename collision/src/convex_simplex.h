@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 #include "dovetail/collision/types.h"
 
@@ -177,6 +178,23 @@ struct SimplexPoint {
   Vec3 w, a, b;
   std::uint32_t ia = 0, ib = 0;
 };
+
+/// Which difference of the two hulls a search works on.
+enum class Difference { kAMinusB, kBMinusA };
+
+/// The simplex point of vertex ia of A and vertex ib of B, B's vertex mapped
+/// into A's frame by X_AB.apply (as every hull query maps it).
+inline SimplexPoint simplex_point(const std::vector<Vec3>& vertices_a,
+                                  const std::vector<Vec3>& vertices_b, const Transform& X_AB,
+                                  std::uint32_t ia, std::uint32_t ib, Difference difference) {
+  SimplexPoint s;
+  s.ia = ia;
+  s.ib = ib;
+  s.a = vertices_a[ia];
+  s.b = X_AB.apply(vertices_b[ib]);
+  s.w = difference == Difference::kAMinusB ? Vec3(s.a - s.b) : Vec3(s.b - s.a);
+  return s;
+}
 
 /// Up to four simplex vertices (with their differences w side by side for
 /// the sub-distance) and the weights of the nearest point.

@@ -67,13 +67,8 @@ GjkResult gjk(const ConvexHull& a, const ConvexHull& b, const Transform& X_AB, G
   const auto nb = static_cast<std::uint32_t>(b.vertices.size());
 
   auto make_point = [&](std::uint32_t ia, std::uint32_t ib) {
-    SimplexPoint s;
-    s.ia = ia;
-    s.ib = ib;
-    s.a = a.vertices[ia];
-    s.b = X_AB.apply(b.vertices[ib]);
-    s.w = s.a - s.b;
-    return s;
+    return detail::simplex_point(a.vertices, b.vertices, X_AB, ia, ib,
+                                 detail::Difference::kAMinusB);
   };
   // Support pair of M = A - B in direction -v: A lowest along v, B highest.
   std::uint32_t last_a = 0, last_b = 0;

@@ -81,13 +81,8 @@ SeparatingPlaneResult separating_plane_test(const ConvexHull& a, const ConvexHul
   const auto nb = static_cast<std::uint32_t>(b.vertices.size());
   const Real contact = kSeparatingPlaneContact * (a.radius + b.radius);
   auto make_point = [&](std::uint32_t ia, std::uint32_t ib) {
-    SimplexPoint s;
-    s.ia = ia;
-    s.ib = ib;
-    s.a = a.vertices[ia];
-    s.b = X_AB.apply(b.vertices[ib]);
-    s.w = s.b - s.a;
-    return s;
+    return detail::simplex_point(a.vertices, b.vertices, X_AB, ia, ib,
+                                 detail::Difference::kBMinusA);
   };
 
   // Last call's simplex at the new pose: loaded first when it is an overlap
