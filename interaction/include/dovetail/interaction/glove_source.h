@@ -1,0 +1,95 @@
+#pragma once
+/// \file glove_source.h
+/// Where the hand's input comes from: one interface that yields the glove
+/// sample for a simulation time, with three implementations (a recorded
+/// trace, the simulated glove, and a noise and latency model on top of
+/// either).
+///
+/// Why: a run, a replay and a test differ only in their source. A source is
+/// a pure function of time: the same t gives the same bits whatever was asked
+/// before, so a run replays exactly and sources can be sampled at any rate.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "dovetail/interaction/glove_plan.h"
+#include "dovetail/interaction/glove_sample.h"
+
+namespace dovetail::interaction {
+
+/// Yields the sample for simulation time t (seconds).
+class GloveSource {
+ public:
+  virtual ~GloveSource() = default;
+  /// The sample at time t; its `t` is t. A pure function of t.
+  virtual GloveSample sample(Real t) const = 0;
+  /// The time after which the source does not change any more (the end of
+  /// a trace or a plan).
+  virtual Real end_time() const = 0;
+};
+
+/// A recorded trace. Between two samples the joints and the position are
+/// interpolated linearly and the orientation by slerp; at a sample's own time
+/// the sample is returned bit for bit; before the first sample the first is
+/// held, after the last the last.
+class TraceSource final : public GloveSource {
+ public:
+  /// Throws std::invalid_argument for an empty trace or times that do not
+  /// increase (read_trace already refuses both).
+  explicit TraceSource(std::vector<GloveSample> samples);
+  GloveSample sample(Real t) const override;
+  Real end_time() const override;
+  const std::vector<GloveSample>& samples() const { return samples_; }
+
+ private:
+  std::vector<GloveSample> samples_;
+};
+
+/// The simulated glove: a GlovePlan turned into samples (see glove_plan.h
+/// for how each step moves the hand).
+class SimulatedGlove final : public GloveSource {
+ public:
+  explicit SimulatedGlove(GlovePlan plan);
+  GloveSample sample(Real t) const override;
+  Real end_time() const override;
+  const GlovePlan& plan() const { return plan_; }
+
+ private:
+  GlovePlan plan_;
+  std::vector<Real> step_start_;  ///< start time of each step
+};
+
+/// How a real glove and tracker distort what the hand does. The defaults are
+/// typical of a CyberGlove with a magnetic tracker (see docs/interaction.md).
+struct GloveNoise {
+  std::uint64_t seed = 1;
+  Real joint_sigma_deg = 0.5;      ///< white noise per joint and reading
+  Real donning_sigma_deg = 3.0;    ///< offset per joint, drawn once (glove put on)
+  Real degrees_per_count = 1.0;    ///< 8-bit quantisation step; 0: none
+  Real position_sigma_m = 0.001;   ///< tracker position noise per axis
+  Real orientation_sigma_deg = 0.15;  ///< tracker orientation noise (rotation vector per axis)
+  Real rate_hz = 120;              ///< the glove's own reading rate; held between readings
+  Real latency_s = 0.005;          ///< a reading reaches the simulation this much later
+};
+
+/// A source seen through a real glove: the inner source is read at the
+/// glove's own rate (reading k at time k / rate_hz), each reading is delayed
+/// by the latency and held until the next one arrives, and noise is added.
+/// The noise of reading k depends only on (seed, k, channel), never on the
+/// order of calls, so the source stays a pure function of time.
+class NoisyGlove final : public GloveSource {
+ public:
+  /// Throws std::invalid_argument for a null source, a rate <= 0, or a
+  /// negative or non-finite sigma or latency.
+  NoisyGlove(std::shared_ptr<const GloveSource> inner, const GloveNoise& noise = {});
+  GloveSample sample(Real t) const override;
+  Real end_time() const override;
+
+ private:
+  std::shared_ptr<const GloveSource> inner_;
+  GloveNoise noise_;
+  JointAngles donning_offset_{};
+};
+
+}  // namespace dovetail::interaction

@@ -1,0 +1,58 @@
+#pragma once
+/// \file glove_trace.h
+/// Glove traces: the CSV format in which glove samples are recorded,
+/// replayed and handed to outside tools (DESIGN.md, "Glove traces").
+///
+/// Format: a header row naming the 30 columns, then one sample per row,
+/// comma separated. Columns `t` (s), `x y z` (m, tracker position in the
+/// world), `qw qx qy qz` (tracker orientation, need not be unit length), then
+/// the 22 joint angles in degrees named as joint_name() names them. A reader
+/// accepts the columns in any order; a writer writes them in the order above.
+/// Numbers are written in the shortest form that reads back to the same bits,
+/// so writing then reading gives the same samples bit for bit, and reading
+/// then writing a written trace gives the same bytes.
+///
+/// Errors name the file and the line (`trace.csv:12: ...`): a missing,
+/// unknown or duplicated column, a row with too few or too many fields, a
+/// field that is not a number or not finite, a zero quaternion, time that does
+/// not increase, a file without a header or without samples, a line longer
+/// than kMaxTraceLineBytes (detected without reading the rest of the line).
+
+#include <cstddef>
+#include <filesystem>
+#include <iosfwd>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "dovetail/interaction/glove_sample.h"
+
+namespace dovetail::interaction {
+
+/// Thrown for a trace that cannot be read or written; what() starts with
+/// `file:line: ` for a bad line, `file: ` otherwise.
+class TraceError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Longest accepted line, in bytes (without the line ending).
+inline constexpr std::size_t kMaxTraceLineBytes = 64 * 1024;
+
+/// The 30 column names in the order a writer writes them.
+std::span<const std::string_view> trace_columns();
+
+/// Reads the trace in `in`; `name` is the file name used in messages.
+std::vector<GloveSample> read_trace(std::istream& in, std::string_view name);
+/// Reads the trace file at `path`; throws TraceError when it is missing,
+/// a directory, unreadable, or bad.
+std::vector<GloveSample> read_trace(const std::filesystem::path& path);
+
+/// The header row and one row per sample, each ending in '\n'.
+std::string format_trace(std::span<const GloveSample> samples);
+/// Writes format_trace to `path`; throws TraceError naming it on failure.
+void write_trace(const std::filesystem::path& path, std::span<const GloveSample> samples);
+
+}  // namespace dovetail::interaction
