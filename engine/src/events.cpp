@@ -19,6 +19,10 @@ std::string_view event_kind_name(EventKind kind) {
       return "region_enter";
     case EventKind::kRegionLeave:
       return "region_leave";
+    case EventKind::kHandContactBegin:
+      return "hand_contact_begin";
+    case EventKind::kHandContactEnd:
+      return "hand_contact_end";
     case EventKind::kGrasp:
       return "grasp";
     case EventKind::kRelease:

@@ -124,6 +124,13 @@ std::string Report::to_json(bool with_timings) const {
            ", \"max_contacts\": " + std::to_string(c.max_contacts) + "}";
   }
   out += contacts.empty() ? "]" : "\n  ]";
+  if (!notes.empty()) {
+    out += ",\n  \"notes\": [";
+    for (std::size_t i = 0; i < notes.size(); ++i) {
+      out += (i == 0 ? "\n    " : ",\n    ") + json_string(notes[i]);
+    }
+    out += "\n  ]";
+  }
   if (with_timings) out += ",\n  \"timings\": " + timings_json();
   out += "\n}\n";
   return out;

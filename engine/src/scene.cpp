@@ -88,6 +88,8 @@ PartHandle Scene::add_part(const PartDesc& desc) {
   s.parent = parent;
   s.X_PC = desc.X_PC;
   s.movable = desc.movable;
+  s.collision_group = desc.collision_group;
+  s.color = desc.color;
   s.render_mesh = desc.render_mesh;
   s.collision_mesh = desc.collision_mesh ? desc.collision_mesh : desc.render_mesh;
   by_name_.insert(at, {desc.name, index});
@@ -179,6 +181,12 @@ void Scene::set_world_pose(PartHandle part, const Transform& X_WP) {
 }
 
 bool Scene::movable(PartHandle part) const { return slot(part).movable; }
+const std::string& Scene::collision_group(PartHandle part) const {
+  return slot(part).collision_group;
+}
+const std::optional<std::array<float, 3>>& Scene::color(PartHandle part) const {
+  return slot(part).color;
+}
 void Scene::set_movable(PartHandle part, bool movable) { slot(part).movable = movable; }
 
 const std::shared_ptr<const Mesh>& Scene::render_mesh(PartHandle part) const {

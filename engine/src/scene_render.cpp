@@ -43,13 +43,15 @@ RenderScene render_scene(const Scene& scene, const collision::StepResult* step,
   RenderScene out;
   out.cameras = scene.cameras();
   std::map<collision::PartId, Highlight> by_id;
+  std::size_t palette_index = 0;  // parts with a colour of their own take none
   for (const PartHandle part : scene.parts()) {
     const auto& mesh = scene.render_mesh(part);
     if (!mesh) continue;  // a group node
     RenderItem item;
     item.mesh = mesh;
     item.X_WP = scene.world_pose(part);
-    item.color = palette_color(out.items.size());
+    const auto& own = scene.color(part);
+    item.color = own ? Color{(*own)[0], (*own)[1], (*own)[2]} : palette_color(palette_index++);
     item.name = scene.name(part);
     if (step != nullptr) {
       const collision::PartId id = collision_id(part);

@@ -132,6 +132,15 @@ void Simulation::commit(std::vector<Event>& events, double now) {
                                   .level = collision::LevelOfDetail::kExact,
                                   .name = scene_.name(part)});
         collision_names_[r->id] = scene_.name(part);
+        const std::string& group = scene_.collision_group(part);
+        if (!group.empty()) {
+          for (const std::unique_ptr<Registered>& other : registered_) {
+            if (other && other.get() != r.get() && other->id.valid() &&
+                scene_.contains(other->handle) && scene_.collision_group(other->handle) == group) {
+              world_->set_interest(r->id, other->id, false);
+            }
+          }
+        }
         const collision::Bounds b = collision::mesh_bounds(*mesh);
         r->local_box = {b.min, b.max};
       }
@@ -234,7 +243,7 @@ const FrameResult& Simulation::step() {
     ++due;
   }
   commands_.erase(commands_.begin(), due);
-  if (hook_) hook_(*this, frame_, now);
+  for (const FrameHook& hook : hooks_) hook(*this, frame_, now);
 
   // 4. Commit the poses.
   commit(events, now);
@@ -251,6 +260,7 @@ const FrameResult& Simulation::step() {
   removed_.clear();
   timer_events(events, now);
   region_events(events, now);
+  for (const EventFilter& filter : filters_) filter(*this, events);
 
   // 7. Subscribers react; what they change is committed by the next frame.
   bus_.publish(events);

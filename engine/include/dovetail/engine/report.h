@@ -47,6 +47,9 @@ struct Report {
   std::uint64_t state_hash = 0;
   std::vector<Event> events;               ///< the timeline, in delivery order
   std::vector<PairContactStats> contacts;  ///< sorted by (a, b)
+  /// Things a reader should know (a joint angle clamped to its limit, ...),
+  /// in the order noticed.
+  std::vector<std::string> notes;
   std::vector<FrameTiming> timings;        ///< one per frame
 
   /// The report as JSON (see docs/engine.md); with_timings appends the

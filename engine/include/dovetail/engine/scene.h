@@ -11,11 +11,13 @@
 /// addressed by PartHandle (index + generation), never by pointer; meshes are
 /// shared (`shared_ptr<const Mesh>`) between instances of the same geometry.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -59,6 +61,11 @@ struct PartDesc {
   std::shared_ptr<const collision::Mesh> render_mesh{};
   /// Geometry for collisions; null: the render mesh.
   std::shared_ptr<const collision::Mesh> collision_mesh{};
+  /// Parts of the same non-empty group are never tested against each other
+  /// (the segments of a hand, which overlap at their joints).
+  std::string collision_group{};
+  /// Display colour (RGB in [0, 1]); none: the renderer's palette.
+  std::optional<std::array<float, 3>> color{};
 };
 
 /// Named parts in a transform hierarchy.
@@ -110,6 +117,9 @@ class Scene {
   /// Sets the local pose so that the world pose becomes X_WP.
   void set_world_pose(PartHandle part, const Transform& X_WP);
 
+  const std::string& collision_group(PartHandle part) const;
+  const std::optional<std::array<float, 3>>& color(PartHandle part) const;
+
   bool movable(PartHandle part) const;
   void set_movable(PartHandle part, bool movable);
 
@@ -132,6 +142,8 @@ class Scene {
     PartHandle parent;
     Transform X_PC;
     bool movable = true;
+    std::string collision_group;
+    std::optional<std::array<float, 3>> color;
     std::shared_ptr<const collision::Mesh> render_mesh;
     std::shared_ptr<const collision::Mesh> collision_mesh;
   };

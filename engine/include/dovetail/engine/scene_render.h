@@ -23,8 +23,9 @@ class Simulation;
 using CollisionIdOf = std::function<collision::PartId(PartHandle)>;
 
 /// One RenderItem per part with a render mesh, in name order, posed at the
-/// part's world pose X_WP, coloured palette_color(i) for the i-th such part
-/// and named after the part; the scene's named cameras.
+/// part's world pose X_WP, in the part's own colour if it has one, otherwise
+/// palette_color(i) for the i-th such part without one, named after the
+/// part; the scene's named cameras.
 ///
 /// With a `step`, the contacts of that step are highlighted (rules in
 /// docs/rendering.md): a contact with triangles highlights those triangles of

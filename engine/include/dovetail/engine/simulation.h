@@ -78,6 +78,11 @@ class Simulation {
   /// Called at the start of each frame, after the queued pose commands and
   /// before the commit: the place for input, hand and interaction.
   using FrameHook = std::function<void(Simulation&, std::uint64_t frame, double time)>;
+  /// Called with each frame's events after the engine has made them and
+  /// before anyone sees them: the place where upper layers turn contacts
+  /// into their own events (a hand segment touching a part) or add events.
+  /// The events are sorted (event_less) after all filters have run.
+  using EventFilter = std::function<void(Simulation&, std::vector<Event>& events)>;
 
   explicit Simulation(Scene scene, const SimulationSettings& settings = {});
   ~Simulation();
@@ -96,7 +101,17 @@ class Simulation {
   /// Queues a pose command; throws SceneError for an unknown part (and step()
   /// throws it at frame k if the part was removed by then).
   void queue_pose(const PoseCommand& command);
-  void set_frame_hook(FrameHook hook) { hook_ = std::move(hook); }
+  /// Replaces every frame hook by `hook`.
+  void set_frame_hook(FrameHook hook) {
+    hooks_.clear();
+    hooks_.push_back(std::move(hook));
+  }
+  /// Adds a frame hook; hooks run in the order added.
+  void add_frame_hook(FrameHook hook) { hooks_.push_back(std::move(hook)); }
+  /// Adds an event filter; filters run in the order added.
+  void add_event_filter(EventFilter filter) { filters_.push_back(std::move(filter)); }
+  /// Adds a note to the report (see Report::notes).
+  void add_note(std::string note) { report_.notes.push_back(std::move(note)); }
   /// A timer firing in the first frame whose time reaches `time`.
   void add_timer(const std::string& name, double time);
   /// Adds a region; throws SceneError for a duplicate name or an unknown part.
@@ -144,7 +159,8 @@ class Simulation {
   SimulationSettings settings_;
   std::unique_ptr<collision::CollisionWorld> world_;
   EventBus bus_;
-  FrameHook hook_;
+  std::vector<FrameHook> hooks_;
+  std::vector<EventFilter> filters_;
   std::vector<PoseCommand> commands_;  ///< sorted by frame, stable
   struct Timer {
     std::string name;

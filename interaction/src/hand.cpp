@@ -1,0 +1,104 @@
+#include "dovetail/interaction/hand.h"
+
+#include <cstdio>
+#include <stdexcept>
+#include <utility>
+
+namespace dovetail::interaction {
+
+namespace {
+
+std::string format_angle(Real degrees) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", degrees);
+  return buffer;
+}
+
+}  // namespace
+
+Hand::Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> source,
+           const HandSettings& settings)
+    : model_(settings.model), source_(std::move(source)), settings_(settings) {
+  if (!source_) throw std::invalid_argument("hand: no glove source");
+  if (settings_.name.empty()) throw std::invalid_argument("hand: the hand needs a name");
+  sample_ = source_->sample(simulation.time());
+  angles_ = clamp_to_limits(sample_.joints);
+  pose_ = model_.forward_kinematics(angles_);
+  X_WH_ = sample_.X_WH();
+
+  engine::Scene& scene = simulation.scene();
+  for (std::size_t i = 0; i < kSegmentCount; ++i) {
+    const auto segment = static_cast<Segment>(i);
+    engine::PartDesc desc;
+    desc.name = settings_.name + "." + std::string(segment_name(segment));
+    desc.tags = {"hand"};
+    desc.movable = true;
+    desc.render_mesh = model_.proxy(segment);
+    desc.collision_group = settings_.name;
+    desc.color = kHandColor;
+    desc.X_PC = engine::compose(X_WH_, pose_.X_HS[i]);
+    parts_[i] = scene.add_part(desc);
+    segment_by_part_.emplace(desc.name, segment);
+  }
+  simulation.add_frame_hook(
+      [this](engine::Simulation& sim, std::uint64_t frame, double t) { update(sim, frame, t); });
+  simulation.add_event_filter(
+      [this](engine::Simulation&, std::vector<engine::Event>& events) { filter(events); });
+}
+
+std::optional<Segment> Hand::segment_of(const std::string& part_name) const {
+  const auto it = segment_by_part_.find(part_name);
+  if (it == segment_by_part_.end()) return std::nullopt;
+  return it->second;
+}
+
+void Hand::update(engine::Simulation& simulation, std::uint64_t frame, Real t) {
+  // 1. Input.
+  sample_ = source_->sample(t);
+  if (settings_.record) recorded_.push_back(sample_);
+  // 2. Hand: limits, forward kinematics, the proxies' poses.
+  std::bitset<kJointCount> clamped;
+  angles_ = clamp_to_limits(sample_.joints, &clamped);
+  for (std::size_t j = 0; j < kJointCount; ++j) {
+    if (!clamped[j]) continue;
+    if (clamped_frames_[j]++ == 0) {
+      const JointLimit& limit = joint_limits()[j];
+      simulation.add_note(settings_.name + ": " +
+                          std::string(joint_name(static_cast<Joint>(j))) + " " +
+                          format_angle(sample_.joints[j]) + " deg is outside its range [" +
+                          format_angle(limit.min) + ", " + format_angle(limit.max) +
+                          "] at frame " + std::to_string(frame) +
+                          "; clamped (here and whenever it recurs)");
+    }
+  }
+  pose_ = model_.forward_kinematics(angles_);
+  X_WH_ = sample_.X_WH();
+  pose_parts(simulation.scene());
+}
+
+void Hand::pose_parts(engine::Scene& scene) const {
+  for (std::size_t i = 0; i < kSegmentCount; ++i) {
+    scene.set_local_pose(parts_[i], engine::compose(X_WH_, pose_.X_HS[i]));
+  }
+}
+
+void Hand::filter(std::vector<engine::Event>& events) const {
+  for (engine::Event& e : events) {
+    if (e.kind != engine::EventKind::kContactBegin && e.kind != engine::EventKind::kContactEnd) {
+      continue;
+    }
+    std::optional<Segment> segment = segment_of(e.a);
+    std::string other = e.b;
+    if (!segment) {
+      segment = segment_of(e.b);
+      other = e.a;
+    }
+    if (!segment) continue;
+    e.kind = e.kind == engine::EventKind::kContactBegin ? engine::EventKind::kHandContactBegin
+                                                       : engine::EventKind::kHandContactEnd;
+    e.a = std::string(segment_name(*segment));
+    e.b = std::move(other);
+  }
+}
+
+}  // namespace dovetail::interaction
