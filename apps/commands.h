@@ -21,5 +21,7 @@ int run_command(std::span<const std::string> args);
 int broadphase_command(std::span<const std::string> args);
 /// `dovetail render INPUT --out PNG ...`: draws a mesh or assembly file to PNG.
 int render_command(std::span<const std::string> args);
+/// `dovetail glove convert|plan|check ...`: glove traces from recordings and plans.
+int glove_command(std::span<const std::string> args);
 
 }  // namespace dovetail::cli

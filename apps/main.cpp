@@ -23,7 +23,8 @@ using dovetail::cli::kExitUsage;
 constexpr const char* kUsage =
     R"(usage: dovetail <command> [arguments]
 
-Headless VR assembly simulator: exact collision queries between meshes.
+Headless VR assembly simulator: exact collision queries between meshes, the
+glove-driven hand.
 
 commands:
   query     test mesh B against mesh A at every pose of a pose list
@@ -31,7 +32,8 @@ commands:
   poses     write a contact-distance pose list for two meshes
   run       the built-in job: every method against brute force
   broadphase  overlapping pairs of moving boxes, frame by frame
-  render    draw a mesh or assembly file to PNG
+  render    draw a mesh or assembly file to PNG (with the hand of a glove trace)
+  glove     convert glove recordings, sample glove plans, check traces
   version   print the version
 
 'dovetail <command> --help' describes a command.
@@ -61,6 +63,7 @@ constexpr Command kCommands[] = {
     {"run", dovetail::cli::run_command},
     {"broadphase", dovetail::cli::broadphase_command},
     {"render", dovetail::cli::render_command},
+    {"glove", dovetail::cli::glove_command},
     {"version", version_command},
 };
 

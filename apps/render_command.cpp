@@ -2,12 +2,20 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <string>
 
 #include "cli.h"
 #include "commands.h"
 #include "dovetail/engine/mesh_import.h"
 #include "dovetail/engine/render.h"
+#include "dovetail/engine/scene.h"
+#include "dovetail/engine/scene_render.h"
+#include "dovetail/interaction/glove_plan.h"
+#include "dovetail/interaction/glove_source.h"
+#include "dovetail/interaction/glove_trace.h"
+#include "dovetail/interaction/hand.h"
 
 namespace dovetail::cli {
 
@@ -15,6 +23,8 @@ namespace {
 
 constexpr const char* kHelp =
     R"(usage: dovetail render INPUT --out PNG [--width W] [--height H] [--camera NAME|auto]
+                       [--trace TRACE | --plan PLAN] [--time T] [--hand-size S]
+                       [--hand-length M]
 
 Draws a mesh or assembly file off-screen and writes the picture as PNG.
 
@@ -27,6 +37,12 @@ Draws a mesh or assembly file off-screen and writes the picture as PNG.
                  nodes[81]; `dovetail inspect` lists them), a built-in view (front,
                  back, right, left, top, bottom, iso: the whole scene in view along
                  that axis, y up), or auto (default, the same as iso)
+  --trace TRACE  also draw the hand, as a glove trace (docs/cli.md) has it at
+                 time --time (seconds, default 0, interpolated between samples); the
+                 input is then loaded as an assembly in metres, like a simulation
+  --plan PLAN    the same with a simulated-glove plan (docs/interaction.md)
+  --hand-size S  adult_m50 (default), adult_f50, adult_m95, adult_f05
+  --hand-length M  scale the size to this hand length in metres
 
 Flat shading with a light at the camera, depth-tested, no anti-aliasing; the
 same input and options give the same PNG bytes. Prints a one-line JSON summary
@@ -45,10 +61,76 @@ void check_writable(const std::string& path) {
   }
 }
 
+/// The parts of a mesh or assembly file, in file units.
+engine::RenderScene scene_of_file(const std::string& input, std::uint64_t& triangles) {
+  engine::ImportReport report;
+  try {
+    engine::ImportOptions options;
+    options.merge = false;
+    report = engine::import_file(input, options);
+  } catch (const collision::MeshError& e) {
+    throw InputError(e.what());
+  }
+  for (const std::string& note : report.notes) {
+    std::fprintf(stderr, "dovetail: note: %s: %s\n", input.c_str(), note.c_str());
+  }
+  for (const engine::ImportedPart& part : report.parts) triangles += part.mesh.triangle_count();
+  return engine::scene_from_import(report);
+}
+
+/// The assembly in metres with the hand of a trace or plan at --time.
+engine::RenderScene scene_with_hand(const Args& args, const std::string& input,
+                                    const std::optional<std::string>& trace,
+                                    const std::optional<std::string>& plan,
+                                    std::uint64_t& triangles) {
+  const double time = args.number("time", 0).value_or(0);
+  interaction::HandDef hand_def;
+  hand_def.size = args.value("hand-size").value_or("adult_m50");
+  hand_def.hand_length = args.number("hand-length", 0).value_or(0);
+  std::unique_ptr<interaction::HandModel> model;
+  try {
+    model = std::make_unique<interaction::HandModel>(hand_def);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("render: ") + e.what());
+  }
+  std::unique_ptr<interaction::GloveSource> source;
+  try {
+    if (trace) {
+      source = std::make_unique<interaction::TraceSource>(interaction::read_trace(*trace));
+    } else {
+      source = std::make_unique<interaction::SimulatedGlove>(interaction::read_plan(*plan));
+    }
+  } catch (const interaction::TraceError& e) {
+    throw InputError(e.what());
+  } catch (const interaction::PlanError& e) {
+    throw InputError(e.what());
+  }
+  engine::AssemblyReport assembly;
+  engine::Scene parts;
+  try {
+    parts = engine::load_assembly(input, {}, &assembly);
+  } catch (const collision::MeshError& e) {
+    throw InputError(e.what());
+  }
+  for (const std::string& note : assembly.notes) {
+    std::fprintf(stderr, "dovetail: note: %s: %s\n", input.c_str(), note.c_str());
+  }
+  triangles = assembly.triangles;
+  engine::RenderScene scene = engine::render_scene(parts);
+  for (engine::RenderItem& item : interaction::hand_render_items(*model, source->sample(time))) {
+    triangles += item.mesh->triangle_count();
+    scene.items.push_back(std::move(item));
+  }
+  return scene;
+}
+
 }  // namespace
 
 int render_command(std::span<const std::string> argv) {
-  const Args args("render", argv, {"out", "width", "height", "camera"}, {});
+  const Args args(
+      "render", argv,
+      {"out", "width", "height", "camera", "trace", "plan", "time", "hand-size", "hand-length"},
+      {});
   if (args.help()) {
     std::fputs(kHelp, stdout);
     return kExitOk;
@@ -66,21 +148,20 @@ int render_command(std::span<const std::string> argv) {
   refuse_overwriting_input("render", out, inputs);
   check_writable(out);
 
-  engine::ImportReport report;
-  try {
-    engine::ImportOptions options;
-    options.merge = false;
-    report = engine::import_file(input, options);
-  } catch (const collision::MeshError& e) {
-    throw InputError(e.what());
-  }
-  for (const std::string& note : report.notes) {
-    std::fprintf(stderr, "dovetail: note: %s: %s\n", input.c_str(), note.c_str());
+  const std::optional<std::string> trace = args.value("trace");
+  const std::optional<std::string> plan = args.value("plan");
+  if (trace && plan) throw UsageError("render: give --trace or --plan, not both");
+  const bool with_hand = trace || plan;
+  if (!with_hand) {
+    for (const char* option : {"time", "hand-size", "hand-length"}) {
+      if (args.value(option)) {
+        throw UsageError(std::string("render: --") + option + " needs --trace or --plan");
+      }
+    }
   }
   std::uint64_t triangles = 0;
-  for (const engine::ImportedPart& part : report.parts) triangles += part.mesh.triangle_count();
-  const engine::RenderScene scene = engine::scene_from_import(report);
-  report.parts.clear();
+  const engine::RenderScene scene = with_hand ? scene_with_hand(args, input, trace, plan, triangles)
+                                              : scene_of_file(input, triangles);
 
   if (!engine::has_camera(scene, settings.camera)) {
     std::string known;
@@ -113,6 +194,7 @@ int render_command(std::span<const std::string> argv) {
       .add("height", settings.height)
       .add("camera", settings.camera)
       .add("parts", std::uint64_t{scene.items.size()})
+      .add("hand", with_hand)
       .add("triangles", triangles)
       .add("render_ms", std::round(render_ms * 1000.0) / 1000.0);
   std::fputs((json.str() + "\n").c_str(), stdout);

@@ -11,11 +11,11 @@ namespace dovetail::interaction {
 namespace {
 
 constexpr std::array<std::string_view, kJointCount> kJointNames = {
-    "thumb_roll",      "thumb_mcp",       "thumb_ip",       "thumb_abd",  "index_mcp",
-    "index_pip",       "index_dip",       "middle_mcp",     "middle_pip", "middle_dip",
-    "ring_mcp",        "ring_pip",        "ring_dip",       "pinky_mcp",  "pinky_pip",
-    "pinky_dip",       "index_middle_abd", "middle_ring_abd", "ring_pinky_abd", "palm_arch",
-    "wrist_pitch",     "wrist_yaw"};
+    "thumb_roll",  "thumb_mcp",        "thumb_ip",        "thumb_abd",      "index_mcp",
+    "index_pip",   "index_dip",        "middle_mcp",      "middle_pip",     "middle_dip",
+    "ring_mcp",    "ring_pip",         "ring_dip",        "pinky_mcp",      "pinky_pip",
+    "pinky_dip",   "index_middle_abd", "middle_ring_abd", "ring_pinky_abd", "palm_arch",
+    "wrist_pitch", "wrist_yaw"};
 
 bool same_bits(Real a, Real b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
@@ -66,24 +66,25 @@ Quaternion slerp(const Quaternion& a, const Quaternion& b_in, Real s) {
   if (s == 0) return a;
   if (s == 1) return b_in;
   Quaternion b = b_in;
-  Real cos_theta = a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
-  if (cos_theta < 0) {  // the shorter arc
-    b = {-b.w, -b.x, -b.y, -b.z};
-    cos_theta = -cos_theta;
-  }
-  Real ka = 1 - s;
-  Real kb = s;
-  if (cos_theta < 0.9995) {
-    const Real theta = std::acos(std::min<Real>(cos_theta, 1));
-    const Real sin_theta = std::sin(theta);
-    ka = std::sin((1 - s) * theta) / sin_theta;
-    kb = std::sin(s * theta) / sin_theta;
-  }
-  // Nearly equal rotations: linear interpolation, renormalised.
-  return normalized({ka * a.w + kb * b.w, ka * a.x + kb * b.x, ka * a.y + kb * b.y,
-                     ka * a.z + kb * b.z});
+  if (a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z < 0)
+    b = {-b.w, -b.x, -b.y, -b.z};  // shorter arc
+  // The angle between a and b as 4-vectors from the chord lengths, accurate
+  // for small angles too (acos of the dot product is not).
+  const Real diff = std::sqrt((b.w - a.w) * (b.w - a.w) + (b.x - a.x) * (b.x - a.x) +
+                              (b.y - a.y) * (b.y - a.y) + (b.z - a.z) * (b.z - a.z));
+  const Real sum = std::sqrt((b.w + a.w) * (b.w + a.w) + (b.x + a.x) * (b.x + a.x) +
+                             (b.y + a.y) * (b.y + a.y) + (b.z + a.z) * (b.z + a.z));
+  const Real angle = 2 * std::atan2(diff, sum);
+  if (angle == 0) return a;
+  const Real sin_angle = std::sin(angle);
+  const Real ka = std::sin((1 - s) * angle) / sin_angle;
+  const Real kb = std::sin(s * angle) / sin_angle;
+  return normalized(
+      {ka * a.w + kb * b.w, ka * a.x + kb * b.x, ka * a.y + kb * b.y, ka * a.z + kb * b.z});
 }
 
-Mat3 rotation(const Quaternion& q) { return collision::rotation_from_quaternion(q.w, q.x, q.y, q.z); }
+Mat3 rotation(const Quaternion& q) {
+  return collision::rotation_from_quaternion(q.w, q.x, q.y, q.z);
+}
 
 }  // namespace dovetail::interaction

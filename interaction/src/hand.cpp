@@ -16,6 +16,23 @@ std::string format_angle(Real degrees) {
 
 }  // namespace
 
+std::vector<engine::RenderItem> hand_render_items(const HandModel& model, const GloveSample& sample,
+                                                  const std::string& name) {
+  const HandPose pose = model.forward_kinematics(clamp_to_limits(sample.joints));
+  const Transform X_WH = sample.X_WH();
+  std::vector<engine::RenderItem> items;
+  for (std::size_t i = 0; i < kSegmentCount; ++i) {
+    const auto segment = static_cast<Segment>(i);
+    engine::RenderItem item;
+    item.mesh = model.proxy(segment);
+    item.X_WP = engine::compose(X_WH, pose.X_HS[i]);
+    item.color = engine::Color{kHandColor[0], kHandColor[1], kHandColor[2]};
+    item.name = name + "." + std::string(segment_name(segment));
+    items.push_back(std::move(item));
+  }
+  return items;
+}
+
 Hand::Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> source,
            const HandSettings& settings)
     : model_(settings.model), source_(std::move(source)), settings_(settings) {
@@ -46,6 +63,9 @@ Hand::Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> so
       [this](engine::Simulation&, std::vector<engine::Event>& events) { filter(events); });
 }
 
+Hand::Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> source)
+    : Hand(simulation, std::move(source), HandSettings{}) {}
+
 std::optional<Segment> Hand::segment_of(const std::string& part_name) const {
   const auto it = segment_by_part_.find(part_name);
   if (it == segment_by_part_.end()) return std::nullopt;
@@ -63,12 +83,10 @@ void Hand::update(engine::Simulation& simulation, std::uint64_t frame, Real t) {
     if (!clamped[j]) continue;
     if (clamped_frames_[j]++ == 0) {
       const JointLimit& limit = joint_limits()[j];
-      simulation.add_note(settings_.name + ": " +
-                          std::string(joint_name(static_cast<Joint>(j))) + " " +
-                          format_angle(sample_.joints[j]) + " deg is outside its range [" +
-                          format_angle(limit.min) + ", " + format_angle(limit.max) +
-                          "] at frame " + std::to_string(frame) +
-                          "; clamped (here and whenever it recurs)");
+      simulation.add_note(settings_.name + ": " + std::string(joint_name(static_cast<Joint>(j))) +
+                          " " + format_angle(sample_.joints[j]) + " deg is outside its range [" +
+                          format_angle(limit.min) + ", " + format_angle(limit.max) + "] at frame " +
+                          std::to_string(frame) + "; clamped (here and whenever it recurs)");
     }
   }
   pose_ = model_.forward_kinematics(angles_);
@@ -95,7 +113,7 @@ void Hand::filter(std::vector<engine::Event>& events) const {
     }
     if (!segment) continue;
     e.kind = e.kind == engine::EventKind::kContactBegin ? engine::EventKind::kHandContactBegin
-                                                       : engine::EventKind::kHandContactEnd;
+                                                        : engine::EventKind::kHandContactEnd;
     e.a = std::string(segment_name(*segment));
     e.b = std::move(other);
   }

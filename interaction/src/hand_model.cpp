@@ -9,10 +9,12 @@ namespace dovetail::interaction {
 namespace {
 
 constexpr std::array<std::string_view, kSegmentCount> kSegmentNames = {
-    "palm",          "thumb_metacarpal", "thumb_proximal",      "thumb_distal",
-    "index_proximal", "index_intermediate", "index_distal",     "middle_proximal",
-    "middle_intermediate", "middle_distal", "ring_proximal",     "ring_intermediate",
-    "ring_distal",   "pinky_proximal",   "pinky_intermediate",  "pinky_distal"};
+    "palm",          "thumb_metacarpal", "thumb_proximal",
+    "thumb_distal",  "index_proximal",   "index_intermediate",
+    "index_distal",  "middle_proximal",  "middle_intermediate",
+    "middle_distal", "ring_proximal",    "ring_intermediate",
+    "ring_distal",   "pinky_proximal",   "pinky_intermediate",
+    "pinky_distal"};
 
 constexpr std::array<JointLimit, kJointCount> kLimits = {{
     {-20, 90},   // thumb_roll
@@ -58,8 +60,8 @@ constexpr Segment finger_segment(std::size_t f, std::size_t phalanx) {
 std::size_t index_of(Segment s) { return static_cast<std::size_t>(s); }
 
 /// Orients every triangle of a convex mesh so its normal points away from `inside`.
-void orient_outward(const std::vector<Vec3>& vertices, std::vector<collision::TriangleIndices>& triangles,
-                    const Vec3& inside) {
+void orient_outward(const std::vector<Vec3>& vertices,
+                    std::vector<collision::TriangleIndices>& triangles, const Vec3& inside) {
   for (collision::TriangleIndices& t : triangles) {
     const Vec3& a = vertices[t[0]];
     const Vec3 n = (vertices[t[1]] - a).cross(vertices[t[2]] - a);
@@ -162,7 +164,10 @@ collision::Mesh capsule_mesh(Real length, Real radius) {
   // Rings: 0 proximal equator, 1 distal equator, 2 proximal 45 degrees, 3 distal 45 degrees.
   for (int ring = 0; ring < 4; ++ring) {
     const Real scale = ring < 2 ? 1 : mid;
-    const Real z = ring == 0 ? 0 : ring == 1 ? -length : ring == 2 ? radius * mid : -length - radius * mid;
+    const Real z = ring == 0   ? 0
+                   : ring == 1 ? -length
+                   : ring == 2 ? radius * mid
+                               : -length - radius * mid;
     for (int k = 0; k < kAround; ++k) {
       const Real angle = 2 * std::numbers::pi * k / kAround;
       // Exact axis directions at k = 0, 2, 4, 6.
@@ -237,7 +242,9 @@ Vec3 HandModel::knuckle(Digit digit, Real arch_deg) const {
   const Real hl = hand_length_;
   const Vec3 p((static_cast<Real>(f) - 1.5) * P::kSpacing * hl, 0,
                -(P::kCarpal + P::kFinger[f][0]) * hl);
-  const Real share = digit == Digit::kRing ? P::kArchRing : digit == Digit::kPinky ? P::kArchPinky : 0;
+  const Real share = digit == Digit::kRing    ? P::kArchRing
+                     : digit == Digit::kPinky ? P::kArchPinky
+                                              : 0;
   if (share == 0) return p;
   return rotation_z_deg(-share * arch_deg) * p;
 }
@@ -246,7 +253,9 @@ Vec3 HandModel::metacarpal_base(Digit digit, Real arch_deg) const {
   const auto f = static_cast<std::size_t>(digit) - 1;
   const Real hl = hand_length_;
   const Vec3 p((static_cast<Real>(f) - 1.5) * P::kSpacing * hl, 0, -P::kCarpal * hl);
-  const Real share = digit == Digit::kRing ? P::kArchRing : digit == Digit::kPinky ? P::kArchPinky : 0;
+  const Real share = digit == Digit::kRing    ? P::kArchRing
+                     : digit == Digit::kPinky ? P::kArchPinky
+                                              : 0;
   if (share == 0) return p;
   return rotation_z_deg(-share * arch_deg) * p;
 }
@@ -292,8 +301,8 @@ HandPose HandModel::forward_kinematics(const JointAngles& q) const {
     const std::size_t j = static_cast<std::size_t>(Joint::kIndexMcp) + 3 * f;
     Transform X_HF;
     X_HF.t = knuckle(digit, arch);
-    X_HF.R = rotation_z_deg(-arch_share[f] * arch) * rotation_y_deg(spread[f]) *
-             rotation_x_deg(-q[j]);
+    X_HF.R =
+        rotation_z_deg(-arch_share[f] * arch) * rotation_y_deg(spread[f]) * rotation_x_deg(-q[j]);
     const std::array<Real, 3> flexion = {q[j], q[j + 1], q[j + 2]};
     chain(X_HF, finger_segment(f, 0), flexion, f + 1);
   }

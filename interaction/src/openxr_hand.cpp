@@ -14,14 +14,32 @@ namespace dovetail::interaction {
 
 namespace {
 
-constexpr std::array<std::string_view, kXrJointCount> kXrNames = {
-    "palm",           "wrist",           "thumb_metacarpal",  "thumb_proximal",
-    "thumb_distal",   "thumb_tip",       "index_metacarpal",  "index_proximal",
-    "index_intermediate", "index_distal", "index_tip",         "middle_metacarpal",
-    "middle_proximal", "middle_intermediate", "middle_distal", "middle_tip",
-    "ring_metacarpal", "ring_proximal",  "ring_intermediate", "ring_distal",
-    "ring_tip",       "little_metacarpal", "little_proximal", "little_intermediate",
-    "little_distal",  "little_tip"};
+constexpr std::array<std::string_view, kXrJointCount> kXrNames = {"palm",
+                                                                  "wrist",
+                                                                  "thumb_metacarpal",
+                                                                  "thumb_proximal",
+                                                                  "thumb_distal",
+                                                                  "thumb_tip",
+                                                                  "index_metacarpal",
+                                                                  "index_proximal",
+                                                                  "index_intermediate",
+                                                                  "index_distal",
+                                                                  "index_tip",
+                                                                  "middle_metacarpal",
+                                                                  "middle_proximal",
+                                                                  "middle_intermediate",
+                                                                  "middle_distal",
+                                                                  "middle_tip",
+                                                                  "ring_metacarpal",
+                                                                  "ring_proximal",
+                                                                  "ring_intermediate",
+                                                                  "ring_distal",
+                                                                  "ring_tip",
+                                                                  "little_metacarpal",
+                                                                  "little_proximal",
+                                                                  "little_intermediate",
+                                                                  "little_distal",
+                                                                  "little_tip"};
 
 constexpr Real kDegreesPerRadian = 180 / std::numbers::pi;
 
@@ -60,7 +78,9 @@ XrHandFrame openxr_frame(const HandModel& model, const JointAngles& angles, cons
   const HandPose pose = model.forward_kinematics(angles);
   XrHandFrame frame;
   frame.t = t;
-  auto put = [&](XrJoint j, const Transform& X_HJ) { frame.X_WJ[xr(j)] = engine::compose(X_WH, X_HJ); };
+  auto put = [&](XrJoint j, const Transform& X_HJ) {
+    frame.X_WJ[xr(j)] = engine::compose(X_WH, X_HJ);
+  };
   auto tip = [&](XrJoint j, Segment distal, Digit digit) {
     Transform X_HJ = pose.X_HS[seg(distal)];
     X_HJ.t = pose.p_HTip[static_cast<std::size_t>(digit)];
@@ -70,7 +90,8 @@ XrHandFrame openxr_frame(const HandModel& model, const JointAngles& angles, cons
 
   put(XrJoint::kWrist, Transform::identity());
   Transform X_HPalm;
-  X_HPalm.t = (model.metacarpal_base(Digit::kMiddle, arch) + model.knuckle(Digit::kMiddle, arch)) / 2;
+  X_HPalm.t =
+      (model.metacarpal_base(Digit::kMiddle, arch) + model.knuckle(Digit::kMiddle, arch)) / 2;
   put(XrJoint::kPalm, X_HPalm);
 
   put(XrJoint::kThumbMetacarpal, pose.X_HS[seg(Segment::kThumbMetacarpal)]);
@@ -88,7 +109,8 @@ XrHandFrame openxr_frame(const HandModel& model, const JointAngles& angles, cons
     X_HM.R = rotation_z_deg(-arch_share[f] * arch);
     X_HM.t = model.metacarpal_base(digit, arch);
     put(static_cast<XrJoint>(base), X_HM);
-    for (std::size_t i = 0; i < 3; ++i) put(static_cast<XrJoint>(base + 1 + i), pose.X_HS[first + i]);
+    for (std::size_t i = 0; i < 3; ++i)
+      put(static_cast<XrJoint>(base + 1 + i), pose.X_HS[first + i]);
     tip(static_cast<XrJoint>(base + 4), static_cast<Segment>(first + 2), digit);
   }
   return frame;
@@ -130,8 +152,8 @@ GloveSample sample_from_openxr(const XrHandFrame& frame) {
 
   // Palm arch: the little finger's metacarpal in H is Rz(-arch).
   const Mat3 M_little = relative(X_WH, X[xr(XrJoint::kLittleMetacarpal)]);
-  at(q, Joint::kPalmArch) = -std::atan2(M_little(1, 0), M_little(0, 0)) * kDegreesPerRadian /
-                            HandProportions::kArchPinky;
+  at(q, Joint::kPalmArch) =
+      -std::atan2(M_little(1, 0), M_little(0, 0)) * kDegreesPerRadian / HandProportions::kArchPinky;
   return s;
 }
 
@@ -166,7 +188,8 @@ std::vector<GloveSample> read_openxr(std::istream& in, std::string_view name) {
   // Column index of t and of each joint's seven values.
   std::array<std::size_t, kColumns> column_of{};
   std::array<bool, kColumns> seen{};
-  const std::vector<std::string_view> names = split_commas(*header);
+  std::vector<std::string> names;  // copied: the reader's next line replaces the header's text
+  for (std::string_view field : split_commas(*header)) names.emplace_back(field);
   for (std::size_t i = 0; i < names.size(); ++i) {
     std::optional<std::size_t> slot;
     if (names[i] == "t") slot = 0;
@@ -179,10 +202,11 @@ std::vector<GloveSample> read_openxr(std::istream& in, std::string_view name) {
       }
     }
     if (!slot) {
-      if (parse_number(names[i])) reader.fail("expected a header row naming the columns, found numbers");
-      reader.fail("unknown column " + quoted(names[i]));
+      if (parse_number(names[i]))
+        reader.fail("expected a header row naming the columns, found numbers");
+      reader.fail("unknown column " + interaction::quoted(names[i]));
     }
-    if (seen[*slot]) reader.fail("column " + quoted(names[i]) + " appears twice");
+    if (seen[*slot]) reader.fail("column " + interaction::quoted(names[i]) + " appears twice");
     seen[*slot] = true;
     column_of[*slot] = i;
   }
@@ -205,15 +229,19 @@ std::vector<GloveSample> read_openxr(std::istream& in, std::string_view name) {
     for (std::size_t k = 0; k < kColumns; ++k) {
       const std::string_view field = fields[column_of[k]];
       const std::optional<Real> number = parse_number(field);
-      if (!number) reader.fail("column " + quoted(names[column_of[k]]) + ": " + quoted(field) + " is not a number");
-      if (!std::isfinite(*number)) reader.fail("column " + quoted(names[column_of[k]]) + ": " + quoted(field) + " is not finite");
+      if (!number)
+        reader.fail("column " + interaction::quoted(names[column_of[k]]) + ": " + quoted(field) +
+                    " is not a number");
+      if (!std::isfinite(*number))
+        reader.fail("column " + interaction::quoted(names[column_of[k]]) + ": " + quoted(field) +
+                    " is not finite");
       v[k] = *number;
     }
     XrHandFrame frame;
     frame.t = v[0];
     if (!samples.empty() && !(frame.t > samples.back().t)) {
-      reader.fail("time does not increase: t = " + format_number(frame.t) + " after t = " +
-                  format_number(samples.back().t));
+      reader.fail("time does not increase: t = " + format_number(frame.t) +
+                  " after t = " + format_number(samples.back().t));
     }
     for (std::size_t j = 0; j < kXrJointCount; ++j) {
       const Real* p = &v[1 + 7 * j];

@@ -38,14 +38,17 @@ class FallingHand final : public GloveSource {
   Real y0_, speed_;
 };
 
-/// A slab under the whole hand: top face y = 0, bottom y = -0.02.
+/// A box under the whole hand, 2 mm thick (thinner than every segment, so a
+/// segment passing through always crosses its surface: a segment wholly inside
+/// a part crosses no surface and has no contact): top face y = 0, bottom y = -0.002.
+constexpr Real kSlabBottom = -0.002;
 engine::Scene slab_scene() {
   engine::Scene scene;
   scene.add_part({.name = "slab",
-                  .X_PC = {collision::Mat3::Identity(), Vec3(0, -0.01, -0.1)},
+                  .X_PC = {collision::Mat3::Identity(), Vec3(0, -0.001, -0.1)},
                   .movable = false,
                   .render_mesh = std::make_shared<const collision::Mesh>(
-                      collision::make_box(Vec3(0.2, 0.01, 0.2)))});
+                      collision::make_box(Vec3(0.2, 0.001, 0.2)))});
   return scene;
 }
 
@@ -69,10 +72,10 @@ TEST(InvisibleHand, OpenHandThroughABoxTouchesEachSegmentInTheExpectedFrames) {
     }
     std::uint64_t begin = 0, end = 0;
     while (source->y_at(static_cast<Real>(begin) * kDt) + low > 0) ++begin;
-    while (source->y_at(static_cast<Real>(end) * kDt) + high >= -0.02) ++end;
+    while (source->y_at(static_cast<Real>(end) * kDt) + high >= kSlabBottom) ++end;
     // No frame lands within rounding of touching, so the expectation is sharp.
     ASSERT_GT(std::abs(source->y_at(static_cast<Real>(begin) * kDt) + low), 1e-9);
-    ASSERT_GT(std::abs(source->y_at(static_cast<Real>(end) * kDt) + high + 0.02), 1e-9);
+    ASSERT_GT(std::abs(source->y_at(static_cast<Real>(end) * kDt) + high - kSlabBottom), 1e-9);
     expected[std::string(segment_name(segment))] = {begin, end};
   }
 
@@ -162,9 +165,9 @@ struct RunResult {
 
 RunResult run_hand(std::shared_ptr<const GloveSource> source, int threads, Real time_step,
                    std::uint64_t frames) {
-  engine::Simulation sim(blocks_scene(),
-                         {.time_step = time_step, .collision_threads = threads,
-                          .contacts = collision::ContactDetail::kTriangles});
+  engine::Simulation sim(blocks_scene(), {.time_step = time_step,
+                                          .collision_threads = threads,
+                                          .contacts = collision::ContactDetail::kTriangles});
   Hand hand(sim, std::move(source));
   sim.run(frames);
   return {sim.state_hash(), sim.report().events, hand.recorded()};

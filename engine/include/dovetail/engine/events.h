@@ -20,19 +20,19 @@ namespace dovetail::engine {
 /// What happened. The order of the enumerators is the delivery order within
 /// a frame; kinds after kRegionLeave are produced by the interaction layer.
 enum class EventKind : std::uint8_t {
-  kTimer,         ///< a timer fired: a = timer name
-  kPartMoved,     ///< a part's world pose changed: a = part
-  kContactBegin,  ///< a and b (a < b by name) touch now, not in the last frame
-  kContactEnd,    ///< a and b touched in the last frame, not now
-  kRegionEnter,   ///< part a entered region b
-  kRegionLeave,   ///< part a left region b
+  kTimer,             ///< a timer fired: a = timer name
+  kPartMoved,         ///< a part's world pose changed: a = part
+  kContactBegin,      ///< a and b (a < b by name) touch now, not in the last frame
+  kContactEnd,        ///< a and b touched in the last frame, not now
+  kRegionEnter,       ///< part a entered region b
+  kRegionLeave,       ///< part a left region b
   kHandContactBegin,  ///< hand segment a (`index_distal`, `palm`, ...) touches part b now
   kHandContactEnd,    ///< hand segment a touched part b in the last frame, not now
-  kGrasp,         ///< reserved: the hand grasped part a
-  kRelease,       ///< reserved: the hand released part a
-  kSlideBegin,    ///< reserved: part a began sliding on part b
-  kSlideEnd,      ///< reserved: part a stopped sliding on part b
-  kMate,          ///< reserved: part a snapped onto part b
+  kGrasp,             ///< reserved: the hand grasped part a
+  kRelease,           ///< reserved: the hand released part a
+  kSlideBegin,        ///< reserved: part a began sliding on part b
+  kSlideEnd,          ///< reserved: part a stopped sliding on part b
+  kMate,              ///< reserved: part a snapped onto part b
 };
 
 /// Number of event kinds.

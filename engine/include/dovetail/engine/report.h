@@ -50,7 +50,7 @@ struct Report {
   /// Things a reader should know (a joint angle clamped to its limit, ...),
   /// in the order noticed.
   std::vector<std::string> notes;
-  std::vector<FrameTiming> timings;        ///< one per frame
+  std::vector<FrameTiming> timings;  ///< one per frame
 
   /// The report as JSON (see docs/engine.md); with_timings appends the
   /// non-deterministic "timings" section.

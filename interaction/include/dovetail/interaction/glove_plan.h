@@ -12,7 +12,8 @@
 /// `wait` holds. The fingers and the tracker move independently: `reach`
 /// and `path` keep the posture, `close` and `open` keep the pose.
 ///
-/// Text format, one step per line, `#` starts a comment line:
+/// Text format, one step per line; `#` starts a comment that runs to the end
+/// of the line, and blank lines are skipped:
 ///
 ///     start X Y Z QW QX QY QZ [POSTURE]    # optional, first: the pose at t = 0
 ///     reach DURATION X Y Z QW QX QY QZ
@@ -22,8 +23,16 @@
 ///     open DURATION
 ///     wait DURATION
 ///
+/// The POSTURE of `start` is a name or 22 angles, as for `close`; without it
+/// the hand starts open. Without `start` the hand starts at the origin with
+/// the identity orientation. Quaternions are normalised on reading.
+///
 /// Positions in metres, durations in seconds (>= 0, finite). Errors name the
-/// file and the line (`plan.txt:3: ...`).
+/// file and the line (`plan.txt:3: ...`): an unknown keyword, a wrong number
+/// of fields, a field that is not a number or not finite, a negative
+/// duration, a zero quaternion, an unknown posture, a `start` that is not the
+/// first step or comes twice; a plan without steps is refused
+/// (`plan.txt: plan has no steps`).
 
 #include <filesystem>
 #include <iosfwd>
@@ -58,7 +67,7 @@ struct PlanStep {
 
 /// What the simulated glove does, from t = 0.
 struct GlovePlan {
-  TrackerPose start{};         ///< the pose at t = 0
+  TrackerPose start{};          ///< the pose at t = 0
   JointAngles start_posture{};  ///< the angles at t = 0 (the open hand)
   std::vector<PlanStep> steps{};
   /// Sum of the steps' durations.

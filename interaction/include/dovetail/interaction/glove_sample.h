@@ -74,10 +74,10 @@ inline Real at(const JointAngles& angles, Joint joint) {
 
 /// One glove and tracker reading.
 struct GloveSample {
-  Real t = 0;                          ///< seconds
-  Vec3 p_WH = Vec3::Zero();            ///< tracker (hand frame H) position in the world, metres
-  Quaternion q_WH{};                   ///< tracker orientation; need not be unit length
-  JointAngles joints{};                ///< degrees
+  Real t = 0;                ///< seconds
+  Vec3 p_WH = Vec3::Zero();  ///< tracker (hand frame H) position in the world, metres
+  Quaternion q_WH{};         ///< tracker orientation; need not be unit length
+  JointAngles joints{};      ///< degrees
   /// The hand's pose in the world: the normalised quaternion's rotation and p_WH.
   Transform X_WH() const;
 };

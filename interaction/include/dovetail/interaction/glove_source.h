@@ -25,7 +25,7 @@ class GloveSource {
   /// The sample at time t; its `t` is t. A pure function of t.
   virtual GloveSample sample(Real t) const = 0;
   /// The time after which the source does not change any more (the end of
-  /// a trace or a plan).
+  /// a trace or a plan; NoisyGlove: only its noise changes after it).
   virtual Real end_time() const = 0;
 };
 
@@ -47,30 +47,41 @@ class TraceSource final : public GloveSource {
 };
 
 /// The simulated glove: a GlovePlan turned into samples (see glove_plan.h
-/// for how each step moves the hand).
+/// for how each step moves the hand). Before t = 0 the start is held, after
+/// the plan's end its final state. At a step's start the pose and the angles
+/// are those the previous steps ended on, bit for bit; a step of zero duration
+/// jumps. Quaternions need not be unit length: they are normalised for slerp,
+/// and the ends of a move keep them as given.
 class SimulatedGlove final : public GloveSource {
  public:
+  /// Throws std::invalid_argument for a negative or non-finite duration (or a
+  /// total that overflows), a reach without exactly one pose or a path without poses.
   explicit SimulatedGlove(GlovePlan plan);
   GloveSample sample(Real t) const override;
+  /// The plan's duration.
   Real end_time() const override;
   const GlovePlan& plan() const { return plan_; }
 
  private:
   GlovePlan plan_;
-  std::vector<Real> step_start_;  ///< start time of each step
+  // Entry i is where step i starts; entry steps.size() is the end of the plan,
+  // so sample(t) finds its step by binary search and needs no earlier step.
+  std::vector<Real> step_start_;            ///< start time of each step, then the end
+  std::vector<TrackerPose> start_pose_;     ///< the pose at each of those times
+  std::vector<JointAngles> start_posture_;  ///< the angles at each of those times
 };
 
 /// How a real glove and tracker distort what the hand does. The defaults are
 /// typical of a CyberGlove with a magnetic tracker (see docs/interaction.md).
 struct GloveNoise {
   std::uint64_t seed = 1;
-  Real joint_sigma_deg = 0.5;      ///< white noise per joint and reading
-  Real donning_sigma_deg = 3.0;    ///< offset per joint, drawn once (glove put on)
-  Real degrees_per_count = 1.0;    ///< 8-bit quantisation step; 0: none
-  Real position_sigma_m = 0.001;   ///< tracker position noise per axis
+  Real joint_sigma_deg = 0.5;         ///< white noise per joint and reading
+  Real donning_sigma_deg = 3.0;       ///< offset per joint, drawn once (glove put on)
+  Real degrees_per_count = 1.0;       ///< 8-bit quantisation step; 0: none
+  Real position_sigma_m = 0.001;      ///< tracker position noise per axis
   Real orientation_sigma_deg = 0.15;  ///< tracker orientation noise (rotation vector per axis)
-  Real rate_hz = 120;              ///< the glove's own reading rate; held between readings
-  Real latency_s = 0.005;          ///< a reading reaches the simulation this much later
+  Real rate_hz = 120;                 ///< the glove's own reading rate; held between readings
+  Real latency_s = 0.005;             ///< a reading reaches the simulation this much later
 };
 
 /// A source seen through a real glove: the inner source is read at the
@@ -78,12 +89,26 @@ struct GloveNoise {
 /// by the latency and held until the next one arrives, and noise is added.
 /// The noise of reading k depends only on (seed, k, channel), never on the
 /// order of calls, so the source stays a pure function of time.
+///
+/// At time t the output is reading k, the largest k >= 0 with
+/// k / rate_hz + latency_s <= t, both sides evaluated in double exactly as
+/// written (so at t = k / rate_hz + latency_s reading k has arrived, even
+/// where (t - latency_s) * rate_hz rounds below k); before reading 0 arrives
+/// it is shown all the same. Each joint is the inner angle plus its donning
+/// offset plus white noise, then rounded to the nearest multiple of
+/// degrees_per_count; the position gets noise per axis; the orientation is
+/// turned by a small rotation in the world frame (q_WH becomes dq * q_WH)
+/// whose rotation vector has the noise per axis. A sigma of 0 leaves its
+/// field's bits alone. Gaussians come from splitmix64 and Box-Muller, the same
+/// numbers wherever the C library's log, cos and sin agree.
 class NoisyGlove final : public GloveSource {
  public:
   /// Throws std::invalid_argument for a null source, a rate <= 0, or a
   /// negative or non-finite sigma or latency.
   NoisyGlove(std::shared_ptr<const GloveSource> inner, const GloveNoise& noise = {});
   GloveSample sample(Real t) const override;
+  /// When the first reading taken at or after the inner source's end arrives;
+  /// later readings see a hand that no longer moves, but their noise differs.
   Real end_time() const override;
 
  private:

@@ -12,11 +12,19 @@
 /// so writing then reading gives the same samples bit for bit, and reading
 /// then writing a written trace gives the same bytes.
 ///
+/// Lines end in '\n' or "\r\n". Blank lines and lines whose first non-blank
+/// is `#` are skipped anywhere; the header is the first other line. Blanks
+/// around a field are ignored, a number may start with '+', and one too small
+/// for a double reads as the nearest subnormal or zero. A writer writes no
+/// comments, no blanks and no '\r'.
+///
 /// Errors name the file and the line (`trace.csv:12: ...`): a missing,
 /// unknown or duplicated column, a row with too few or too many fields, a
 /// field that is not a number or not finite, a zero quaternion, time that does
-/// not increase, a file without a header or without samples, a line longer
-/// than kMaxTraceLineBytes (detected without reading the rest of the line).
+/// not increase, numbers where the header belongs, a header without samples
+/// (named at the header's line), a line longer than kMaxTraceLineBytes
+/// (detected without reading the rest of the line). A file with no header
+/// at all gives `trace.csv: empty, no header`.
 
 #include <cstddef>
 #include <filesystem>
@@ -50,7 +58,9 @@ std::vector<GloveSample> read_trace(std::istream& in, std::string_view name);
 /// a directory, unreadable, or bad.
 std::vector<GloveSample> read_trace(const std::filesystem::path& path);
 
-/// The header row and one row per sample, each ending in '\n'.
+/// The header row and one row per sample, each ending in '\n'. The samples
+/// are not checked: ones that read_trace refuses (none, non-finite values, a
+/// zero quaternion, time that does not increase) are written as they are.
 std::string format_trace(std::span<const GloveSample> samples);
 /// Writes format_trace to `path`; throws TraceError naming it on failure.
 void write_trace(const std::filesystem::path& path, std::span<const GloveSample> samples);

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "dovetail/engine/render.h"
 #include "dovetail/engine/simulation.h"
 #include "dovetail/interaction/glove_source.h"
 #include "dovetail/interaction/hand_model.h"
@@ -28,6 +29,12 @@ namespace dovetail::interaction {
 /// The colour of the hand in renders (a light skin tone, unlike every
 /// palette colour and the highlight).
 inline constexpr std::array<float, 3> kHandColor = {0.96F, 0.76F, 0.62F};
+
+/// The hand of one glove sample as render items, one per segment named
+/// `<name>.<segment>` in kHandColor, the angles clamped to their limits: for
+/// drawing the hand without a simulation (`dovetail render --trace`).
+std::vector<engine::RenderItem> hand_render_items(const HandModel& model, const GloveSample& sample,
+                                                  const std::string& name = "hand");
 
 /// How to put a hand into a simulation.
 struct HandSettings {
@@ -48,7 +55,9 @@ class Hand {
   /// engine::SceneError when a segment's name is taken, std::invalid_argument
   /// for a null source or a bad hand definition.
   Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> source,
-       const HandSettings& settings = {});
+       const HandSettings& settings);
+  /// A hand with the default settings.
+  Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> source);
   Hand(const Hand&) = delete;
   Hand& operator=(const Hand&) = delete;
 

@@ -97,9 +97,9 @@ struct HandDef {
 struct HandProportions {
   /// Metacarpal, proximal, intermediate, distal of index..pinky (Buchholz et al. 1992).
   static constexpr std::array<std::array<Real, 4>, 4> kFinger = {{{0.374, 0.265, 0.143, 0.097},
-                                                                 {0.373, 0.277, 0.170, 0.108},
-                                                                 {0.336, 0.259, 0.165, 0.107},
-                                                                 {0.295, 0.206, 0.117, 0.093}}};
+                                                                  {0.373, 0.277, 0.170, 0.108},
+                                                                  {0.336, 0.259, 0.165, 0.107},
+                                                                  {0.295, 0.206, 0.117, 0.093}}};
   /// Thumb metacarpal, proximal, distal.
   static constexpr std::array<Real, 3> kThumb = {0.251, 0.196, 0.158};
   /// Wrist crease to the carpometacarpal joints: the rest of the hand

@@ -1,0 +1,189 @@
+/// \file glove_command.cpp
+/// `dovetail glove`: the glove tools users need before scenarios exist:
+/// convert a CyberGlove or OpenXR recording to a glove trace, turn a
+/// simulated-glove plan into a trace, check a trace.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli.h"
+#include "commands.h"
+#include "dovetail/interaction/cyberglove.h"
+#include "dovetail/interaction/glove_plan.h"
+#include "dovetail/interaction/glove_source.h"
+#include "dovetail/interaction/glove_trace.h"
+#include "dovetail/interaction/openxr_hand.h"
+
+namespace dovetail::cli {
+
+namespace {
+
+using interaction::GloveSample;
+
+constexpr const char* kHelp =
+    R"(usage: dovetail glove convert --cyberglove RAW --calibration CAL --out TRACE
+       dovetail glove convert --openxr JOINTS --out TRACE
+       dovetail glove plan PLAN --out TRACE [--rate HZ] [--noise] [--seed N]
+       dovetail glove check TRACE
+
+Glove traces (CSV: t, x y z, qw qx qy qz, 22 joint angles; see docs/cli.md).
+
+  convert        a recording made elsewhere to a glove trace:
+    --cyberglove RAW     CyberGlove rows `t` + 22 raw counts in the glove's native
+                         order [+ x y z qw qx qy qz], with
+    --calibration CAL    22 rows `GAIN OFFSET` (or a row of A and b): angle = A raw + b
+    --openxr JOINTS      OpenXR hand-joint poses (26 joints: J_px J_py J_pz J_qx J_qy
+                         J_qz J_qw per joint), converted to the 22 angles
+  plan           samples a simulated-glove plan (docs/interaction.md) into a trace
+    --rate HZ            samples per second (default 90)
+    --noise              through the glove noise and latency model (defaults of
+                         docs/interaction.md), seeded by
+    --seed N             (default 1)
+  check          reads a trace and reports its samples, duration and rate
+  --out TRACE    the trace to write
+
+Bad input gives an error naming the file and the line and exit code 1. Prints a
+one-line JSON summary on standard output.
+)";
+
+void print_summary(const std::string& action, const std::vector<GloveSample>& samples,
+                   const std::string& out) {
+  JsonLine json;
+  json.add("action", action).add("samples", std::uint64_t{samples.size()});
+  const double duration = samples.empty() ? 0 : samples.back().t - samples.front().t;
+  json.add("start", samples.empty() ? 0.0 : samples.front().t).add("duration", duration);
+  if (samples.size() >= 2) {
+    std::vector<double> gaps;
+    for (std::size_t i = 1; i < samples.size(); ++i)
+      gaps.push_back(samples[i].t - samples[i - 1].t);
+    std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2),
+                     gaps.end());
+    json.add("rate_hz_median", 1 / gaps[gaps.size() / 2]);
+  }
+  if (!out.empty()) json.add("out", out);
+  std::fputs((json.str() + "\n").c_str(), stdout);
+}
+
+/// Runs a reader or writer, turning the interaction layer's errors into InputError.
+template <typename F>
+auto input_step(F&& step) {
+  try {
+    return step();
+  } catch (const interaction::TraceError& e) {
+    throw InputError(e.what());
+  } catch (const interaction::PlanError& e) {
+    throw InputError(e.what());
+  }
+}
+
+int convert(std::span<const std::string> argv) {
+  const Args args("glove convert", argv, {"cyberglove", "calibration", "openxr", "out"}, {});
+  if (args.help()) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  args.expect_positional(0, "no positional arguments");
+  const std::string out = args.required("out");
+  const auto raw = args.value("cyberglove");
+  const auto xr = args.value("openxr");
+  if (raw.has_value() == xr.has_value()) {
+    throw UsageError("glove convert: give one of --cyberglove RAW or --openxr JOINTS");
+  }
+  std::vector<GloveSample> samples;
+  if (raw) {
+    const std::string calibration = args.required("calibration");
+    const std::string inputs[] = {*raw, calibration};
+    refuse_overwriting_input("glove convert", out, inputs);
+    samples = input_step([&] {
+      return interaction::read_cyberglove_raw(*raw, interaction::read_calibration(calibration));
+    });
+  } else {
+    if (args.value("calibration")) {
+      throw UsageError("glove convert: --calibration belongs to --cyberglove");
+    }
+    const std::string inputs[] = {*xr};
+    refuse_overwriting_input("glove convert", out, inputs);
+    samples = input_step([&] { return interaction::read_openxr(*xr); });
+  }
+  input_step([&] {
+    interaction::write_trace(out, samples);
+    return 0;
+  });
+  print_summary(raw ? "convert_cyberglove" : "convert_openxr", samples, out);
+  return kExitOk;
+}
+
+int plan(std::span<const std::string> argv) {
+  const Args args("glove plan", argv, {"out", "rate", "seed"}, {"noise"});
+  if (args.help()) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  args.expect_positional(1, "one plan file PLAN");
+  const std::string& path = args.positional()[0];
+  const std::string out = args.required("out");
+  const double rate = args.number("rate", 1e-3).value_or(90);
+  if (!(rate > 0) || rate > 1e5) throw UsageError("glove plan: --rate must be in (0, 100000] Hz");
+  const std::string inputs[] = {path};
+  refuse_overwriting_input("glove plan", out, inputs);
+
+  std::shared_ptr<const interaction::GloveSource> source =
+      std::make_shared<interaction::SimulatedGlove>(
+          input_step([&] { return interaction::read_plan(std::filesystem::path(path)); }));
+  if (args.flag("noise")) {
+    interaction::GloveNoise noise;
+    noise.seed = args.unsigned_integer("seed").value_or(1);
+    source = std::make_shared<interaction::NoisyGlove>(source, noise);
+  } else if (args.value("seed")) {
+    throw UsageError("glove plan: --seed needs --noise");
+  }
+  const double end = source->end_time();
+  const auto count = static_cast<std::uint64_t>(std::floor(end * rate + 1e-9)) + 1;
+  if (count > 100'000'000) throw UsageError("glove plan: more than 10^8 samples; lower --rate");
+  std::vector<GloveSample> samples;
+  samples.reserve(count);
+  for (std::uint64_t k = 0; k < count; ++k) {
+    samples.push_back(source->sample(static_cast<double>(k) / rate));
+  }
+  input_step([&] {
+    interaction::write_trace(out, samples);
+    return 0;
+  });
+  print_summary("plan", samples, out);
+  return kExitOk;
+}
+
+int check(std::span<const std::string> argv) {
+  const Args args("glove check", argv, {}, {});
+  if (args.help()) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  args.expect_positional(1, "one trace file TRACE");
+  const auto samples = input_step(
+      [&] { return interaction::read_trace(std::filesystem::path(args.positional()[0])); });
+  print_summary("check", samples, "");
+  return kExitOk;
+}
+
+}  // namespace
+
+int glove_command(std::span<const std::string> argv) {
+  if (argv.empty()) throw UsageError("glove: expected an action: convert, plan or check");
+  const std::string& action = argv[0];
+  if (action == "--help" || action == "-h") {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  const auto rest = argv.subspan(1);
+  if (action == "convert") return convert(rest);
+  if (action == "plan") return plan(rest);
+  if (action == "check") return check(rest);
+  throw UsageError("glove: unknown action '" + action + "' (convert, plan, check)");
+}
+
+}  // namespace dovetail::cli

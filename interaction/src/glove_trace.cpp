@@ -1,0 +1,190 @@
+#include "dovetail/interaction/glove_trace.h"
+
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <optional>
+
+#include "text_reading.h"
+
+namespace dovetail::interaction {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::size_t kColumnCount = 8 + kJointCount;
+constexpr std::size_t kFirstJointColumn = 8;
+
+const std::array<std::string_view, kColumnCount>& column_names() {
+  static const std::array<std::string_view, kColumnCount> names = [] {
+    std::array<std::string_view, kColumnCount> all = {"t", "x", "y", "z", "qw", "qx", "qy", "qz"};
+    for (std::size_t k = 0; k < kJointCount; ++k) {
+      all[kFirstJointColumn + k] = joint_name(static_cast<Joint>(k));
+    }
+    return all;
+  }();
+  return names;
+}
+
+std::optional<std::size_t> column_index(std::string_view name) {
+  const auto& names = column_names();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == name) return i;
+  }
+  return std::nullopt;
+}
+
+/// The comma-separated fields of `line`, each without surrounding blanks.
+void split_commas(std::string_view line, std::vector<std::string_view>& fields) {
+  fields.clear();
+  while (true) {
+    const std::size_t comma = line.find(',');
+    fields.push_back(trim_blanks(line.substr(0, comma)));
+    if (comma == std::string_view::npos) return;
+    line.remove_prefix(comma + 1);
+  }
+}
+
+/// For each field of the header, the canonical column it holds.
+std::vector<std::size_t> parse_header(const LineReader& reader, std::string_view line) {
+  std::vector<std::string_view> fields;
+  split_commas(line, fields);
+  for (std::size_t f = 0; f < fields.size(); ++f) {
+    if (parse_number(fields[f])) {
+      reader.fail("expected a header row naming the columns, found the number " +
+                  quoted(fields[f]) + " in field " + std::to_string(f + 1));
+    }
+  }
+  std::array<std::size_t, kColumnCount> field_of_column{};  // 1-based; 0 = not seen
+  std::vector<std::size_t> column_of_field;
+  for (std::size_t f = 0; f < fields.size(); ++f) {
+    const std::optional<std::size_t> column = column_index(fields[f]);
+    if (!column) {
+      if (fields[f].empty()) reader.fail("field " + std::to_string(f + 1) + " names no column");
+      reader.fail("unknown column " + quoted(fields[f]) + " (field " + std::to_string(f + 1) + ")");
+    }
+    if (field_of_column[*column] != 0) {
+      reader.fail("duplicated column " + quoted(fields[f]) + " (fields " +
+                  std::to_string(field_of_column[*column]) + " and " + std::to_string(f + 1) + ")");
+    }
+    field_of_column[*column] = f + 1;
+    column_of_field.push_back(*column);
+  }
+  std::string missing;
+  for (std::size_t c = 0; c < kColumnCount; ++c) {
+    if (field_of_column[c] != 0) continue;
+    if (!missing.empty()) missing += ", ";
+    missing += column_names()[c];
+  }
+  if (!missing.empty()) reader.fail("missing columns: " + missing);
+  return column_of_field;
+}
+
+GloveSample parse_row(const LineReader& reader, std::string_view line,
+                      const std::vector<std::size_t>& column_of_field,
+                      std::vector<std::string_view>& fields) {
+  split_commas(line, fields);
+  if (fields.size() != kColumnCount) {
+    reader.fail("expected " + std::to_string(kColumnCount) + " fields, found " +
+                std::to_string(fields.size()));
+  }
+  std::array<Real, kColumnCount> values{};
+  for (std::size_t f = 0; f < fields.size(); ++f) {
+    const auto where = [&] {
+      return "column " + std::string(column_names()[column_of_field[f]]) + " (field " +
+             std::to_string(f + 1) + ")";
+    };
+    const std::optional<Real> value = parse_number(fields[f]);
+    if (!value) {
+      if (fields[f].empty()) reader.fail(where() + " is empty");
+      reader.fail(where() + ": " + quoted(fields[f]) + " is not a number");
+    }
+    if (!std::isfinite(*value)) reader.fail(where() + ": " + quoted(fields[f]) + " is not finite");
+    values[column_of_field[f]] = *value;
+  }
+  GloveSample sample;
+  sample.t = values[0];
+  sample.p_WH = Vec3(values[1], values[2], values[3]);
+  sample.q_WH = {values[4], values[5], values[6], values[7]};
+  for (std::size_t k = 0; k < kJointCount; ++k) sample.joints[k] = values[kFirstJointColumn + k];
+  if (sample.q_WH.w == 0 && sample.q_WH.x == 0 && sample.q_WH.y == 0 && sample.q_WH.z == 0) {
+    reader.fail("quaternion (qw qx qy qz) is zero");
+  }
+  return sample;
+}
+
+}  // namespace
+
+std::span<const std::string_view> trace_columns() { return column_names(); }
+
+std::vector<GloveSample> read_trace(std::istream& in, std::string_view name) {
+  LineReader reader(in, name);
+  const std::optional<std::string_view> header = reader.next_content();
+  if (!header) throw TraceError(std::string(name) + ": empty, no header");
+  const std::size_t header_line = reader.line();
+  const std::vector<std::size_t> column_of_field = parse_header(reader, *header);
+
+  std::vector<GloveSample> samples;
+  std::vector<std::string_view> fields;
+  std::size_t previous_line = 0;
+  while (const std::optional<std::string_view> line = reader.next_content()) {
+    GloveSample sample = parse_row(reader, *line, column_of_field, fields);
+    if (!samples.empty() && !(sample.t > samples.back().t)) {
+      reader.fail("time does not increase: t = " + format_number(sample.t) + " after t = " +
+                  format_number(samples.back().t) + " on line " + std::to_string(previous_line));
+    }
+    previous_line = reader.line();
+    samples.push_back(sample);
+  }
+  if (samples.empty()) {
+    throw TraceError(std::string(name) + ":" + std::to_string(header_line) +
+                     ": header but no samples");
+  }
+  return samples;
+}
+
+std::vector<GloveSample> read_trace(const fs::path& path) {
+  std::ifstream in = open_for_reading(path);
+  return read_trace(in, path.string());
+}
+
+std::string format_trace(std::span<const GloveSample> samples) {
+  std::string text;
+  // Up to 24 characters a number and a separator.
+  text.reserve((samples.size() + 1) * kColumnCount * 25);
+  for (std::size_t c = 0; c < kColumnCount; ++c) {
+    text += column_names()[c];
+    text += c + 1 < kColumnCount ? ',' : '\n';
+  }
+  for (const GloveSample& sample : samples) {
+    for (Real value : {sample.t, sample.p_WH.x(), sample.p_WH.y(), sample.p_WH.z(), sample.q_WH.w,
+                       sample.q_WH.x, sample.q_WH.y, sample.q_WH.z}) {
+      append_number(text, value);
+      text += ',';
+    }
+    for (std::size_t k = 0; k < kJointCount; ++k) {
+      append_number(text, sample.joints[k]);
+      text += k + 1 < kJointCount ? ',' : '\n';
+    }
+  }
+  return text;
+}
+
+void write_trace(const fs::path& path, std::span<const GloveSample> samples) {
+  const std::string text = format_trace(samples);
+  const auto cannot_be_written = [&] {
+    const std::string reason = errno != 0 ? std::strerror(errno) : "write failed";
+    return TraceError(path.string() + ": cannot be written: " + reason);
+  };
+  errno = 0;
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw cannot_be_written();
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+  out.close();
+  if (!out) throw cannot_be_written();
+}
+
+}  // namespace dovetail::interaction

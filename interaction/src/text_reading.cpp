@@ -1,0 +1,112 @@
+#include "text_reading.h"
+
+#include <cerrno>
+#include <charconv>
+#include <cstdlib>
+#include <cstring>
+#include <system_error>
+
+#include "dovetail/interaction/glove_trace.h"
+
+namespace dovetail::interaction {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+}  // namespace
+
+// Room for the longest line, a '\r' and the NUL that getline stores.
+LineReader::LineReader(std::istream& in, std::string_view name)
+    : in_(in), name_(name), buffer_(kMaxTraceLineBytes + 2) {}
+
+std::optional<std::string_view> LineReader::next() {
+  in_.getline(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+  const std::size_t extracted = static_cast<std::size_t>(in_.gcount());
+  if (in_.bad() || (in_.fail() && extracted == 0 && !in_.eof())) {
+    throw TraceError(name_ + ": read error after line " + std::to_string(line_));
+  }
+  if (in_.fail() && extracted == 0) return std::nullopt;
+  ++line_;
+  // failbit with characters extracted: the buffer filled before the line ended.
+  if (in_.fail()) fail("line longer than " + std::to_string(kMaxTraceLineBytes) + " bytes");
+  const bool ended_by_newline = !in_.eof();
+  std::size_t length = ended_by_newline ? extracted - 1 : extracted;
+  if (length > 0 && buffer_[length - 1] == '\r') --length;
+  if (length > kMaxTraceLineBytes) {
+    fail("line longer than " + std::to_string(kMaxTraceLineBytes) + " bytes");
+  }
+  return std::string_view(buffer_.data(), length);
+}
+
+std::optional<std::string_view> LineReader::next_content() {
+  while (std::optional<std::string_view> text = next()) {
+    if (!is_blank_or_comment(*text)) return text;
+  }
+  return std::nullopt;
+}
+
+void LineReader::fail(const std::string& what) const {
+  throw TraceError(name_ + ":" + std::to_string(line_) + ": " + what);
+}
+
+bool is_blank_or_comment(std::string_view line) {
+  const std::string_view content = trim_blanks(line);
+  return content.empty() || content.front() == '#';
+}
+
+std::string_view trim_blanks(std::string_view text) {
+  while (!text.empty() && is_blank(text.front())) text.remove_prefix(1);
+  while (!text.empty() && is_blank(text.back())) text.remove_suffix(1);
+  return text;
+}
+
+std::optional<Real> parse_number(std::string_view token) {
+  const char* first = token.data();
+  const char* last = token.data() + token.size();
+  if (first != last && *first == '+') ++first;
+  Real value = 0;
+  const auto [ptr, ec] = std::from_chars(first, last, value);
+  if (ptr != last || first == last) return std::nullopt;
+  if (ec == std::errc::result_out_of_range) {
+    // Overflow becomes infinity (refused later as not finite); underflow to a
+    // subnormal or zero is a number.
+    return std::strtod(std::string(first, last).c_str(), nullptr);
+  }
+  if (ec != std::errc()) return std::nullopt;
+  return value;
+}
+
+std::string quoted(std::string_view token) {
+  constexpr std::size_t kMax = 40;
+  std::string text = "'";
+  text.append(token.substr(0, kMax));
+  text.append(token.size() > kMax ? "...'" : "'");
+  return text;
+}
+
+void append_number(std::string& out, Real value) {
+  char buffer[32];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  out.append(buffer, end);
+}
+
+std::string format_number(Real value) {
+  std::string text;
+  append_number(text, value);
+  return text;
+}
+
+std::ifstream open_for_reading(const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status)) throw TraceError(path.string() + ": file not found");
+  if (fs::is_directory(status)) throw TraceError(path.string() + ": is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw TraceError(path.string() + ": cannot be opened: " + std::strerror(errno));
+  return in;
+}
+
+}  // namespace dovetail::interaction
