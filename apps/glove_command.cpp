@@ -62,7 +62,8 @@ void print_summary(const std::string& action, const std::vector<GloveSample>& sa
       gaps.push_back(samples[i].t - samples[i - 1].t);
     std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2),
                      gaps.end());
-    json.add("rate_hz_median", 1 / gaps[gaps.size() / 2]);
+    // Rounded to a millionth of a hertz: 1 / (1 / 120.0) is not quite 120.
+    json.add("rate_hz_median", std::round(1e6 / gaps[gaps.size() / 2]) / 1e6);
   }
   if (!out.empty()) json.add("out", out);
   std::fputs((json.str() + "\n").c_str(), stdout);
