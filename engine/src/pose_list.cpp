@@ -36,8 +36,15 @@ std::string shown(std::string_view token) {
   return std::string(token.substr(0, kMax)) + "...";
 }
 
-/// The whole token as a double, or nullopt when it is not a number.
-std::optional<Real> parse_number(std::string_view token) {
+std::string format_number(Real value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  return buffer;
+}
+
+}  // namespace
+
+std::optional<Real> parse_real(std::string_view token) {
   const char* first = token.data();
   const char* last = token.data() + token.size();
   if (first != last && *first == '+') ++first;
@@ -46,19 +53,11 @@ std::optional<Real> parse_number(std::string_view token) {
   if (ptr != last || first == last) return std::nullopt;
   if (ec == std::errc::result_out_of_range) {
     // Overflow is reported as not finite; underflow to zero or a subnormal is a number.
-    return std::strtod(std::string(token).c_str(), nullptr);
+    return std::strtod(std::string(first, last).c_str(), nullptr);
   }
   if (ec != std::errc()) return std::nullopt;
   return value;
 }
-
-std::string format_number(Real value) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.17g", value);
-  return buffer;
-}
-
-}  // namespace
 
 std::optional<Transform> parse_pose_line(std::string_view text, std::string_view where) {
   std::array<Real, 7> v{};
@@ -71,7 +70,7 @@ std::optional<Transform> parse_pose_line(std::string_view text, std::string_view
     const std::size_t start = i;
     while (i < text.size() && !is_blank(text[i])) ++i;
     const std::string_view token = text.substr(start, i - start);
-    const std::optional<Real> number = parse_number(token);
+    const std::optional<Real> number = parse_real(token);
     if (!number) {
       bad_line(where, "column " + std::to_string(column + 1) + " (" + kColumns[column] + ") '" +
                           shown(token) + "' is not a number");

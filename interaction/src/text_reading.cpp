@@ -6,6 +6,7 @@
 #include <cstring>
 #include <system_error>
 
+#include "dovetail/engine/pose_list.h"
 #include "dovetail/interaction/glove_trace.h"
 
 namespace dovetail::interaction {
@@ -63,21 +64,7 @@ std::string_view trim_blanks(std::string_view text) {
   return text;
 }
 
-std::optional<Real> parse_number(std::string_view token) {
-  const char* first = token.data();
-  const char* last = token.data() + token.size();
-  if (first != last && *first == '+') ++first;
-  Real value = 0;
-  const auto [ptr, ec] = std::from_chars(first, last, value);
-  if (ptr != last || first == last) return std::nullopt;
-  if (ec == std::errc::result_out_of_range) {
-    // Overflow becomes infinity (refused later as not finite); underflow to a
-    // subnormal or zero is a number.
-    return std::strtod(std::string(first, last).c_str(), nullptr);
-  }
-  if (ec != std::errc()) return std::nullopt;
-  return value;
-}
+std::optional<Real> parse_number(std::string_view token) { return engine::parse_real(token); }
 
 std::string quoted(std::string_view token) {
   constexpr std::size_t kMax = 40;

@@ -47,6 +47,12 @@ struct PoseEntry {
   std::size_t line = 0;
 };
 
+/// The whole token as a double, or nullopt when it is not a number: an
+/// optional leading '+', decimal or exponent form, `inf`/`nan` as from_chars
+/// reads them; overflow gives infinity, underflow the nearest subnormal or
+/// zero. The one number parser of the project's text formats.
+std::optional<collision::Real> parse_real(std::string_view token);
+
 /// Parses one line of a pose list. Returns nullopt for a blank or comment
 /// line; throws PoseListError with message `where: what` for a bad line.
 std::optional<collision::Transform> parse_pose_line(std::string_view text, std::string_view where);
