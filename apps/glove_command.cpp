@@ -143,8 +143,9 @@ int plan(std::span<const std::string> argv) {
     throw UsageError("glove plan: --seed needs --noise");
   }
   const double end = source->end_time();
+  // Checked as a double first: a plan of 1e300 s would not fit any integer.
+  if (!(end * rate < 1e8)) throw UsageError("glove plan: more than 10^8 samples; lower --rate");
   const auto count = static_cast<std::uint64_t>(std::floor(end * rate + 1e-9)) + 1;
-  if (count > 100'000'000) throw UsageError("glove plan: more than 10^8 samples; lower --rate");
   std::vector<GloveSample> samples;
   samples.reserve(count);
   for (std::uint64_t k = 0; k < count; ++k) {

@@ -57,14 +57,10 @@ int version_command(std::span<const std::string> args) {
 }
 
 constexpr Command kCommands[] = {
-    {"query", dovetail::cli::query_command},
-    {"inspect", dovetail::cli::inspect_command},
-    {"poses", dovetail::cli::poses_command},
-    {"run", dovetail::cli::run_command},
-    {"broadphase", dovetail::cli::broadphase_command},
-    {"render", dovetail::cli::render_command},
-    {"glove", dovetail::cli::glove_command},
-    {"version", version_command},
+    {"query", dovetail::cli::query_command},           {"inspect", dovetail::cli::inspect_command},
+    {"poses", dovetail::cli::poses_command},           {"run", dovetail::cli::run_command},
+    {"broadphase", dovetail::cli::broadphase_command}, {"render", dovetail::cli::render_command},
+    {"glove", dovetail::cli::glove_command},           {"version", version_command},
 };
 
 int dispatch(const std::vector<std::string>& args) {

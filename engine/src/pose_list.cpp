@@ -47,7 +47,10 @@ std::string format_number(Real value) {
 std::optional<Real> parse_real(std::string_view token) {
   const char* first = token.data();
   const char* last = token.data() + token.size();
-  if (first != last && *first == '+') ++first;
+  if (first != last && *first == '+') {
+    ++first;
+    if (first != last && (*first == '-' || *first == '+')) return std::nullopt;
+  }
   Real value = 0;
   const auto [ptr, ec] = std::from_chars(first, last, value);
   if (ptr != last || first == last) return std::nullopt;

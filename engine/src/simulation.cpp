@@ -243,6 +243,7 @@ const FrameResult& Simulation::step() {
     ++due;
   }
   commands_.erase(commands_.begin(), due);
+  if (hook_) hook_(*this, frame_, now);
   for (const FrameHook& hook : hooks_) hook(*this, frame_, now);
 
   // 4. Commit the poses.

@@ -70,6 +70,12 @@ GloveSample parse_raw_row(const LineReader& reader, const std::vector<std::strin
     }
   }
   sample.joints = calibrate(calibration, raw);
+  for (std::size_t k = 0; k < kJointCount; ++k) {
+    if (!std::isfinite(sample.joints[k])) {
+      reader.fail("the calibrated angle of " + std::string(joint_name(static_cast<Joint>(k))) +
+                  " (native sensor " + std::to_string(kNativeOfJoint[k]) + ") is not finite");
+    }
+  }
   if (fields.size() == kRawFieldsWithTracker) {
     constexpr std::array<std::string_view, 7> kTracker = {"x", "y", "z", "qw", "qx", "qy", "qz"};
     std::array<Real, 7> v{};

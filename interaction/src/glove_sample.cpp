@@ -54,8 +54,11 @@ bool same_bits(const GloveSample& a, const GloveSample& b) {
 }
 
 Quaternion normalized(const Quaternion& q) {
+  if (!std::isfinite(q.w) || !std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) {
+    return {};
+  }
   const Real largest = std::max({std::abs(q.w), std::abs(q.x), std::abs(q.y), std::abs(q.z)});
-  if (!(largest > 0) || !std::isfinite(largest)) return {};
+  if (!(largest > 0)) return {};
   // Scale first so the squared norm neither overflows nor underflows.
   const Quaternion s{q.w / largest, q.x / largest, q.y / largest, q.z / largest};
   const Real n = std::sqrt(s.w * s.w + s.x * s.x + s.y * s.y + s.z * s.z);

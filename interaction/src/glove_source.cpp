@@ -13,7 +13,9 @@ namespace dovetail::interaction {
 
 namespace {
 
-Real lerp(Real a, Real b, Real s) { return a + s * (b - a); }
+/// (1 - s) a + s b: exact at s = 0 and 1, and never past max(|a|, |b|) (a + s (b - a) overflows
+/// for a = -1e308, b = 1e308).
+Real lerp(Real a, Real b, Real s) { return (1 - s) * a + s * b; }
 
 /// Minimum-jerk profile s(u) = 10u^3 - 15u^4 + 6u^5 in Horner form: exact at
 /// u = 0, 1/2 and 1.
@@ -281,6 +283,12 @@ NoisyGlove::NoisyGlove(std::shared_ptr<const GloveSource> inner, const GloveNois
   check_not_negative(noise_.position_sigma_m, "position_sigma_m");
   check_not_negative(noise_.orientation_sigma_deg, "orientation_sigma_deg");
   check_not_negative(noise_.latency_s, "latency_s");
+  // Bounds that keep reading indices and arrival times exact in a double.
+  if (noise_.rate_hz > 1e6) throw std::invalid_argument("NoisyGlove: rate_hz must be <= 1e6");
+  if (noise_.latency_s > 3600) throw std::invalid_argument("NoisyGlove: latency_s must be <= 3600");
+  if (noise_.degrees_per_count != 0 && noise_.degrees_per_count < 1e-6) {
+    throw std::invalid_argument("NoisyGlove: degrees_per_count must be 0 or >= 1e-6");
+  }
   if (noise_.donning_sigma_deg > 0) {
     for (std::size_t j = 0; j < kJointCount; ++j) {
       donning_offset_[j] = noise_.donning_sigma_deg * gaussian(noise_.seed, 0, kDonningChannel + j);

@@ -44,6 +44,13 @@ Hand::Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> so
   X_WH_ = sample_.X_WH();
 
   engine::Scene& scene = simulation.scene();
+  for (std::size_t i = 0; i < kSegmentCount; ++i) {  // all names first: all parts or none
+    const std::string name =
+        settings_.name + "." + std::string(segment_name(static_cast<Segment>(i)));
+    if (scene.find(name).valid()) {
+      throw engine::SceneError("hand: the scene already has a part named '" + name + "'");
+    }
+  }
   for (std::size_t i = 0; i < kSegmentCount; ++i) {
     const auto segment = static_cast<Segment>(i);
     engine::PartDesc desc;
@@ -59,8 +66,9 @@ Hand::Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> so
   }
   simulation.add_frame_hook(
       [this](engine::Simulation& sim, std::uint64_t frame, double t) { update(sim, frame, t); });
-  simulation.add_event_filter(
-      [this](engine::Simulation&, std::vector<engine::Event>& events) { filter(events); });
+  simulation.add_event_filter([this](engine::Simulation& sim, std::vector<engine::Event>& events) {
+    filter(sim.scene(), events);
+  });
 }
 
 Hand::Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> source)
@@ -96,26 +104,27 @@ void Hand::update(engine::Simulation& simulation, std::uint64_t frame, Real t) {
 
 void Hand::pose_parts(engine::Scene& scene) const {
   for (std::size_t i = 0; i < kSegmentCount; ++i) {
-    scene.set_local_pose(parts_[i], engine::compose(X_WH_, pose_.X_HS[i]));
+    if (scene.contains(parts_[i]))
+      scene.set_local_pose(parts_[i], engine::compose(X_WH_, pose_.X_HS[i]));
   }
 }
 
-void Hand::filter(std::vector<engine::Event>& events) const {
+void Hand::filter(const engine::Scene& scene, std::vector<engine::Event>& events) const {
+  auto is_any_hand = [&](const std::string& name) {
+    const engine::PartHandle part = scene.find(name);
+    return part.valid() && scene.has_tag(part, "hand");
+  };
   for (engine::Event& e : events) {
     if (e.kind != engine::EventKind::kContactBegin && e.kind != engine::EventKind::kContactEnd) {
       continue;
     }
-    std::optional<Segment> segment = segment_of(e.a);
-    std::string other = e.b;
-    if (!segment) {
-      segment = segment_of(e.b);
-      other = e.a;
-    }
-    if (!segment) continue;
+    // The segment's part first; a contact between two hands stays a contact event.
+    const bool a_is_hand = segment_of(e.a).has_value();
+    const bool b_is_hand = segment_of(e.b).has_value();
+    if (a_is_hand == b_is_hand || is_any_hand(a_is_hand ? e.b : e.a)) continue;
     e.kind = e.kind == engine::EventKind::kContactBegin ? engine::EventKind::kHandContactBegin
                                                         : engine::EventKind::kHandContactEnd;
-    e.a = std::string(segment_name(*segment));
-    e.b = std::move(other);
+    if (b_is_hand) std::swap(e.a, e.b);
   }
 }
 

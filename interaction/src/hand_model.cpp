@@ -238,6 +238,7 @@ HandModel::HandModel(const HandDef& def) {
 }
 
 Vec3 HandModel::knuckle(Digit digit, Real arch_deg) const {
+  if (digit == Digit::kThumb) throw std::invalid_argument("hand: the thumb has no knuckle here");
   const auto f = static_cast<std::size_t>(digit) - 1;
   const Real hl = hand_length_;
   const Vec3 p((static_cast<Real>(f) - 1.5) * P::kSpacing * hl, 0,
@@ -250,6 +251,9 @@ Vec3 HandModel::knuckle(Digit digit, Real arch_deg) const {
 }
 
 Vec3 HandModel::metacarpal_base(Digit digit, Real arch_deg) const {
+  if (digit == Digit::kThumb) {
+    throw std::invalid_argument("hand: the thumb's metacarpal base is its first segment's pose");
+  }
   const auto f = static_cast<std::size_t>(digit) - 1;
   const Real hl = hand_length_;
   const Vec3 p((static_cast<Real>(f) - 1.5) * P::kSpacing * hl, 0, -P::kCarpal * hl);

@@ -90,6 +90,9 @@ dovetail_cli_test(glove_plan_seed_without_noise EXIT 2
                   ARGS glove plan ${PROJECT_SOURCE_DIR}/assets/glove/reach_engine.plan
                        --out ${out}/x.csv --seed 3
                   STDERR "--seed needs --noise")
+file(WRITE ${out}/endless.plan "wait 1e300\n")
+dovetail_cli_test(glove_plan_endless EXIT 2 ARGS glove plan ${out}/endless.plan --out ${out}/x.csv
+                  STDERR "more than 10\\^8 samples")
 dovetail_cli_test(glove_plan_bad_plan EXIT 1
                   ARGS glove plan ${glove}/trace_three_samples.csv --out ${out}/x.csv
                   STDERR "trace_three_samples.csv:1: ")

@@ -108,6 +108,7 @@ TEST(PoseList, BadLinesNameFileAndLine) {
       {"1 2 3\n", ":1: ", "found 3"},
       {"# c\n\n1 2 x 1 0 0 0\n", ":3: ", "'x' is not a number"},
       {"1 2 3 1 0 0 0abc\n", ":1: ", "is not a number"},
+      {"+-1 2 3 1 0 0 0\n", ":1: ", "'+-1' is not a number"},
       {"1 2 3 0 0 0 0\n", ":1: ", "zero"},
       {"1 2 3 -0 0 0 -0\n", ":1: ", "zero"},
       {"nan 2 3 1 0 0 0\n", ":1: ", "not finite"},

@@ -321,3 +321,20 @@ TEST(CyberGlove, RefusesBadCalibrationRows) {
 
 }  // namespace
 }  // namespace dovetail::interaction
+
+namespace dovetail::interaction {
+namespace {
+
+TEST(CyberGlove, RefusesACalibrationThatOverflowsTheAngle) {
+  std::string text = "1e308 0\n";  // native sensor 0: 1e308 degrees per count
+  for (int i = 1; i < 22; ++i) text += "1 0\n";
+  const CyberGloveCalibration c = parse_calibration(text);
+  const std::string message = error_of(
+      [&] { parse_raw("0" + std::string(raw_row(0, raw_counts(0)).substr(1)) + "\n", c); });
+  EXPECT_EQ(message.rfind("glove.raw:1: ", 0), 0U) << message;
+  EXPECT_NE(message.find("thumb_roll"), std::string::npos) << message;
+  EXPECT_NE(message.find("not finite"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace dovetail::interaction

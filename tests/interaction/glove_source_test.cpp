@@ -185,6 +185,16 @@ TEST(TraceSource, ConstantAngularVelocitySlerpsToTheAnalyticRotation) {
   }
 }
 
+TEST(TraceSource, InterpolatingHugePositionsDoesNotOverflow) {
+  std::vector<GloveSample> trace(2);
+  trace[0].p_WH.x() = -1e308;
+  trace[1].t = 1;
+  trace[1].p_WH.x() = 1e308;
+  const TraceSource source(trace);
+  EXPECT_TRUE(std::isfinite(source.sample(0.5).p_WH.x()));
+  EXPECT_EQ(source.sample(0.5).p_WH.x(), 0);
+}
+
 TEST(TraceSource, HoldsTheEndsOutsideTheTrace) {
   const std::vector<GloveSample> trace = linear_trace(kTraceRateHz, 13);
   const TraceSource source(trace);
@@ -672,6 +682,9 @@ TEST(NoisyGlove, RefusesBadSettings) {
   EXPECT_NO_THROW(make([](GloveNoise&) {}));
   EXPECT_THROW(make([](GloveNoise& n) { n.rate_hz = 0; }), std::invalid_argument);
   EXPECT_THROW(make([](GloveNoise& n) { n.rate_hz = -120; }), std::invalid_argument);
+  EXPECT_THROW(make([](GloveNoise& n) { n.rate_hz = 1e7; }), std::invalid_argument);
+  EXPECT_THROW(make([](GloveNoise& n) { n.latency_s = 1e30; }), std::invalid_argument);
+  EXPECT_THROW(make([](GloveNoise& n) { n.degrees_per_count = 1e-320; }), std::invalid_argument);
   EXPECT_THROW(make([&](GloveNoise& n) { n.rate_hz = inf; }), std::invalid_argument);
   EXPECT_THROW(make([](GloveNoise& n) { n.joint_sigma_deg = -1; }), std::invalid_argument);
   EXPECT_THROW(make([&](GloveNoise& n) { n.donning_sigma_deg = nan; }), std::invalid_argument);

@@ -207,3 +207,26 @@ TEST(HandModel, EverySegmentHasAProxyAndAName) {
 
 }  // namespace
 }  // namespace dovetail::interaction
+
+namespace dovetail::interaction {
+namespace {
+
+TEST(HandModel, TheThumbHasNoFingerKnuckle) {
+  const HandModel hand;
+  EXPECT_THROW(hand.knuckle(Digit::kThumb, 0), std::invalid_argument);
+  EXPECT_THROW(hand.metacarpal_base(Digit::kThumb, 0), std::invalid_argument);
+}
+
+TEST(GloveSample, NonFiniteQuaternionsNormaliseToTheIdentity) {
+  for (const Quaternion q : {Quaternion{1, std::nan(""), 0, 0}, Quaternion{std::nan(""), 1, 0, 0},
+                             Quaternion{1, 0, INFINITY, 0}, Quaternion{0, 0, 0, 0}}) {
+    const Quaternion n = normalized(q);
+    EXPECT_EQ(n.w, 1);
+    EXPECT_EQ(n.x, 0);
+    EXPECT_EQ(n.y, 0);
+    EXPECT_EQ(n.z, 0);
+  }
+}
+
+}  // namespace
+}  // namespace dovetail::interaction

@@ -17,9 +17,8 @@
 namespace dovetail::interaction {
 namespace {
 
-const std::filesystem::path kEngine =
-    std::filesystem::path(DOVETAIL_ASSIMP_MODELS) /
-    "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+const std::filesystem::path kEngine = std::filesystem::path(DOVETAIL_ASSIMP_MODELS) /
+                                      "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
 
 /// Pixels whose colour is the hand's under any shade: flat shading scales
 /// all three channels alike, so the ratios G/R and B/R stay the hand's.
@@ -57,7 +56,8 @@ TEST(HandRender, TheHandReachingForAnEnginePartIsDrawnInItsColour) {
   // The hand is above the crankcase, in the upper half of the picture.
   std::size_t upper = 0, lower = 0;
   for (int y = 0; y < reaching.height; ++y) {
-    engine::Image row{reaching.width, 1,
+    engine::Image row{reaching.width,
+                      1,
                       {reaching.rgba.begin() + 4 * y * reaching.width,
                        reaching.rgba.begin() + 4 * (y + 1) * reaching.width}};
     (y < reaching.height / 2 ? upper : lower) += hand_pixels(row);

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "../support/temp_dir.h"
 #include "dovetail/collision/primitives.h"
@@ -76,7 +77,7 @@ TEST(InvisibleHand, OpenHandThroughABoxTouchesEachSegmentInTheExpectedFrames) {
     // No frame lands within rounding of touching, so the expectation is sharp.
     ASSERT_GT(std::abs(source->y_at(static_cast<Real>(begin) * kDt) + low), 1e-9);
     ASSERT_GT(std::abs(source->y_at(static_cast<Real>(end) * kDt) + high - kSlabBottom), 1e-9);
-    expected[std::string(segment_name(segment))] = {begin, end};
+    expected["hand." + std::string(segment_name(segment))] = {begin, end};
   }
 
   std::map<std::string, std::pair<std::uint64_t, std::uint64_t>> seen;
@@ -101,7 +102,7 @@ TEST(InvisibleHand, OpenHandThroughABoxTouchesEachSegmentInTheExpectedFrames) {
   EXPECT_EQ(std::min_element(expected.begin(), expected.end(),
                              [](const auto& x, const auto& y) { return x.second < y.second; })
                 ->first,
-            "thumb_metacarpal");
+            "hand.thumb_metacarpal");
 }
 
 TEST(InvisibleHand, ClampedJointsLeaveANote) {
@@ -210,6 +211,51 @@ TEST(HandReplay, ARecordedRunReplaysToTheSameRun) {
   }
   // Another noise seed is another run.
   EXPECT_NE(run_hand(sweeping_glove(12), 1, kDt, 200).state_hash, original.state_hash);
+}
+
+}  // namespace
+}  // namespace dovetail::interaction
+
+namespace dovetail::interaction {
+namespace {
+
+TEST(InvisibleHand, ARemovedSegmentIsNoLongerPosedAndTheRunGoesOn) {
+  engine::Simulation sim(slab_scene(), {.time_step = kDt});
+  Hand hand(sim, std::make_shared<FallingHand>(0.05, 0.2));
+  sim.step();
+  sim.scene().remove_part(hand.part(Segment::kPinkyDistal));
+  EXPECT_NO_THROW(sim.run(40));
+  EXPECT_FALSE(sim.scene().find("hand.pinky_distal").valid());
+  EXPECT_EQ(sim.scene().part_count(), 16U);
+}
+
+TEST(InvisibleHand, ATakenNameAddsNoSegment) {
+  engine::Scene scene = slab_scene();
+  scene.add_part({.name = "hand.index_proximal"});
+  engine::Simulation sim(std::move(scene));
+  EXPECT_THROW(Hand(sim, std::make_shared<FallingHand>(0.05, 0.2)), engine::SceneError);
+  EXPECT_EQ(sim.scene().part_count(), 2U);
+}
+
+TEST(InvisibleHand, TwoHandsKeepTheirEventsApart) {
+  engine::Simulation sim(slab_scene(), {.time_step = kDt});
+  HandSettings left_settings, right_settings;  // (designated initialisers trip GCC 12's
+  left_settings.name = "left";                 // -Wmaybe-uninitialized here)
+  right_settings.name = "right";
+  Hand left(sim, std::make_shared<FallingHand>(0.05, 0.2), left_settings);
+  Hand right(sim, std::make_shared<FallingHand>(0.06, 0.2), right_settings);
+  std::set<std::string> touching;
+  sim.events().subscribe(EventKind::kHandContactBegin,
+                         [&](const Event& e) { EXPECT_TRUE(touching.insert(e.a).second) << e.a; });
+  std::size_t hands_touching = 0;
+  sim.events().subscribe(EventKind::kContactBegin, [&](const Event& e) {
+    EXPECT_TRUE(e.a.starts_with("left.") && e.b.starts_with("right.")) << e.a << " " << e.b;
+    ++hands_touching;
+  });
+  sim.run(40);
+  EXPECT_GT(hands_touching, 0U) << "the two hands overlap: their contacts stay contact events";
+  EXPECT_TRUE(touching.count("left.palm"));
+  EXPECT_TRUE(touching.count("right.palm"));
 }
 
 }  // namespace

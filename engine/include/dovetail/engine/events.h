@@ -26,7 +26,7 @@ enum class EventKind : std::uint8_t {
   kContactEnd,        ///< a and b touched in the last frame, not now
   kRegionEnter,       ///< part a entered region b
   kRegionLeave,       ///< part a left region b
-  kHandContactBegin,  ///< hand segment a (`index_distal`, `palm`, ...) touches part b now
+  kHandContactBegin,  ///< hand segment a (its part, `hand.index_distal`) touches part b now
   kHandContactEnd,    ///< hand segment a touched part b in the last frame, not now
   kGrasp,             ///< reserved: the hand grasped part a
   kRelease,           ///< reserved: the hand released part a

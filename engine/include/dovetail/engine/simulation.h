@@ -101,12 +101,10 @@ class Simulation {
   /// Queues a pose command; throws SceneError for an unknown part (and step()
   /// throws it at frame k if the part was removed by then).
   void queue_pose(const PoseCommand& command);
-  /// Replaces every frame hook by `hook`.
-  void set_frame_hook(FrameHook hook) {
-    hooks_.clear();
-    hooks_.push_back(std::move(hook));
-  }
-  /// Adds a frame hook; hooks run in the order added.
+  /// Sets the one frame hook that runs before the added ones (replacing the
+  /// last one set this way; hooks added with add_frame_hook stay).
+  void set_frame_hook(FrameHook hook) { hook_ = std::move(hook); }
+  /// Adds a frame hook; they run after the set one, in the order added.
   void add_frame_hook(FrameHook hook) { hooks_.push_back(std::move(hook)); }
   /// Adds an event filter; filters run in the order added.
   void add_event_filter(EventFilter filter) { filters_.push_back(std::move(filter)); }
@@ -159,6 +157,7 @@ class Simulation {
   SimulationSettings settings_;
   std::unique_ptr<collision::CollisionWorld> world_;
   EventBus bus_;
+  FrameHook hook_;
   std::vector<FrameHook> hooks_;
   std::vector<EventFilter> filters_;
   std::vector<PoseCommand> commands_;  ///< sorted by frame, stable

@@ -103,8 +103,9 @@ struct GloveNoise {
 /// numbers wherever the C library's log, cos and sin agree.
 class NoisyGlove final : public GloveSource {
  public:
-  /// Throws std::invalid_argument for a null source, a rate <= 0, or a
-  /// negative or non-finite sigma or latency.
+  /// Throws std::invalid_argument for a null source, a rate <= 0 or above
+  /// 10^6 Hz, a negative or non-finite sigma, a latency that is negative or
+  /// above an hour, a quantisation step between 0 and 1e-6 degrees.
   NoisyGlove(std::shared_ptr<const GloveSource> inner, const GloveNoise& noise = {});
   GloveSample sample(Real t) const override;
   /// When the first reading taken at or after the inner source's end arrives;

@@ -4,7 +4,8 @@
 /// the joint angles, runs the forward kinematics and poses one scene part per
 /// segment, the "invisible hand" the collision pipeline checks against the
 /// parts in the same frame; contacts of its segments become hand_contact
-/// events that name the segment; every sample it used is recorded.
+/// events that name the segment's part (`hand.index_distal`); every sample it
+/// used is recorded.
 ///
 /// Why: frame steps 1 and 2 of DESIGN.md ("Input", "Hand") belong together
 /// and to nobody else. The segments are ordinary scene parts (named
@@ -53,7 +54,8 @@ class Hand {
   /// hook and an event filter on the simulation. The Hand must outlive the
   /// simulation's use of them (it is neither copied nor moved). Throws
   /// engine::SceneError when a segment's name is taken, std::invalid_argument
-  /// for a null source or a bad hand definition.
+  /// for a null source or a bad hand definition; then nothing was added. A
+  /// segment later removed from the scene is no longer posed.
   Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> source,
        const HandSettings& settings);
   /// A hand with the default settings.
@@ -84,7 +86,7 @@ class Hand {
 
  private:
   void update(engine::Simulation& simulation, std::uint64_t frame, Real t);
-  void filter(std::vector<engine::Event>& events) const;
+  void filter(const engine::Scene& scene, std::vector<engine::Event>& events) const;
   void pose_parts(engine::Scene& scene) const;
 
   HandModel model_;

@@ -154,8 +154,9 @@ class HandModel {
   /// (clamp_to_limits); the wrist angles are ignored.
   HandPose forward_kinematics(const JointAngles& angles) const;
 
-  /// The knuckle (metacarpophalangeal joint) of finger `digit` (not the thumb)
-  /// in H with the palm arch `arch_deg`, and the metacarpal's base.
+  /// The knuckle (metacarpophalangeal joint) of finger `digit` in H with the
+  /// palm arch `arch_deg`, and the metacarpal's base; std::invalid_argument
+  /// for the thumb.
   Vec3 knuckle(Digit digit, Real arch_deg) const;
   Vec3 metacarpal_base(Digit digit, Real arch_deg) const;
 
