@@ -387,8 +387,8 @@ Vec3 normalized_or(const Vec3& v, Real total_weight, const Vec3& fallback) {
 /// Patch of the pieces `members` (indices into `pieces`).
 ContactPatch make_patch(const std::vector<PairPiece>& pieces,
                         const std::vector<std::size_t>& members,
-                        std::span<const TrianglePair> pairs, InsideReach& b_in_a,
-                        InsideReach& a_in_b, const ContactRequest& request) {
+                        std::span<const TrianglePair> pairs, InsideReach* b_in_a,
+                        InsideReach* a_in_b, const ContactRequest& request) {
   ContactPatch patch;
   Real area = 0;
   Real length = 0;
@@ -444,6 +444,9 @@ ContactPatch make_patch(const std::vector<PairPiece>& pieces,
     patch.normal = normalized_or(sum, count, fallback);
   }
 
+  if (b_in_a == nullptr || a_in_b == nullptr) {  // depth not asked for
+    return patch;
+  }
   // Depth: how deep B reaches into A and A into B, the larger. Into a
   // closed part: the deepest vertex of the other inside it, in a region
   // connected to the patch (InsideReach), measured to its surface; this sees
@@ -474,8 +477,8 @@ ContactPatch make_patch(const std::vector<PairPiece>& pieces,
     }
     return depth;
   };
-  const std::optional<Real> b_into_a = b_in_a.reach(triangles_b);
-  const std::optional<Real> a_into_b = a_in_b.reach(triangles_a);
+  const std::optional<Real> b_into_a = b_in_a->reach(triangles_b);
+  const std::optional<Real> a_into_b = a_in_b->reach(triangles_a);
   patch.depth = std::max(b_into_a ? *b_into_a : behind_faces(true),
                          a_into_b ? *a_into_b : behind_faces(false));
   patch.penetrating = patch.depth > request.touching_tolerance;
@@ -574,10 +577,14 @@ std::vector<ContactPatch> compute_contacts(const Mesh& a, const Mesh& b, const T
     a_crossing_b.emplace_back(p.a, p.b);
   }
   const Transform identity;
-  InsideReach b_in_a(b, around_b, X_AB, a, identity, std::move(b_crossing_a));
-  InsideReach a_in_b(a, around_a, identity, b, X_AB, std::move(a_crossing_b));
+  std::optional<InsideReach> b_in_a, a_in_b;
+  if (request.estimate_depth) {
+    b_in_a.emplace(b, around_b, X_AB, a, identity, std::move(b_crossing_a));
+    a_in_b.emplace(a, around_a, identity, b, X_AB, std::move(a_crossing_b));
+  }
   for (const std::vector<std::size_t>& g : groups) {
-    patches.push_back(make_patch(pieces, g, pairs, b_in_a, a_in_b, request));
+    patches.push_back(make_patch(pieces, g, pairs, b_in_a ? &*b_in_a : nullptr,
+                                 a_in_b ? &*a_in_b : nullptr, request));
   }
   std::sort(patches.begin(), patches.end(), [](const ContactPatch& x, const ContactPatch& y) {
     return x.pairs.front() < y.pairs.front();

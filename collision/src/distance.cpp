@@ -125,6 +125,12 @@ class BrutePairs {
 
 }  // namespace
 
+TrianglePairDistance triangle_pair_distance(const std::array<Vec3, 3>& a,
+                                            const std::array<Vec3, 3>& b) {
+  const detail::TriangleDistance d = detail::triangle_distance(a, b);
+  return {d.distance, d.p, d.q};
+}
+
 DistanceResult distance_brute(const Mesh& a, const Mesh& b, const Transform& X_AB) {
   DistanceResult result;
   const BrutePairs pairs(a, b, X_AB);

@@ -1,8 +1,10 @@
 #include "dovetail/collision/primitives.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -115,6 +117,74 @@ Mesh make_cylinder(Real radius, Real height, int sides) {
     t.push_back(tri(top, a1, b1));
   }
   return make_mesh(std::move(v), std::move(t), describe("cylinder", sides));
+}
+
+Mesh make_block_with_hole(const Vec3& half_extents, Real hole_radius, Real hole_depth, int sides) {
+  auto positive = [](Real x) { return std::isfinite(x) && x > 0; };
+  if (!positive(half_extents.x()) || !positive(half_extents.y()) || !positive(half_extents.z()) ||
+      !positive(hole_radius) || !positive(hole_depth)) {
+    throw std::invalid_argument("make_block_with_hole: sizes must be positive and finite");
+  }
+  if (sides < 3) throw std::invalid_argument("make_block_with_hole: sides must be at least 3");
+  const Real hx = half_extents.x(), hy = half_extents.y(), hz = half_extents.z();
+  if (hole_depth >= 2 * hy) {
+    throw std::invalid_argument("make_block_with_hole: the hole is deeper than the box");
+  }
+  const Real corner_radius = hole_radius / std::cos(std::numbers::pi / sides);
+  if (!(corner_radius < std::min(hx, hz))) {
+    throw std::invalid_argument("make_block_with_hole: the hole does not fit in the top face");
+  }
+  const std::size_t n = static_cast<std::size_t>(sides);
+  const Real bottom_y = hy - hole_depth;
+  // Plan coordinates (x, -z): counter-clockwise in the plan is counter-clockwise seen from +y.
+  auto at = [](Real px, Real y, Real py) { return Vec3(px, y, -py); };
+  std::vector<Vec3> v;
+  // Square corners s_j counter-clockwise from (hx, -hz); side j runs from s_j to s_(j+1)
+  // and faces the plan direction j * 90 degrees. Lower ring 0..3, upper ring 4..7.
+  const Real square[4][2] = {{hx, -hz}, {hx, hz}, {-hx, hz}, {-hx, -hz}};
+  for (Real y : {-hy, hy}) {
+    for (const auto& s : square) v.push_back(at(s[0], y, s[1]));
+  }
+  auto lower = [](std::size_t j) { return j % 4; };
+  auto upper = [](std::size_t j) { return 4 + j % 4; };
+  // Polygon corner k at plan angle 2 pi (k + 1/2) / n: the flat of edge k (corner k to k + 1)
+  // faces 2 pi (k + 1) / n. Rim ring at the top, floor ring at the hole's bottom.
+  const std::size_t rim = v.size();
+  for (Real y : {hy, bottom_y}) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const Real w = 2 * std::numbers::pi * (static_cast<Real>(k) + 0.5) / sides;
+      v.push_back(at(corner_radius * std::cos(w), y, corner_radius * std::sin(w)));
+    }
+  }
+  const std::size_t floor_ring = rim + n;
+  const std::size_t floor_centre = v.size();
+  v.emplace_back(0, bottom_y, 0);
+  auto top = [&](std::size_t k) { return rim + k % n; };
+  auto bot = [&](std::size_t k) { return floor_ring + k % n; };
+
+  Triangles t;
+  t.push_back(tri(lower(0), lower(2), lower(1)));
+  t.push_back(tri(lower(0), lower(3), lower(2)));
+  for (std::size_t j = 0; j < 4; ++j) {
+    t.push_back(tri(lower(j), lower(j + 1), upper(j + 1)));
+    t.push_back(tri(lower(j), upper(j + 1), upper(j)));
+  }
+  // Top face: polygon corner m_j = floor(j n / 4) is (one of) the nearest to side j; the
+  // triangle (s_j, s_(j+1), corner m_j) lies between them, and each square corner s_j fans
+  // to the polygon edges m_(j-1) .. m_j - 1, whose flats face between sides j - 1 and j.
+  auto nearest = [&](std::size_t j) { return j * n / 4; };
+  for (std::size_t j = 0; j < 4; ++j) t.push_back(tri(upper(j), upper(j + 1), top(nearest(j))));
+  for (std::size_t j = 1; j <= 4; ++j) {
+    for (std::size_t k = nearest(j - 1); k < nearest(j); ++k) {
+      t.push_back(tri(upper(j), top(k + 1), top(k)));
+    }
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    t.push_back(tri(bot(k), top(k), top(k + 1)));
+    t.push_back(tri(bot(k), top(k + 1), bot(k + 1)));
+    t.push_back(tri(floor_centre, bot(k), bot(k + 1)));
+  }
+  return make_mesh(std::move(v), std::move(t), describe("block with hole", sides));
 }
 
 Mesh make_wavy_sheet(Real half, Real amplitude, Real freq, int n) {

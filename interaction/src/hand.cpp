@@ -39,7 +39,8 @@ Hand::Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> so
   if (!source_) throw std::invalid_argument("hand: no glove source");
   if (settings_.name.empty()) throw std::invalid_argument("hand: the hand needs a name");
   sample_ = source_->sample(simulation.time());
-  angles_ = clamp_to_limits(sample_.joints);
+  glove_angles_ = clamp_to_limits(sample_.joints);
+  angles_ = glove_angles_;
   pose_ = model_.forward_kinematics(angles_);
   X_WH_ = sample_.X_WH();
 
@@ -86,7 +87,7 @@ void Hand::update(engine::Simulation& simulation, std::uint64_t frame, Real t) {
   if (settings_.record) recorded_.push_back(sample_);
   // 2. Hand: limits, forward kinematics, the proxies' poses.
   std::bitset<kJointCount> clamped;
-  angles_ = clamp_to_limits(sample_.joints, &clamped);
+  glove_angles_ = clamp_to_limits(sample_.joints, &clamped);
   for (std::size_t j = 0; j < kJointCount; ++j) {
     if (!clamped[j]) continue;
     if (clamped_frames_[j]++ == 0) {
@@ -97,8 +98,16 @@ void Hand::update(engine::Simulation& simulation, std::uint64_t frame, Real t) {
                           std::to_string(frame) + "; clamped (here and whenever it recurs)");
     }
   }
-  pose_ = model_.forward_kinematics(angles_);
   X_WH_ = sample_.X_WH();
+  const JointAngles previous = angles_;
+  angles_ = glove_angles_;
+  if (limiter_)
+    angles_ = clamp_to_limits([&] {
+      JointAngles limited = glove_angles_;
+      limiter_(model_, X_WH_, previous, limited);
+      return limited;
+    }());
+  pose_ = model_.forward_kinematics(angles_);
   pose_parts(simulation.scene());
 }
 

@@ -32,6 +32,10 @@ struct ContactRequest {
   /// distance actually used is at least 1e-9 times the coordinate magnitude
   /// (at least 1), so pieces that meet up to rounding are always joined.
   Real merge_distance = 0;
+  /// Estimate each patch's depth (the dearest part of the query). False:
+  /// depth 0 and `penetrating` false for every patch, and the patch's pairs
+  /// are the intersecting pairs and nearly coplanar neighbours as usual.
+  bool estimate_depth = true;
 };
 
 /// How the surfaces meet in a patch.

@@ -119,6 +119,16 @@ DistanceResult distance(const DistanceModel& a, const DistanceModel& b, const Tr
 ToleranceResult within_tolerance(const DistanceModel& a, const DistanceModel& b,
                                  const Transform& X_AB, Real tolerance);
 
+/// Closest points of two closed triangles given in one frame.
+struct TrianglePairDistance {
+  Real distance = 0;      ///< 0 exactly when the exact triangle test says they intersect
+  Vec3 p = Vec3::Zero();  ///< on the first triangle
+  Vec3 q = Vec3::Zero();  ///< on the second
+};
+/// The distance of the leaf test of the distance queries, for one pair.
+TrianglePairDistance triangle_pair_distance(const std::array<Vec3, 3>& a,
+                                            const std::array<Vec3, 3>& b);
+
 /// The reference: every triangle pair of A and B (a pair is skipped only when
 /// its triangles' bounding boxes are provably farther apart than the best so
 /// far). For tests and as the `brute` method.

@@ -21,6 +21,17 @@ Mesh make_torus(Real major, Real minor, int rings, int sides);
 /// Closed cylinder along z from z = 0 to z = `height`, `sides` facets.
 Mesh make_cylinder(Real radius, Real height, int sides);
 
+/// A box with a blind cylindrical hole: the box spans x, z in [-hx, hx] x [-hz, hz]
+/// and y in [-hy, hy]; the hole, of radius `hole_radius`, opens in the top face (y = hy)
+/// around the y axis and goes `hole_depth` down, with a flat bottom. The hole's wall is a
+/// prism of `sides` flat faces whose flats (not corners) lie at hole_radius from the axis,
+/// so a cylinder of radius hole_radius fits however coarse the tessellation; the flats face
+/// +x, +z, -x and -z when `sides` is a multiple of 4. Closed, outward (the wall's normals
+/// point toward the axis). Throws std::invalid_argument when a size is not positive and
+/// finite, when the hole does not fit inside the box (the polygon's corner radius
+/// hole_radius / cos(pi / sides) >= min(hx, hz)), when hole_depth >= 2 hy, or sides < 3.
+Mesh make_block_with_hole(const Vec3& half_extents, Real hole_radius, Real hole_depth, int sides);
+
 /// Open height field z = amplitude * sin(x * freq) * cos(y * freq) over
 /// [-half, half]^2 sampled n x n: many parallel close faces in contact tests.
 Mesh make_wavy_sheet(Real half, Real amplitude, Real freq, int n);

@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -67,8 +68,18 @@ class Hand {
   const GloveSource& source() const { return *source_; }
   /// The sample of the last frame as the source gave it.
   const GloveSample& sample() const { return sample_; }
-  /// Its joint angles within limits, as the hand used them.
+  /// Its joint angles within limits: what the glove asks for.
+  const JointAngles& glove_angles() const { return glove_angles_; }
+  /// The angles the hand shows and collides with: the glove's, unless a
+  /// finger limiter (natural grasping) stopped a finger at its first contact.
   const JointAngles& angles() const { return angles_; }
+
+  /// Called each frame after the glove is read and before the kinematics,
+  /// with the hand pose X_WH, the angles shown in the last frame and the
+  /// glove's angles within limits, which it may change (never past the limits).
+  using FingerLimiter = std::function<void(const HandModel& model, const Transform& X_WH,
+                                           const JointAngles& previous, JointAngles& angles)>;
+  void set_finger_limiter(FingerLimiter limiter) { limiter_ = std::move(limiter); }
   /// Its segment poses in H, and X_WH.
   const HandPose& pose() const { return pose_; }
   const Transform& X_WH() const { return X_WH_; }
@@ -95,7 +106,9 @@ class Hand {
   std::array<engine::PartHandle, kSegmentCount> parts_{};
   std::map<std::string, Segment, std::less<>> segment_by_part_;
   GloveSample sample_{};
+  JointAngles glove_angles_{};
   JointAngles angles_{};
+  FingerLimiter limiter_;
   HandPose pose_{};
   Transform X_WH_{};
   std::vector<GloveSample> recorded_;

@@ -1,0 +1,159 @@
+#pragma once
+/// \file grasping.h
+/// Natural grasping, rubber-band sliding and mates for one hand in a
+/// simulation (frame step 3 of DESIGN.md, "Interaction").
+///
+/// Why: the glove says how far the user closes the hand, not what the hand
+/// touches. Each frame the fingers close from their last free posture toward
+/// the glove's, each stopping at its first contact with a part; the contacts
+/// within a small gap are analysed, and when they oppose each other for a
+/// few frames while the hand closes, the part is grasped (precision, 3-point
+/// pinch or power) and keeps its pose in the hand, X_HO. It then follows the
+/// hand through a rubber band (sliding.h) and is released when the fingers
+/// open several degrees past where they were at the grasp. A released part
+/// near a declared mate snaps into place. Everything is kinematic, exact and
+/// deterministic: the same trace gives the same bits at any thread count.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "dovetail/engine/simulation.h"
+#include "dovetail/interaction/hand.h"
+#include "dovetail/interaction/sliding.h"
+
+namespace dovetail::interaction {
+
+/// The grasp types of Cutkosky's taxonomy that the contact analysis tells apart.
+enum class GraspType : std::uint8_t {
+  kPrecision,  ///< thumb tip opposing the index or middle tip
+  kTripod,     ///< 3-point pinch: thumb tip opposing both index and middle tips
+  kPower,      ///< palm and at least two fingers around the part, a finger opposing the palm
+};
+/// "precision", "tripod", "power": the `b` of a grasp event.
+std::string_view grasp_type_name(GraspType type);
+
+/// When a grasp begins and ends (defaults: notes/grasping.md).
+struct GraspSettings {
+  Real contact_gap = 0.0002;   ///< a segment within this of a part touches it (GraspIt!'s 0.2 mm)
+  Real friction = 0.5;         ///< mu: contacts oppose inside cones of half-angle atan(mu)
+  int onset_frames = 3;        ///< the grasp must hold this many frames while the hand closes
+  Real release_open_deg = 8;   ///< a grasping digit opened this far past its flexion at the grasp
+  Real release_time_s = 0.05;  ///< ... for this long releases the part
+  int finger_bisection_steps = 12;  ///< halvings toward a finger's first contact (0.02 deg)
+};
+
+/// A declared fit between a feature of one part and a feature of another:
+/// a point and an axis in each part's frame.
+///
+/// Guidance: while `part` is carried with its target's feature point within
+/// the position tolerance of the other's axis line and the axes within the
+/// angle tolerance, the band pulls it onto the axis: the target turned by
+/// the least rotation onto the other's axis and moved onto the line (a peg
+/// held a little off a hole's axis is drawn in, not left on the rim). Once
+/// drawn, it stays drawn until three times the tolerances away.
+/// Snap: when `part` is released with its point within the position
+/// tolerance of the other's point and the axes within the angle tolerance,
+/// its axis turns onto the other's (the least turn), its point onto the
+/// other's point, and a mate event fires.
+struct Mate {
+  std::string name{};
+  std::string part{};           ///< the part that is carried and snaps
+  Vec3 p_PF = Vec3::Zero();     ///< its feature point, in its frame
+  Vec3 axis_P = Vec3::UnitY();  ///< its feature axis, in its frame
+  std::string other{};          ///< the part it fits onto
+  Vec3 p_OF = Vec3::Zero();
+  Vec3 axis_O = Vec3::UnitY();
+  Real position_tolerance = 0.002;  ///< metres
+  Real angle_tolerance_deg = 5;
+};
+
+/// What the interaction of one hand does, and its settings.
+struct InteractionSettings {
+  GraspSettings grasp{};
+  SlidingSettings sliding{};
+};
+
+/// Per-frame work counters.
+struct InteractionStats {
+  std::uint64_t finger_queries = 0;   ///< collision tests while closing fingers
+  std::uint64_t contact_queries = 0;  ///< tolerance tests of the contact analysis
+  std::uint64_t slide_queries = 0;    ///< collision tests and contact queries of sliding
+  Real max_stretch_m = 0;             ///< largest band stretch of the run
+};
+
+/// Grasping, sliding and mates for one Hand in one Simulation.
+class Grasping {
+ public:
+  /// Installs a finger limiter on the hand, a frame hook (after the hand's)
+  /// and an event filter on the simulation. Both must outlive their use.
+  Grasping(engine::Simulation& simulation, Hand& hand, const InteractionSettings& settings);
+  Grasping(engine::Simulation& simulation, Hand& hand);
+  ~Grasping();
+  Grasping(const Grasping&) = delete;
+  Grasping& operator=(const Grasping&) = delete;
+
+  /// Declares a mate; throws engine::SceneError for an unknown part.
+  void add_mate(const Mate& mate);
+  /// Makes the hand hold `part` from now on with grasp `type`, as if grasped
+  /// (for scenarios that start with a part in hand). Throws engine::SceneError
+  /// for an unknown part or one without a collision mesh.
+  void hold(const std::string& part, GraspType type);
+
+  /// The part held, if any.
+  const std::optional<std::string>& held() const { return held_; }
+  std::optional<GraspType> grasp_type() const {
+    return held_ ? std::optional(type_) : std::nullopt;
+  }
+  /// X_HO of the part held.
+  const Transform& X_HO() const { return X_HO_; }
+  /// The last sliding step of the part held.
+  const SlideResult& last_slide() const { return last_slide_; }
+  const InteractionStats& stats() const { return stats_; }
+
+ private:
+  struct Models;
+  struct Touch;
+  void limit_fingers(const HandModel& model, const Transform& X_WH, const JointAngles& previous,
+                     JointAngles& angles);
+  void update(engine::Simulation& simulation, std::uint64_t frame, Real t);
+  std::vector<engine::PartHandle> candidates(const engine::Scene& scene, const Transform& X_WH,
+                                             Real reach) const;
+  std::vector<Touch> touches(const engine::Scene& scene, engine::PartHandle part);
+  std::optional<GraspType> classify(const std::vector<Touch>& touches) const;
+  void carry(engine::Simulation& simulation);
+  Transform guided(const engine::Scene& scene, const std::string& part,
+                   const Transform& X_WP_target);
+  void release(engine::Simulation& simulation, const std::string& reason);
+  void snap(engine::Simulation& simulation, const std::string& part);
+
+  engine::Simulation* simulation_;
+  Hand* hand_;
+  InteractionSettings settings_;
+  std::unique_ptr<Models> models_;
+  std::vector<Mate> mates_;
+  std::vector<engine::Event> pending_;
+
+  std::optional<std::string> held_;
+  GraspType type_ = GraspType::kPrecision;
+  Transform X_HO_{};
+  std::array<Real, kDigitCount> flexion_at_grasp_{};
+  std::array<bool, kDigitCount> grasping_digit_{};
+  Real opened_since_ = -1;  ///< time the release condition began to hold; < 0: not holding
+  std::string candidate_;   ///< part whose grasp is building up
+  GraspType candidate_type_ = GraspType::kPrecision;
+  int candidate_frames_ = 0;
+  Real last_flexion_ = 0;
+  std::optional<std::size_t> guiding_;  ///< the mate drawing the held part onto its axis
+  bool sliding_ = false;
+  std::string sliding_on_;
+  SlideResult last_slide_{};
+  std::vector<engine::PartHandle> contact_parts_;  ///< the parts of last_slide_'s obstacle ids
+  InteractionStats stats_{};
+};
+
+}  // namespace dovetail::interaction

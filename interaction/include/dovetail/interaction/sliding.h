@@ -1,0 +1,140 @@
+#pragma once
+/// \file sliding.h
+/// Rubber-band sliding: one step of a held part toward the pose the hand
+/// wants for it, along the surfaces it meets instead of through them.
+///
+/// Why: without force feedback a user cannot feel a part touch another, so a
+/// part tied rigidly to the hand would pass through everything. Tied by a
+/// rubber band, it goes where the hand pulls it as far as the other parts
+/// allow, and slides tangentially where they do not. Every pose this step
+/// accepts is collision-free by the exact triangle test, so a sliding part
+/// never penetrates; a jammed part stays behind until the band overstretches.
+///
+/// The state machine of one step, after ALGORITHMS.md ("Rubber-band sliding"):
+///   1. try the wanted motion; where it collides, approximate the exact
+///      contact pose by bisection between the last free pose and the
+///      colliding one;
+///   2. classify the contact from the contact patches of the colliding pose
+///      (face, curve: edge on face or edge on edge, point);
+///   3. take the contact normal from the closest points of the last free
+///      pose, a hair's breadth from the contact: the direction from the other
+///      part's closest point to the sliding part's, which is the face normal
+///      for a vertex or edge on a face and the common perpendicular for two
+///      edges (a patch's own normal averages the faces around an edge and
+///      would let a peg's rim through a hole's rim);
+///   4. project the rest of the motion onto what the contacts allow: the
+///      motion (v, w) about the part's centre closest to the wanted one, in
+///      the metric |v|^2 + L^2 |w|^2 (L the part's size), with
+///      n . (v + w x r) >= 0 at every contact (a peg in a hole keeps only the
+///      motion along the hole's axis);
+///   5. stop when the band is overstretched, the part is at rest, or the goal
+///      is reached; otherwise go on with the projected motion, up to a
+///      budget of sub-steps.
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "dovetail/collision/contacts.h"
+#include "dovetail/collision/distance.h"
+#include "dovetail/collision/model.h"
+#include "dovetail/interaction/glove_sample.h"
+
+namespace dovetail::interaction {
+
+/// How a sliding part behaves.
+struct SlidingSettings {
+  int substeps = 4;          ///< projected moves per frame at most
+  int bisection_steps = 14;  ///< halvings toward the exact contact pose at most (10 mm -> 0.6 um)
+  Real resolution_m = 1e-6;  ///< ... stopping once the bracket moves a point less than this
+  int solver_sweeps = 64;    ///< passes over the contacts projecting the motion
+  Real band_limit_m = 0.05;  ///< stretch (centre to centre) past which the band breaks
+  Real band_limit_deg = 20;  ///< ... or angle between held and wanted orientation
+  Real rest_m = 1e-7;        ///< a sub-step moving less than this ends the frame: at rest
+  /// How much more the band resists turning than moving: the metric's length
+  /// is turn_stiffness * L. Near 1 a part held back at one end pivots about
+  /// the contact; larger keeps the hand's orientation and slides instead.
+  Real turn_stiffness = 3;
+  /// A part in contact moves out to this clearance from the contact while
+  /// sliding along it: room for the curvature the linearised contact misses.
+  Real skin_m = 2e-6;
+};
+
+/// Another part, as the sliding part sees it.
+struct SlideObstacle {
+  std::shared_ptr<const collision::CollisionModel> model;    ///< exact-level model (kObb)
+  std::shared_ptr<const collision::DistanceModel> distance;  ///< of the same mesh
+  Transform X_WO;                                            ///< its pose in the world
+  std::uint32_t id = 0;                                      ///< caller's index, in the contacts
+};
+
+/// One contact of the sliding part in the world.
+struct SlideContact {
+  std::uint32_t obstacle = 0;  ///< SlideObstacle::id
+  Vec3 p_W = Vec3::Zero();     ///< contact point
+  Vec3 n_W = Vec3::UnitY();    ///< unit normal from the obstacle toward the part
+  collision::ContactKind kind = collision::ContactKind::kPoint;
+  /// How far the part has moved away from the contact along its normal since
+  /// it was found; past kContactExpiry the contact no longer constrains.
+  Real separation = 0;
+};
+
+/// A contact the part has moved this far away from is forgotten (metres).
+inline constexpr Real kContactExpiry = 1e-4;
+
+/// What one step wants.
+struct SlideRequest {
+  std::shared_ptr<const collision::CollisionModel> part;          ///< the sliding part (kObb)
+  std::shared_ptr<const collision::DistanceModel> part_distance;  ///< of the same mesh
+  Vec3 p_PC = Vec3::Zero();  ///< its centre in its own frame (the point it turns about)
+  Real size = 0.05;          ///< its size L in metres (weights turning against moving)
+  Transform X_WP{};          ///< where it is: collision-free
+  Transform X_WP_target{};   ///< where the hand wants it
+  std::span<const SlideObstacle> obstacles;
+  /// The contacts of the last step (SlideResult::contacts): the part is
+  /// still against them, so they constrain the first move of this step and
+  /// a part resting in a corner costs no search (contact coherence).
+  std::span<const SlideContact> previous_contacts;
+};
+
+/// How the step ended.
+enum class SlideStatus : std::uint8_t {
+  kReached,        ///< at the target, no contact on the way
+  kSliding,        ///< held back by contacts, moved as far as they allow
+  kAtRest,         ///< held back and no further motion possible this frame
+  kOverstretched,  ///< the target is past the band's limit: the part stays where it is
+  kBlocked,        ///< the starting pose already collides: nothing moved
+};
+
+/// Outcome of a step.
+struct SlideResult {
+  SlideStatus status = SlideStatus::kReached;
+  Transform X_WP{};  ///< the new pose (collision-free unless kBlocked)
+  /// The contacts that constrained the step: the previous step's, then those
+  /// met on the way, without repeats (same obstacle, point within 0.1 mm,
+  /// normal within 1 degree), at most kMaxSlideContacts, the newest kept.
+  std::vector<SlideContact> contacts;
+  int new_contacts = 0;  ///< of those, met in this step
+  int substeps = 0;
+  int collision_queries = 0;
+  Real stretch_m = 0;    ///< band stretch at the end: target centre to part centre
+  Real stretch_deg = 0;  ///< and angle
+};
+
+/// Most contacts a step keeps.
+inline constexpr std::size_t kMaxSlideContacts = 48;
+
+/// One step of a held part toward its target (see the file comment).
+SlideResult slide(const SlideRequest& request, const SlidingSettings& settings = {});
+
+/// Whether the part at X_WP collides with any obstacle (exact first-hit tests).
+bool collides(const collision::CollisionModel& part, const Transform& X_WP,
+              std::span<const SlideObstacle> obstacles, int* queries = nullptr);
+
+/// The rotation vector (axis times angle, radians) of R, and its inverse.
+Vec3 rotation_vector(const Mat3& R);
+Mat3 rotation_from_vector(const Vec3& w);
+
+}  // namespace dovetail::interaction

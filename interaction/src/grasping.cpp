@@ -1,0 +1,513 @@
+#include "dovetail/interaction/grasping.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "dovetail/collision/distance.h"
+#include "dovetail/engine/scene.h"
+
+namespace dovetail::interaction {
+
+namespace {
+
+using engine::EventKind;
+using engine::PartHandle;
+
+constexpr Real kDegree = std::numbers::pi / 180;
+/// A part drawn onto a mate's axis stays drawn until it is this many times
+/// the mate's tolerances away.
+constexpr Real kGuideHysteresis = 3;
+
+/// The joints a digit closes with, and the segments that move with them.
+struct DigitJoints {
+  std::vector<std::size_t> joints;
+  std::vector<std::size_t> flexion;  ///< of those, the ones whose sum is the digit's flexion
+  std::vector<Segment> segments;
+};
+
+DigitJoints digit_joints(std::size_t digit) {
+  if (digit == 0) {
+    return {{0, 1, 2, 3},
+            {0, 1, 2},
+            {Segment::kThumbMetacarpal, Segment::kThumbProximal, Segment::kThumbDistal}};
+  }
+  const std::size_t j = static_cast<std::size_t>(Joint::kIndexMcp) + 3 * (digit - 1);
+  const auto s = static_cast<std::size_t>(Segment::kIndexProximal) + 3 * (digit - 1);
+  return {{j, j + 1, j + 2},
+          {j, j + 1, j + 2},
+          {static_cast<Segment>(s), static_cast<Segment>(s + 1), static_cast<Segment>(s + 2)}};
+}
+
+Real flexion(const JointAngles& q, const DigitJoints& d) {
+  Real sum = 0;
+  for (std::size_t j : d.flexion) sum += q[j];
+  return sum;
+}
+
+std::optional<std::size_t> digit_of(Segment s) {
+  const auto i = static_cast<std::size_t>(s);
+  if (i == 0) return std::nullopt;
+  if (i <= 3) return 0;
+  return 1 + (i - 4) / 3;
+}
+
+Transform relative(const Transform& X_WA, const Transform& X_WB) {
+  const Transform X_AW = X_WA.inverse();
+  return {X_AW.R * X_WB.R, X_AW.apply(X_WB.t)};
+}
+
+collision::Bounds world_bounds(const collision::Bounds& local, const Transform& X_WP) {
+  collision::Bounds out{Vec3::Constant(INFINITY), Vec3::Constant(-INFINITY)};
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vec3 p(corner & 1 ? local.max.x() : local.min.x(),
+                 corner & 2 ? local.max.y() : local.min.y(),
+                 corner & 4 ? local.max.z() : local.min.z());
+    const Vec3 p_W = X_WP.apply(p);
+    out.min = out.min.cwiseMin(p_W);
+    out.max = out.max.cwiseMax(p_W);
+  }
+  return out;
+}
+
+bool overlap(const collision::Bounds& a, const collision::Bounds& b, Real margin) {
+  return (a.min.array() - margin <= b.max.array()).all() &&
+         (b.min.array() - margin <= a.max.array()).all();
+}
+
+/// Do contacts i and j oppose: the line between them inside both friction cones?
+bool oppose(const Vec3& p_i, const Vec3& n_i, const Vec3& p_j, const Vec3& n_j, Real cos_cone) {
+  const Vec3 d = p_j - p_i;
+  const Real length = d.norm();
+  if (!(length > 0)) return false;
+  return (-n_i).dot(d) >= cos_cone * length && (-n_j).dot(-d) >= cos_cone * length;
+}
+
+}  // namespace
+
+std::string_view grasp_type_name(GraspType type) {
+  switch (type) {
+    case GraspType::kPrecision:
+      return "precision";
+    case GraspType::kTripod:
+      return "tripod";
+    case GraspType::kPower:
+      return "power";
+  }
+  return "unknown";
+}
+
+/// Models of the meshes met, built once each and shared.
+struct Grasping::Models {
+  std::map<const collision::Mesh*, std::shared_ptr<const collision::CollisionModel>> collision;
+  std::map<const collision::Mesh*, std::shared_ptr<const collision::DistanceModel>> distance;
+  std::map<const collision::Mesh*, collision::Bounds> bounds;
+
+  const std::shared_ptr<const collision::CollisionModel>& collision_model(
+      const std::shared_ptr<const collision::Mesh>& mesh) {
+    auto& m = collision[mesh.get()];
+    if (!m) m = collision::build_model(collision::Method::kObb, mesh);
+    return m;
+  }
+  const std::shared_ptr<const collision::DistanceModel>& distance_shared(
+      const std::shared_ptr<const collision::Mesh>& mesh) {
+    auto& m = distance[mesh.get()];
+    if (!m) m = collision::build_distance_model(mesh);
+    return m;
+  }
+  const collision::DistanceModel& distance_model(
+      const std::shared_ptr<const collision::Mesh>& mesh) {
+    return *distance_shared(mesh);
+  }
+  const collision::Bounds& mesh_bounds(const std::shared_ptr<const collision::Mesh>& mesh) {
+    auto it = bounds.find(mesh.get());
+    if (it == bounds.end()) it = bounds.emplace(mesh.get(), collision::mesh_bounds(*mesh)).first;
+    return it->second;
+  }
+};
+
+/// A hand segment within the contact gap of a part.
+struct Grasping::Touch {
+  Segment segment = Segment::kPalm;
+  Vec3 p_W = Vec3::Zero();   ///< the witness point on the part
+  Vec3 n_W = Vec3::UnitY();  ///< the part's outward normal there
+};
+
+Grasping::Grasping(engine::Simulation& simulation, Hand& hand)
+    : Grasping(simulation, hand, InteractionSettings{}) {}
+
+Grasping::Grasping(engine::Simulation& simulation, Hand& hand, const InteractionSettings& settings)
+    : simulation_(&simulation),
+      hand_(&hand),
+      settings_(settings),
+      models_(std::make_unique<Models>()) {
+  hand.set_finger_limiter(
+      [this](const HandModel& model, const Transform& X_WH, const JointAngles& previous,
+             JointAngles& angles) { limit_fingers(model, X_WH, previous, angles); });
+  simulation.add_frame_hook(
+      [this](engine::Simulation& sim, std::uint64_t frame, double t) { update(sim, frame, t); });
+  simulation.add_event_filter([this](engine::Simulation&, std::vector<engine::Event>& events) {
+    events.insert(events.end(), pending_.begin(), pending_.end());
+    pending_.clear();
+  });
+}
+
+Grasping::~Grasping() = default;
+
+void Grasping::add_mate(const Mate& mate) {
+  simulation_->scene().get(mate.part);
+  simulation_->scene().get(mate.other);
+  mates_.push_back(mate);
+}
+
+void Grasping::hold(const std::string& part, GraspType type) {
+  const engine::Scene& scene = simulation_->scene();
+  const PartHandle handle = scene.get(part);
+  if (!scene.collision_mesh(handle)) {
+    throw engine::SceneError("grasping: part '" + part + "' has no collision mesh to hold");
+  }
+  held_ = part;
+  type_ = type;
+  last_slide_ = {};
+  contact_parts_.clear();
+  X_HO_ = relative(hand_->X_WH(), scene.world_pose(handle));
+  for (std::size_t d = 0; d < kDigitCount; ++d) {
+    flexion_at_grasp_[d] = flexion(hand_->glove_angles(), digit_joints(d));
+    grasping_digit_[d] = type == GraspType::kPower || d <= (type == GraspType::kTripod ? 2U : 1U);
+  }
+  opened_since_ = -1;
+}
+
+std::vector<PartHandle> Grasping::candidates(const engine::Scene& scene, const Transform& X_WH,
+                                             Real reach) const {
+  std::vector<PartHandle> out;
+  const collision::Bounds around{X_WH.t - Vec3::Constant(reach), X_WH.t + Vec3::Constant(reach)};
+  for (const PartHandle part : scene.parts()) {
+    const auto& mesh = scene.collision_mesh(part);
+    if (!mesh || scene.has_tag(part, "hand")) continue;
+    const Transform X_WP =
+        held_ && scene.name(part) == *held_ ? engine::compose(X_WH, X_HO_) : scene.world_pose(part);
+    if (overlap(world_bounds(models_->mesh_bounds(mesh), X_WP), around, 0)) out.push_back(part);
+  }
+  return out;
+}
+
+void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
+                             const JointAngles& previous, JointAngles& angles) {
+  const engine::Scene& scene = simulation_->scene();
+  const std::vector<PartHandle> parts = candidates(scene, X_WH, 1.2 * model.hand_length());
+  if (parts.empty()) return;
+  std::vector<SlideObstacle> obstacles;
+  for (const PartHandle part : parts) {
+    const bool held = held_ && scene.name(part) == *held_;
+    obstacles.push_back({models_->collision_model(scene.collision_mesh(part)), nullptr,
+                         held ? engine::compose(X_WH, X_HO_) : scene.world_pose(part), part.index});
+  }
+  auto digit_collides = [&](const JointAngles& q, const DigitJoints& d) {
+    const HandPose pose = model.forward_kinematics(q);
+    for (const Segment s : d.segments) {
+      const auto& proxy = models_->collision_model(model.proxy(s));
+      const Transform X_WS = engine::compose(X_WH, pose.X_HS[static_cast<std::size_t>(s)]);
+      int queries = 0;
+      const bool hit = collides(*proxy, X_WS, obstacles, &queries);
+      stats_.finger_queries += static_cast<std::uint64_t>(queries);
+      if (hit) return true;
+    }
+    return false;
+  };
+  const JointAngles target = angles;
+  for (std::size_t digit = 0; digit < kDigitCount; ++digit) {
+    const DigitJoints d = digit_joints(digit);
+    if (flexion(target, d) <= flexion(previous, d)) continue;  // opening: nothing to stop
+    if (!digit_collides(angles, d)) continue;
+    // Closing into a part: from the last free posture toward the glove's, to the first contact.
+    JointAngles q = angles;
+    for (std::size_t j : d.joints) q[j] = previous[j];
+    if (digit_collides(q, d)) continue;  // already in contact where it was: the glove's angles
+    Real free = 0, hit = 1;
+    for (int i = 0; i < settings_.grasp.finger_bisection_steps; ++i) {
+      const Real mid = (free + hit) / 2;
+      for (std::size_t j : d.joints) q[j] = previous[j] + mid * (target[j] - previous[j]);
+      (digit_collides(q, d) ? hit : free) = mid;
+    }
+    for (std::size_t j : d.joints) angles[j] = previous[j] + free * (target[j] - previous[j]);
+  }
+}
+
+std::vector<Grasping::Touch> Grasping::touches(const engine::Scene& scene, PartHandle part) {
+  std::vector<Touch> out;
+  const auto& mesh = scene.collision_mesh(part);
+  const collision::DistanceModel& part_model = models_->distance_model(mesh);
+  const Transform X_WP = scene.world_pose(part);
+  const Transform X_PW = X_WP.inverse();
+  const HandModel& model = hand_->model();
+  const HandPose& pose = hand_->pose();
+  const collision::Bounds part_box = world_bounds(models_->mesh_bounds(mesh), X_WP);
+  for (std::size_t i = 0; i < kSegmentCount; ++i) {
+    const auto segment = static_cast<Segment>(i);
+    const Transform X_WS = engine::compose(hand_->X_WH(), pose.X_HS[i]);
+    const auto& proxy = model.proxy(segment);
+    if (!overlap(world_bounds(models_->mesh_bounds(proxy), X_WS), part_box,
+                 settings_.grasp.contact_gap)) {
+      continue;
+    }
+    ++stats_.contact_queries;
+    const collision::ToleranceResult r = collision::within_tolerance(
+        part_model, models_->distance_model(proxy), {X_PW.R * X_WS.R, X_PW.apply(X_WS.t)},
+        settings_.grasp.contact_gap);
+    if (!r.within) continue;
+    const auto& tri = mesh->triangles[r.triangle_a];
+    const Vec3 n_P = (mesh->vertices[tri[1]] - mesh->vertices[tri[0]])
+                         .cross(mesh->vertices[tri[2]] - mesh->vertices[tri[0]])
+                         .normalized();
+    out.push_back({segment, X_WP.apply(r.p_A), X_WP.R * n_P});
+  }
+  return out;
+}
+
+std::optional<GraspType> Grasping::classify(const std::vector<Touch>& touches) const {
+  const Real cos_cone = std::cos(std::atan(settings_.grasp.friction));
+  const Touch* palm = nullptr;
+  const Touch* tip[kDigitCount] = {};
+  std::vector<const Touch*> fingers;  // touching segments of the digits
+  for (const Touch& t : touches) {
+    if (t.segment == Segment::kPalm) palm = &t;
+    const std::optional<std::size_t> digit = digit_of(t.segment);
+    if (!digit) continue;
+    fingers.push_back(&t);
+    const DigitJoints d = digit_joints(*digit);
+    if (t.segment == d.segments.back()) tip[*digit] = &t;
+  }
+  auto opposes = [&](const Touch* a, const Touch* b) {
+    return a && b && oppose(a->p_W, a->n_W, b->p_W, b->n_W, cos_cone);
+  };
+  if (palm && fingers.size() >= 2) {
+    for (const Touch* f : fingers) {
+      if (opposes(palm, f)) return GraspType::kPower;
+    }
+  }
+  if (opposes(tip[0], tip[1]) && opposes(tip[0], tip[2])) return GraspType::kTripod;
+  if (opposes(tip[0], tip[1]) || opposes(tip[0], tip[2])) return GraspType::kPrecision;
+  return std::nullopt;
+}
+
+void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real t) {
+  engine::Scene& scene = simulation.scene();
+  const JointAngles& glove = hand_->glove_angles();
+  Real total_flexion = 0;
+  std::array<Real, kDigitCount> digit_flexion{};
+  for (std::size_t d = 0; d < kDigitCount; ++d) {
+    digit_flexion[d] = flexion(glove, digit_joints(d));
+    total_flexion += digit_flexion[d];
+  }
+  auto emit = [&](EventKind kind, const std::string& a, const std::string& b) {
+    pending_.push_back({kind, frame, t, a, b});
+  };
+
+  if (held_) {
+    // Release: a grasping digit opened past its flexion at the grasp, long enough.
+    bool opened = false;
+    for (std::size_t d = 0; d < kDigitCount; ++d) {
+      opened =
+          opened || (grasping_digit_[d] &&
+                     digit_flexion[d] < flexion_at_grasp_[d] - settings_.grasp.release_open_deg);
+    }
+    if (!opened) {
+      opened_since_ = -1;
+    } else if (opened_since_ < 0) {
+      opened_since_ = t;
+    }
+    if (opened && t - opened_since_ >= settings_.grasp.release_time_s - 1e-9) {
+      emit(EventKind::kRelease, *held_, "opened");
+      release(simulation, "opened");
+    } else {
+      carry(simulation);
+    }
+    // The carried part's events were emitted in carry and release.
+    last_flexion_ = total_flexion;
+    (void)frame;
+    return;
+  }
+
+  // Grasp onset: the same part and type for onset_frames frames while the hand closes.
+  std::optional<GraspType> found;
+  std::string found_part;
+  for (const PartHandle part :
+       candidates(scene, hand_->X_WH(), 1.2 * hand_->model().hand_length())) {
+    const std::vector<Touch> touching = touches(scene, part);
+    if (touching.empty()) continue;
+    if (const std::optional<GraspType> type = classify(touching)) {
+      found = type;
+      found_part = scene.name(part);
+      break;
+    }
+  }
+  constexpr Real kClosingSlack = 2;  // degrees of glove jitter tolerated while closing
+  const bool closing = total_flexion >= last_flexion_ - kClosingSlack;
+  if (found && closing && found_part == candidate_ && *found == candidate_type_) {
+    ++candidate_frames_;
+  } else if (found && closing) {
+    candidate_ = found_part;
+    candidate_type_ = *found;
+    candidate_frames_ = 1;
+  } else {
+    candidate_.clear();
+    candidate_frames_ = 0;
+  }
+  last_flexion_ = total_flexion;
+  if (candidate_frames_ >= settings_.grasp.onset_frames) {
+    hold(candidate_, candidate_type_);
+    // The digits that grasp are those touching the part now.
+    const std::vector<Touch> touching = touches(scene, scene.get(candidate_));
+    grasping_digit_.fill(false);
+    for (const Touch& touch : touching) {
+      if (const std::optional<std::size_t> d = digit_of(touch.segment)) grasping_digit_[*d] = true;
+    }
+    emit(EventKind::kGrasp, candidate_, std::string(grasp_type_name(candidate_type_)));
+    candidate_.clear();
+    candidate_frames_ = 0;
+  }
+}
+
+void Grasping::carry(engine::Simulation& simulation) {
+  engine::Scene& scene = simulation.scene();
+  const PartHandle part = scene.get(*held_);
+  const auto& mesh = scene.collision_mesh(part);
+  const Transform X_WO = scene.world_pose(part);
+  const Transform X_WO_target = guided(scene, *held_, engine::compose(hand_->X_WH(), X_HO_));
+  const collision::Bounds& local = models_->mesh_bounds(mesh);
+  // Obstacles: every other part that the swept box of the move reaches.
+  collision::Bounds swept = world_bounds(local, X_WO);
+  const collision::Bounds to = world_bounds(local, X_WO_target);
+  swept.min = swept.min.cwiseMin(to.min);
+  swept.max = swept.max.cwiseMax(to.max);
+  std::vector<SlideObstacle> obstacles;
+  std::vector<PartHandle> handles;
+  for (const PartHandle other : scene.parts()) {
+    const auto& other_mesh = scene.collision_mesh(other);
+    if (other == part || !other_mesh || scene.has_tag(other, "hand")) continue;
+    const Transform X_WB = scene.world_pose(other);
+    if (!overlap(world_bounds(models_->mesh_bounds(other_mesh), X_WB), swept, 1e-3)) continue;
+    obstacles.push_back({models_->collision_model(other_mesh), models_->distance_shared(other_mesh),
+                         X_WB, static_cast<std::uint32_t>(handles.size())});
+    handles.push_back(other);
+  }
+  SlideRequest request;
+  request.part = models_->collision_model(mesh);
+  request.part_distance = models_->distance_shared(mesh);
+  request.p_PC = (local.min + local.max) / 2;
+  request.size = std::max<Real>((local.max - local.min).norm() / 2, 1e-4);
+  request.X_WP = X_WO;
+  request.X_WP_target = X_WO_target;
+  request.obstacles = obstacles;
+  // Last frame's contacts, with their obstacles renumbered for this frame's list.
+  std::vector<SlideContact> previous;
+  for (const SlideContact& k : last_slide_.contacts) {
+    const auto it = std::find(handles.begin(), handles.end(), contact_parts_[k.obstacle]);
+    if (it == handles.end()) continue;
+    SlideContact renumbered = k;
+    renumbered.obstacle = static_cast<std::uint32_t>(it - handles.begin());
+    previous.push_back(renumbered);
+  }
+  request.previous_contacts = previous;
+  last_slide_ = slide(request, settings_.sliding);
+  contact_parts_ = handles;
+  stats_.slide_queries += static_cast<std::uint64_t>(last_slide_.collision_queries);
+  stats_.max_stretch_m = std::max(stats_.max_stretch_m, last_slide_.stretch_m);
+  const engine::FrameResult& last = simulation.last_frame();
+  const std::uint64_t frame = simulation.frame();
+  const Real t = simulation.time();
+  (void)last;
+  if (last_slide_.status == SlideStatus::kOverstretched) {
+    pending_.push_back({EventKind::kRelease, frame, t, *held_, "overstretched"});
+    release(simulation, "overstretched");
+    return;
+  }
+  scene.set_world_pose(part, last_slide_.X_WP);
+  const bool in_contact = last_slide_.status != SlideStatus::kReached;
+  if (in_contact && !sliding_) {
+    sliding_ = true;
+    sliding_on_ = scene.name(handles[last_slide_.contacts.front().obstacle]);
+    pending_.push_back({EventKind::kSlideBegin, frame, t, *held_, sliding_on_});
+  } else if (!in_contact && sliding_ && last_slide_.status == SlideStatus::kReached) {
+    sliding_ = false;
+    pending_.push_back({EventKind::kSlideEnd, frame, t, *held_, sliding_on_});
+  }
+}
+
+Transform Grasping::guided(const engine::Scene& scene, const std::string& part,
+                           const Transform& X_WP_target) {
+  for (std::size_t m = 0; m < mates_.size(); ++m) {
+    const Mate& mate = mates_[m];
+    if (mate.part != part) continue;
+    const PartHandle o = scene.find(mate.other);
+    if (!o.valid()) continue;
+    const Transform X_WO = scene.world_pose(o);
+    const Vec3 q_W = X_WO.apply(mate.p_OF);
+    const Vec3 b_W = (X_WO.R * mate.axis_O).normalized();
+    const Vec3 p_W = X_WP_target.apply(mate.p_PF);
+    const Vec3 a_W = (X_WP_target.R * mate.axis_P).normalized();
+    // Within the capture region: the feature point near the other's axis line, the axes aligned.
+    const Vec3 off_axis = (p_W - q_W) - b_W * b_W.dot(p_W - q_W);
+    const Real angle = std::atan2(a_W.cross(b_W).norm(), a_W.dot(b_W));
+    // Captured within the tolerances, kept within three times them (glove noise
+    // must not pull the part in and out of the guide).
+    const Real widen = guiding_ == m ? kGuideHysteresis : 1;
+    if (off_axis.norm() > widen * mate.position_tolerance ||
+        angle > widen * mate.angle_tolerance_deg * kDegree) {
+      if (guiding_ == m) guiding_.reset();
+      continue;
+    }
+    guiding_ = m;
+    // The target turned by the least rotation onto the axis, its point moved onto the line.
+    Transform X = X_WP_target;
+    if (angle > 0) {
+      X.R = rotation_from_vector(a_W.cross(b_W).normalized() * angle) * X.R;
+    }
+    const Vec3 p_new = X.apply(mate.p_PF);
+    const Vec3 on_line = q_W + b_W * b_W.dot(p_new - q_W);
+    X.t += on_line - p_new;
+    return X;
+  }
+  return X_WP_target;
+}
+
+void Grasping::release(engine::Simulation& simulation, const std::string& reason) {
+  (void)reason;
+  const std::string part = *held_;
+  if (sliding_) {
+    pending_.push_back(
+        {EventKind::kSlideEnd, simulation.frame(), simulation.time(), part, sliding_on_});
+    sliding_ = false;
+  }
+  held_.reset();
+  guiding_.reset();
+  opened_since_ = -1;
+  snap(simulation, part);
+}
+
+void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
+  engine::Scene& scene = simulation.scene();
+  for (const Mate& mate : mates_) {
+    if (mate.part != part) continue;
+    const PartHandle p = scene.find(mate.part), o = scene.find(mate.other);
+    if (!p.valid() || !o.valid()) continue;
+    const Transform X_WP = scene.world_pose(p), X_WO = scene.world_pose(o);
+    const Vec3 p_W = X_WP.apply(mate.p_PF), q_W = X_WO.apply(mate.p_OF);
+    const Vec3 a_W = (X_WP.R * mate.axis_P).normalized(), b_W = (X_WO.R * mate.axis_O).normalized();
+    const Real angle = std::atan2(a_W.cross(b_W).norm(), a_W.dot(b_W)) / kDegree;
+    if ((p_W - q_W).norm() > mate.position_tolerance || angle > mate.angle_tolerance_deg) continue;
+    // The least turn of a onto b, then the point onto the point.
+    const Mat3 R = rotation_from_vector(a_W.cross(b_W).normalized() * (angle * kDegree));
+    Transform X_new;
+    X_new.R = angle > 0 ? Mat3(R * X_WP.R) : X_WP.R;
+    X_new.t = q_W - X_new.R * mate.p_PF;
+    scene.set_world_pose(p, X_new);
+    pending_.push_back(
+        {EventKind::kMate, simulation.frame(), simulation.time(), mate.part, mate.other});
+    return;
+  }
+}
+
+}  // namespace dovetail::interaction

@@ -1,0 +1,258 @@
+#include "dovetail/interaction/sliding.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+
+namespace dovetail::interaction {
+
+namespace {
+
+using Vec6 = Eigen::Matrix<Real, 6, 1>;
+
+constexpr Real kDegree = std::numbers::pi / 180;
+
+/// X rotated by w about the point c (world) and moved by v.
+Transform moved(const Transform& X, const Vec3& c, const Vec3& v, const Vec3& w) {
+  const Mat3 R = rotation_from_vector(w);
+  Transform out;
+  out.R = R * X.R;
+  out.t = c + v + R * (X.t - c);
+  return out;
+}
+
+using Triangle = std::array<Vec3, 3>;
+
+/// Most triangle pairs of one patch whose closest points are measured.
+constexpr std::size_t kPairsPerPatch = 64;
+
+/// The contacts met between the last free pose and the colliding one. The
+/// contact patches of the colliding pose X_WP_hit say where the part meets
+/// each obstacle and how (their kind: face, curve, point); for each patch's
+/// triangle pairs, the closest points of the two triangles at the free pose
+/// X_WP_free, a hair's breadth away, give a contact point and the normal from
+/// the obstacle's triangle toward the part's: the face normal for a vertex or
+/// an edge on a face, the common perpendicular for two edges. A patch keeps
+/// its distinct normals (1 degree apart), each at the point of its pair.
+void contacts_at(const SlideRequest& request, const Transform& X_WP_free, const Transform& X_WP_hit,
+                 std::vector<SlideContact>& out, int& queries) {
+  const collision::Mesh& part_mesh = request.part->mesh();
+  for (const SlideObstacle& o : request.obstacles) {
+    const Transform X_OW = o.X_WO.inverse();
+    const Transform X_OP = {X_OW.R * X_WP_hit.R, X_OW.apply(X_WP_hit.t)};
+    ++queries;
+    const std::vector<collision::ContactPatch> patches =
+        collision::compute_contacts(*o.model, *request.part, X_OP, {.estimate_depth = false});
+    const collision::Mesh& obstacle_mesh = o.model->mesh();
+    for (const collision::ContactPatch& patch : patches) {
+      const std::size_t first = out.size();
+      const std::size_t count = std::min(patch.pairs.size(), kPairsPerPatch);
+      for (std::size_t i = 0; i < count; ++i) {
+        // Evenly over the patch when it has more pairs than are measured.
+        const collision::TrianglePair& pair = patch.pairs[i * patch.pairs.size() / count];
+        Triangle ta, tb;
+        for (int k = 0; k < 3; ++k) {
+          ta[k] = o.X_WO.apply(obstacle_mesh.vertices[obstacle_mesh.triangles[pair.a][k]]);
+          tb[k] = X_WP_free.apply(part_mesh.vertices[part_mesh.triangles[pair.b][k]]);
+        }
+        const collision::TrianglePairDistance d = collision::triangle_pair_distance(ta, tb);
+        if (!(d.distance > 0)) continue;  // still touching at the free pose: no direction
+        const Vec3 n_W = (d.q - d.p) / d.distance;
+        bool seen = false;
+        for (std::size_t j = first; j < out.size() && !seen; ++j)
+          seen = out[j].n_W.dot(n_W) > 0.9998;
+        if (!seen) out.push_back({o.id, (d.p + d.q) / 2, n_W, patch.kind, 0});
+      }
+      if (out.size() == first) {
+        out.push_back({o.id, o.X_WO.apply(patch.point), (o.X_WO.R * patch.normal).normalized(),
+                       patch.kind, 0});
+      }
+    }
+  }
+}
+
+/// The motion x = (v, w) closest to x_d in the metric diag(1, 1, 1, L^2, L^2, L^2) with
+/// a_i . x >= b_i for every contact: Hildreth's dual coordinate ascent, a fixed number of
+/// sweeps in a fixed order.
+Vec6 project(const Vec6& x_d, const std::vector<Vec6>& a, const std::vector<Real>& b, Real size,
+             int sweeps) {
+  Vec6 m_inv;
+  const Real l2 = size * size;
+  m_inv << 1, 1, 1, 1 / l2, 1 / l2, 1 / l2;
+  std::vector<Real> lambda(a.size(), 0);
+  std::vector<Real> norm(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) norm[i] = a[i].dot(m_inv.cwiseProduct(a[i]));
+  Vec6 x = x_d;
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (!(norm[i] > 0)) continue;
+      const Real step = std::max(-lambda[i], (b[i] - a[i].dot(x)) / norm[i]);
+      lambda[i] += step;
+      x += step * m_inv.cwiseProduct(a[i]);
+    }
+  }
+  return x;
+}
+
+}  // namespace
+
+Vec3 rotation_vector(const Mat3& R) {
+  // Angle from the trace, axis from the skew part; near pi from the diagonal.
+  const Real cos_angle = std::clamp((R.trace() - 1) / 2, Real{-1}, Real{1});
+  const Vec3 skew(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
+  const Real sin_angle = skew.norm() / 2;
+  const Real angle = std::atan2(sin_angle, cos_angle);
+  if (angle < 1e-12) return skew / 2;
+  if (angle < std::numbers::pi - 1e-6) return skew * (angle / (2 * sin_angle));
+  Vec3 axis;
+  const Mat3 B = (R + Mat3::Identity()) / 2;
+  int k = 0;
+  B.diagonal().maxCoeff(&k);
+  axis = B.col(k) / std::sqrt(std::max(B(k, k), Real{0}));
+  if (axis.dot(skew) < 0) axis = -axis;
+  return axis.normalized() * angle;
+}
+
+Mat3 rotation_from_vector(const Vec3& w) {
+  const Real angle = w.norm();
+  if (angle == 0) return Mat3::Identity();
+  const Vec3 k = w / angle;
+  Mat3 K;
+  K << 0, -k.z(), k.y(), k.z(), 0, -k.x(), -k.y(), k.x(), 0;
+  return Mat3::Identity() + std::sin(angle) * K + (1 - std::cos(angle)) * (K * K);
+}
+
+bool collides(const collision::CollisionModel& part, const Transform& X_WP,
+              std::span<const SlideObstacle> obstacles, int* queries) {
+  for (const SlideObstacle& o : obstacles) {
+    const Transform X_OW = o.X_WO.inverse();
+    const Transform X_OP = {X_OW.R * X_WP.R, X_OW.apply(X_WP.t)};
+    if (queries) ++*queries;
+    if (o.model->collide(part, X_OP).colliding) return true;
+  }
+  return false;
+}
+
+SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) {
+  SlideResult result;
+  result.X_WP = request.X_WP;
+  const collision::CollisionModel& part = *request.part;
+  auto centre = [&](const Transform& X) { return X.apply(request.p_PC); };
+  auto measure_stretch = [&] {
+    result.stretch_m = (centre(request.X_WP_target) - centre(result.X_WP)).norm();
+    result.stretch_deg =
+        rotation_vector(request.X_WP_target.R * result.X_WP.R.transpose()).norm() / kDegree;
+  };
+  measure_stretch();
+  if (result.stretch_m > settings.band_limit_m || result.stretch_deg > settings.band_limit_deg) {
+    result.status = SlideStatus::kOverstretched;
+    return result;
+  }
+  if (collides(part, result.X_WP, request.obstacles, &result.collision_queries)) {
+    result.status = SlideStatus::kBlocked;
+    return result;
+  }
+  auto add_contact = [&](const SlideContact& k) {
+    for (const SlideContact& c : result.contacts) {
+      if (c.obstacle == k.obstacle && (c.p_W - k.p_W).norm() < 1e-4 && c.n_W.dot(k.n_W) > 0.9998) {
+        return false;
+      }
+    }
+    result.contacts.push_back(k);
+    if (result.contacts.size() > kMaxSlideContacts) result.contacts.erase(result.contacts.begin());
+    return true;
+  };
+  for (const SlideContact& k : request.previous_contacts) add_contact(k);
+
+  // The contacts move with the part; those it moves away from expire.
+  auto follow_contacts = [&](const Vec3& c, const Vec3& v, const Vec3& w) {
+    const Mat3 R = rotation_from_vector(w);
+    std::vector<SlideContact> kept;
+    for (SlideContact k : result.contacts) {
+      const Vec3 p = c + v + R * (k.p_W - c);
+      k.separation += k.n_W.dot(p - k.p_W);
+      k.p_W = p;
+      if (k.separation <= kContactExpiry) kept.push_back(k);
+    }
+    result.contacts = std::move(kept);
+  };
+
+  bool touched = !result.contacts.empty();
+  int stalled = 0;
+  result.status = SlideStatus::kReached;
+  for (int sub = 0; sub < settings.substeps; ++sub) {
+    ++result.substeps;
+    // 4. The rest of the wanted motion, projected onto what the contacts allow.
+    const Vec3 c = centre(result.X_WP);
+    Vec6 wanted;
+    wanted << centre(request.X_WP_target) - c,
+        rotation_vector(request.X_WP_target.R * result.X_WP.R.transpose());
+    if (wanted.head<3>().norm() + wanted.tail<3>().norm() * request.size < settings.rest_m) break;
+    // Each contact: not into it, and back out to the skin where closer (so that sliding
+    // along a curved or faceted surface has room for what the first order misses).
+    std::vector<Vec6> constraints;
+    std::vector<Real> clearance;
+    for (const SlideContact& k : result.contacts) {
+      Vec6 a;
+      a << k.n_W, (k.p_W - c).cross(k.n_W);
+      constraints.push_back(a);
+      clearance.push_back(std::max<Real>(0, settings.skin_m - k.separation));
+    }
+    const Vec6 allowed = project(wanted, constraints, clearance,
+                                 settings.turn_stiffness * request.size, settings.solver_sweeps);
+    // 5. At rest: nothing left that the contacts allow.
+    if (allowed.head<3>().norm() + allowed.tail<3>().norm() * request.size < settings.rest_m) {
+      result.status = SlideStatus::kAtRest;
+      break;
+    }
+    const Vec3 v = allowed.head<3>(), w = allowed.tail<3>();
+    // 1. Try the move; where it collides, bisect toward the exact contact pose.
+    const Transform candidate = moved(result.X_WP, c, v, w);
+    if (!collides(part, candidate, request.obstacles, &result.collision_queries)) {
+      result.X_WP = candidate;
+      follow_contacts(c, v, w);
+      result.status = result.contacts.empty() ? SlideStatus::kReached : SlideStatus::kSliding;
+      stalled = 0;
+      continue;
+    }
+    touched = true;
+    result.status = SlideStatus::kSliding;
+    // Halve until the bracket is under the resolution (a small move needs few steps).
+    const Real move = v.norm() + w.norm() * request.size;
+    Real free = 0, hit = 1;
+    for (int i = 0; i < settings.bisection_steps && (hit - free) * move > settings.resolution_m;
+         ++i) {
+      const Real mid = (free + hit) / 2;
+      if (collides(part, moved(result.X_WP, c, mid * v, mid * w), request.obstacles,
+                   &result.collision_queries)) {
+        hit = mid;
+      } else {
+        free = mid;
+      }
+    }
+    const Transform at_hit = moved(result.X_WP, c, hit * v, hit * w);
+    result.X_WP = moved(result.X_WP, c, free * v, free * w);
+    follow_contacts(c, free * v, free * w);
+    // 2, 3. The contacts of the colliding pose, their kinds and normals.
+    std::vector<SlideContact> met;
+    contacts_at(request, result.X_WP, at_hit, met, result.collision_queries);
+    int added = 0;
+    for (const SlideContact& k : met) added += add_contact(k) ? 1 : 0;
+    result.new_contacts += added;
+    // Two moves in a row that got nowhere (under a thousandth of the way): at rest.
+    stalled = free < 1e-3 ? stalled + 1 : 0;
+    if (stalled >= 2) {
+      result.status = SlideStatus::kAtRest;
+      break;
+    }
+  }
+  if (result.status == SlideStatus::kReached && !result.contacts.empty()) {
+    result.status = SlideStatus::kSliding;
+  }
+  (void)touched;
+  measure_stretch();
+  return result;
+}
+
+}  // namespace dovetail::interaction
