@@ -287,7 +287,13 @@ std::optional<GraspType> Grasping::classify(const std::vector<Touch>& touches) c
       if (opposes(palm, f)) return GraspType::kPower;
     }
   }
-  if (opposes(tip[0], tip[1]) && opposes(tip[0], tip[2])) return GraspType::kTripod;
+  // 3-point pinch: the index and middle tips act as one virtual finger (Feix et al.)
+  // that the thumb opposes.
+  if (tip[0] && tip[1] && tip[2]) {
+    const Touch pair{Segment::kIndexDistal, (tip[1]->p_W + tip[2]->p_W) / 2,
+                     (tip[1]->n_W + tip[2]->n_W).normalized()};
+    if (opposes(tip[0], &pair)) return GraspType::kTripod;
+  }
   if (opposes(tip[0], tip[1]) || opposes(tip[0], tip[2])) return GraspType::kPrecision;
   return std::nullopt;
 }
@@ -343,10 +349,13 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
       break;
     }
   }
-  constexpr Real kClosingSlack = 2;  // degrees of glove jitter tolerated while closing
+  constexpr Real kClosingSlack = 2;    // degrees of glove jitter tolerated while closing
+  constexpr Real kStillClosing = 0.5;  // degrees per frame: the hand is still closing
   const bool closing = total_flexion >= last_flexion_ - kClosingSlack;
-  if (found && closing && found_part == candidate_ && *found == candidate_type_) {
+  const bool still_closing = total_flexion > last_flexion_ + kStillClosing;
+  if (found && closing && found_part == candidate_) {
     ++candidate_frames_;
+    candidate_type_ = *found;  // more fingers may arrive while the hand closes
   } else if (found && closing) {
     candidate_ = found_part;
     candidate_type_ = *found;
@@ -356,7 +365,10 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
     candidate_frames_ = 0;
   }
   last_flexion_ = total_flexion;
-  if (candidate_frames_ >= settings_.grasp.onset_frames) {
+  // The grasp holds for onset_frames; its type is taken once the hand stops closing
+  // (or after four times as long), so that the last fingers to arrive count.
+  if (candidate_frames_ >= settings_.grasp.onset_frames &&
+      (!still_closing || candidate_frames_ >= 4 * settings_.grasp.onset_frames)) {
     hold(candidate_, candidate_type_);
     // The digits that grasp are those touching the part now.
     const std::vector<Touch> touching = touches(scene, scene.get(candidate_));

@@ -1,0 +1,123 @@
+// Natural grasping: a designed glove plan grasps a bar with a power grasp,
+// holds it while the hand moves and releases it when the hand opens; an open
+// hand brushing past a part grasps nothing.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "dovetail/collision/primitives.h"
+#include "dovetail/interaction/glove_source.h"
+#include "dovetail/interaction/grasping.h"
+#include "dovetail/interaction/postures.h"
+
+namespace dovetail::interaction {
+namespace {
+
+using engine::Event;
+using engine::EventKind;
+
+/// A cylinder of `radius` and `length` centred at p_H with its axis along `axis` (hand frame
+/// at the origin, so H is the world).
+engine::PartDesc cylinder_part(const std::string& name, Real radius, Real length, const Vec3& p_W,
+                               const Vec3& axis) {
+  Transform X;
+  X.R =
+      Eigen::Quaternion<Real>::FromTwoVectors(Vec3::UnitZ(), axis.normalized()).toRotationMatrix();
+  X.t = p_W - X.R * Vec3(0, 0, length / 2);
+  return {.name = name,
+          .X_PC = X,
+          .render_mesh = std::make_shared<const collision::Mesh>(
+              collision::make_cylinder(radius, length, 48))};
+}
+
+struct GraspRun {
+  std::vector<Event> events;
+  Vec3 moved = Vec3::Zero();  ///< how far the part moved
+  std::optional<GraspType> type_while_moving;
+};
+
+/// The hand open at the origin closes to `posture` in 0.5 s, waits, lifts 50 mm in
+/// 0.5 s, opens in 0.4 s and waits.
+GraspRun run_grasp(engine::PartDesc part, const char* posture) {
+  engine::Scene scene;
+  const std::string name = part.name;
+  scene.add_part(part);
+  engine::Simulation sim(std::move(scene));
+  GlovePlan plan;
+  PlanStep close{.kind = PlanStep::Kind::kClose, .duration = 0.5};
+  close.posture = *named_posture(posture);
+  PlanStep wait{.kind = PlanStep::Kind::kWait, .duration = 0.2};
+  PlanStep lift{.kind = PlanStep::Kind::kReach, .duration = 0.5};
+  lift.poses = {{Vec3(0, 0.05, 0), Quaternion{}}};
+  PlanStep open{.kind = PlanStep::Kind::kOpen, .duration = 0.4};
+  plan.steps = {close, wait, lift, open, wait};
+  Hand hand(sim, std::make_shared<SimulatedGlove>(plan));
+  Grasping grasping(sim, hand);
+  const Vec3 start = sim.scene().world_pose(name).t;
+  GraspRun run;
+  for (int frame = 0; frame < 170; ++frame) {
+    const engine::FrameResult& r = sim.step();
+    run.events.insert(run.events.end(), r.events.begin(), r.events.end());
+    if (frame == 100) run.type_while_moving = grasping.grasp_type();
+  }
+  run.moved = sim.scene().world_pose(name).t - start;
+  return run;
+}
+
+std::optional<std::string> grasp_of(const GraspRun& run, const std::string& part) {
+  for (const Event& e : run.events) {
+    if (e.kind == EventKind::kGrasp && e.a == part) return e.b;
+  }
+  return std::nullopt;
+}
+
+bool released(const GraspRun& run, const std::string& part) {
+  return std::any_of(run.events.begin(), run.events.end(), [&](const Event& e) {
+    return e.kind == EventKind::kRelease && e.a == part && e.b == "opened";
+  });
+}
+
+void expect_carried(const GraspRun& run, const std::string& part, const std::string& type) {
+  EXPECT_EQ(grasp_of(run, part), type);
+  ASSERT_TRUE(run.type_while_moving.has_value()) << "held while the hand moves";
+  EXPECT_EQ(std::string(grasp_type_name(*run.type_while_moving)), type);
+  EXPECT_TRUE(released(run, part));
+  EXPECT_NEAR(run.moved.y(), 0.05, 2e-3) << "the part went up with the hand";
+}
+
+TEST(GraspTypes, ABarAcrossThePalmIsAPowerGrasp) {
+  const GraspRun run = run_grasp(
+      cylinder_part("bar", 0.022, 0.08, Vec3(0.02, -0.0105 - 0.022 - 0.0001, -0.06), Vec3::UnitX()),
+      "power");
+  expect_carried(run, "bar", "power");
+}
+
+TEST(GraspTypes, AnOpenHandBrushingPastGraspsNothing) {
+  // The open hand sweeps sideways across a block so that its fingers run through its top.
+  engine::Scene scene;
+  scene.add_part({.name = "block",
+                  .X_PC = {Mat3::Identity(), Vec3(0, -0.02, -0.15)},
+                  .render_mesh = std::make_shared<const collision::Mesh>(
+                      collision::make_box(Vec3(0.01, 0.0195, 0.01)))});
+  engine::Simulation sim(std::move(scene));
+  GlovePlan plan;
+  plan.start.p_WH = Vec3(-0.12, 0, 0);
+  PlanStep sweep{.kind = PlanStep::Kind::kReach, .duration = 1.0};
+  sweep.poses = {{Vec3(0.12, 0, 0), Quaternion{}}};
+  plan.steps = {sweep};
+  Hand hand(sim, std::make_shared<SimulatedGlove>(plan));
+  Grasping grasping(sim, hand);
+  std::size_t touches = 0;
+  sim.events().subscribe(EventKind::kHandContactBegin, [&](const Event&) { ++touches; });
+  sim.events().subscribe(EventKind::kGrasp,
+                         [&](const Event& e) { ADD_FAILURE() << "grasped " << e.a; });
+  sim.run(100);
+  EXPECT_GT(touches, 2U) << "the fingers touched the block";
+  EXPECT_FALSE(grasping.held());
+  EXPECT_EQ(sim.scene().world_pose("block").t, Vec3(0, -0.02, -0.15));
+}
+
+}  // namespace
+}  // namespace dovetail::interaction
