@@ -1,6 +1,7 @@
 #include "dovetail/interaction/grasping.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -142,11 +143,18 @@ Grasping::Grasping(engine::Simulation& simulation, Hand& hand, const Interaction
       hand_(&hand),
       settings_(settings),
       models_(std::make_unique<Models>()) {
-  hand.set_finger_limiter(
-      [this](const HandModel& model, const Transform& X_WH, const JointAngles& previous,
-             JointAngles& angles) { limit_fingers(model, X_WH, previous, angles); });
-  simulation.add_frame_hook(
-      [this](engine::Simulation& sim, std::uint64_t frame, double t) { update(sim, frame, t); });
+  using Clock = std::chrono::steady_clock;
+  hand.set_finger_limiter([this](const HandModel& model, const Transform& X_WH,
+                                 const JointAngles& previous, JointAngles& angles) {
+    const auto start = Clock::now();
+    limit_fingers(model, X_WH, previous, angles);
+    stats_.frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  });
+  simulation.add_frame_hook([this](engine::Simulation& sim, std::uint64_t frame, double t) {
+    const auto start = Clock::now();
+    update(sim, frame, t);
+    stats_.frame_ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  });
   simulation.add_event_filter([this](engine::Simulation&, std::vector<engine::Event>& events) {
     events.insert(events.end(), pending_.begin(), pending_.end());
     pending_.clear();

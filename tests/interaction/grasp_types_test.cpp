@@ -40,14 +40,14 @@ struct GraspRun {
 
 /// The hand open at the origin closes to `posture` in 0.5 s, waits, lifts 50 mm in
 /// 0.5 s, opens in 0.4 s and waits.
-GraspRun run_grasp(engine::PartDesc part, const char* posture) {
+GraspRun run_grasp(engine::PartDesc part, const JointAngles& posture) {
   engine::Scene scene;
   const std::string name = part.name;
   scene.add_part(part);
   engine::Simulation sim(std::move(scene));
   GlovePlan plan;
   PlanStep close{.kind = PlanStep::Kind::kClose, .duration = 0.5};
-  close.posture = *named_posture(posture);
+  close.posture = posture;
   PlanStep wait{.kind = PlanStep::Kind::kWait, .duration = 0.2};
   PlanStep lift{.kind = PlanStep::Kind::kReach, .duration = 0.5};
   lift.poses = {{Vec3(0, 0.05, 0), Quaternion{}}};
@@ -90,7 +90,7 @@ void expect_carried(const GraspRun& run, const std::string& part, const std::str
 TEST(GraspTypes, ABarAcrossThePalmIsAPowerGrasp) {
   const GraspRun run = run_grasp(
       cylinder_part("bar", 0.022, 0.08, Vec3(0.02, -0.0105 - 0.022 - 0.0001, -0.06), Vec3::UnitX()),
-      "power");
+      *named_posture("power"));
   expect_carried(run, "bar", "power");
 }
 

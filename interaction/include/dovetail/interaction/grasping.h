@@ -84,6 +84,9 @@ struct InteractionStats {
   std::uint64_t contact_queries = 0;  ///< tolerance tests of the contact analysis
   std::uint64_t slide_queries = 0;    ///< collision tests and contact queries of sliding
   Real max_stretch_m = 0;             ///< largest band stretch of the run
+  /// Wall-clock milliseconds of the last frame's interaction work (closing the
+  /// fingers, contact analysis, sliding); for benchmarks, never in a report.
+  double frame_ms = 0;
 };
 
 /// Grasping, sliding and mates for one Hand in one Simulation.

@@ -52,7 +52,7 @@ struct SlidingSettings {
   int solver_sweeps = 64;    ///< passes over the contacts projecting the motion
   Real band_limit_m = 0.05;  ///< stretch (centre to centre) past which the band breaks
   Real band_limit_deg = 20;  ///< ... or angle between held and wanted orientation
-  Real rest_m = 1e-7;        ///< a sub-step moving less than this ends the frame: at rest
+  Real rest_m = 5e-6;        ///< a sub-step moving less than this ends the frame: at rest
   /// How much more the band resists turning than moving: the metric's length
   /// is turn_stiffness * L. Near 1 a part held back at one end pivots about
   /// the contact; larger keeps the hand's orientation and slides instead.
