@@ -27,13 +27,13 @@ constexpr Real kBlockTop = 0.03;
 
 /// The block (fixed, hole axis along y, opening at y = kBlockTop) and the peg
 /// (a cylinder along its z axis from 0 to kPegLength, turned so z points down).
-engine::Scene peg_and_block(const Transform& X_WPeg) {
+engine::Scene peg_and_block(const Transform& X_WPeg, int sides = 64) {
   engine::Scene scene;
   scene.add_part(
       {.name = "block",
        .movable = false,
        .render_mesh = std::make_shared<const collision::Mesh>(collision::make_block_with_hole(
-           Vec3(0.04, kBlockTop, 0.04), kHoleRadius, kHoleDepth, 64))});
+           Vec3(0.04, kBlockTop, 0.04), kHoleRadius, kHoleDepth, sides))});
   scene.add_part({.name = "peg",
                   .X_PC = X_WPeg,
                   .render_mesh = std::make_shared<const collision::Mesh>(
@@ -60,10 +60,12 @@ struct PegRun {
 
 /// The hand holds the peg from the start, carries it 90 mm down along the
 /// hole's axis (20 mm past the bottom) in 2 s, waits, and opens.
-PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool measure_depth = true) {
+PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool measure_depth = true,
+               int sides = 64) {
   const Transform X_WPeg0 = peg_start(offset, tilt_deg);
-  engine::Simulation sim(peg_and_block(X_WPeg0), {.collision_threads = threads,
-                                                  .contacts = collision::ContactDetail::kPairs});
+  engine::Simulation sim(
+      peg_and_block(X_WPeg0, sides),
+      {.collision_threads = threads, .contacts = collision::ContactDetail::kPairs});
   // The hand is above the peg, tilted with it, its power posture around nothing.
   GlovePlan plan;
   plan.start.p_WH = X_WPeg0.t + Vec3(0, 0.05, 0.09);
@@ -170,6 +172,14 @@ TEST(PegInHole, APegFarOffTheHoleIsLeftBehindNotPushedThrough) {
   const Vec3 bottom = run.X_WPeg.apply(Vec3(0, 0, kPegLength));
   EXPECT_GE(bottom.y(), kBlockTop);
   EXPECT_LT(bottom.y(), kBlockTop + 1e-4);
+}
+
+TEST(PegInHole, ACoarselyTessellatedHoleStillTakesThePeg) {
+  // 12 flat walls whose flats lie on the hole's radius (corners 3.5 % further out): the
+  // peg, 64 facets inscribed in its radius, fits with the same 0.25 mm clearance at the
+  // flats, so it still slides in and mates.
+  const PegRun run = run_peg(0.0015, -2, false, 1, true, 12);
+  expect_in_the_hole(run);
 }
 
 }  // namespace

@@ -1,0 +1,131 @@
+// Where sliding is hard: a sharp edge, and two held parts sliding against
+// each other at once.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "dovetail/collision/contacts.h"
+#include "dovetail/collision/primitives.h"
+#include "dovetail/interaction/glove_source.h"
+#include "dovetail/interaction/grasping.h"
+
+namespace dovetail::interaction {
+namespace {
+
+using engine::Event;
+using engine::EventKind;
+
+std::shared_ptr<const collision::Mesh> box(const Vec3& half) {
+  return std::make_shared<const collision::Mesh>(collision::make_box(half));
+}
+
+/// Deepest penetration between two parts of the simulation now.
+Real depth_between(const engine::Simulation& sim, const std::string& a, const std::string& b) {
+  const auto ma = collision::build_model(collision::Method::kObb,
+                                         sim.scene().collision_mesh(sim.scene().get(a)));
+  const auto mb = collision::build_model(collision::Method::kObb,
+                                         sim.scene().collision_mesh(sim.scene().get(b)));
+  const Transform X_WA = sim.scene().world_pose(a), X_WB = sim.scene().world_pose(b);
+  const Transform X_AB{X_WA.R.transpose() * X_WB.R, X_WA.R.transpose() * (X_WB.t - X_WA.t)};
+  Real depth = 0;
+  for (const collision::ContactPatch& p : collision::compute_contacts(*ma, *mb, X_AB)) {
+    depth = std::max(depth, p.depth);
+  }
+  return depth;
+}
+
+/// A hand far above that holds `part` and moves by `moves` (reach steps of `duration`).
+GlovePlan moves_by(const Vec3& start, std::initializer_list<Vec3> moves, Real duration) {
+  GlovePlan plan;
+  plan.start.p_WH = start;
+  Vec3 at = start;
+  for (const Vec3& move : moves) {
+    at += move;
+    PlanStep step{.kind = PlanStep::Kind::kReach, .duration = duration};
+    step.poses = {{at, Quaternion{}}};
+    plan.steps.push_back(step);
+  }
+  return plan;
+}
+
+TEST(SlidingCases, ACubePressedOntoABlockSlidesAlongItsTopAndOverItsSharpEdge) {
+  // A 10 mm cube held 5 mm below the block's top face (the band pulls it into the
+  // block), carried 80 mm sideways past the block's edge. Expected: it slides along the
+  // top face without penetrating, over the edge, and then follows the hand down
+  // to its target, the band relaxed.
+  engine::Scene scene;
+  scene.add_part({.name = "block", .movable = false, .render_mesh = box(Vec3(0.03, 0.02, 0.03))});
+  scene.add_part({.name = "cube",
+                  .X_PC = {Mat3::Identity(), Vec3(-0.02, 0.0251, 0)},
+                  .render_mesh = box(Vec3::Constant(0.005))});
+  engine::Simulation sim(std::move(scene));
+  const Vec3 hand0(-0.02, 0.2, 0);
+  Hand hand(sim, std::make_shared<SimulatedGlove>(
+                     moves_by(hand0, {Vec3(0, -0.005, 0), Vec3(0.08, 0, 0)}, 1.0)));
+  Grasping grasping(sim, hand);
+  grasping.hold("cube", GraspType::kPower);
+  Real max_depth = 0;
+  Real lowest_on_top = 1;
+  for (int frame = 0; frame < 200; ++frame) {
+    sim.step();
+    max_depth = std::max(max_depth, depth_between(sim, "block", "cube"));
+    const Vec3 c = sim.scene().world_pose("cube").t;
+    if (c.x() < 0.03 - 0.005) lowest_on_top = std::min(lowest_on_top, c.y() - 0.005);
+  }
+  EXPECT_LT(max_depth, 1e-5);
+  EXPECT_GE(lowest_on_top, 0.02) << "never into the top face";
+  EXPECT_LT(lowest_on_top, 0.02 + 1e-4) << "but pressed onto it";
+  const Vec3 c = sim.scene().world_pose("cube").t;
+  EXPECT_NEAR(c.x(), 0.06, 5e-6) << "past the edge, where the hand wants it (to the rest step)";
+  EXPECT_NEAR(c.y(), 0.0201, 5e-6);
+  EXPECT_TRUE(grasping.held());
+}
+
+TEST(SlidingCases, TwoHeldPartsSlideAgainstEachOtherAtOnce) {
+  // Two hands carry a cube each toward the other until their targets overlap by 10 mm.
+  // Expected: both stop at contact (no penetration), both report sliding on the other,
+  // and as the hands then move apart vertically the cubes slide along each other.
+  engine::Scene scene;
+  scene.add_part({.name = "left_cube",
+                  .X_PC = {Mat3::Identity(), Vec3(-0.03, 0, 0)},
+                  .render_mesh = box(Vec3::Constant(0.01))});
+  scene.add_part({.name = "right_cube",
+                  .X_PC = {Mat3::Identity(), Vec3(0.03, 0, 0)},
+                  .render_mesh = box(Vec3::Constant(0.01))});
+  engine::Simulation sim(std::move(scene));
+  HandSettings left_settings, right_settings;
+  left_settings.name = "left";
+  right_settings.name = "right";
+  Hand left(sim,
+            std::make_shared<SimulatedGlove>(
+                moves_by(Vec3(-0.03, 0.2, 0), {Vec3(0.025, 0, 0), Vec3(0, 0.004, 0)}, 0.8)),
+            left_settings);
+  Hand right(sim,
+             std::make_shared<SimulatedGlove>(
+                 moves_by(Vec3(0.03, 0.3, 0), {Vec3(-0.025, 0, 0), Vec3(0, -0.004, 0)}, 0.8)),
+             right_settings);
+  Grasping left_grasp(sim, left), right_grasp(sim, right);
+  left_grasp.hold("left_cube", GraspType::kPower);
+  right_grasp.hold("right_cube", GraspType::kPower);
+  std::vector<Event> slides;
+  sim.events().subscribe(EventKind::kSlideBegin, [&](const Event& e) { slides.push_back(e); });
+  Real max_depth = 0;
+  for (int frame = 0; frame < 150; ++frame) {
+    sim.step();
+    max_depth = std::max(max_depth, depth_between(sim, "left_cube", "right_cube"));
+  }
+  EXPECT_LT(max_depth, 1e-5);
+  auto began = [&](const std::string& a, const std::string& b) {
+    return std::any_of(slides.begin(), slides.end(),
+                       [&](const Event& e) { return e.a == a && e.b == b; });
+  };
+  EXPECT_TRUE(began("left_cube", "right_cube"));
+  EXPECT_TRUE(began("right_cube", "left_cube"));
+  const Vec3 l = sim.scene().world_pose("left_cube").t, r = sim.scene().world_pose("right_cube").t;
+  EXPECT_NEAR(r.x() - l.x(), 0.02, 1e-4) << "face to face";
+  EXPECT_GT(l.y() - r.y(), 0.006) << "slid along each other as the hands parted vertically";
+}
+
+}  // namespace
+}  // namespace dovetail::interaction
