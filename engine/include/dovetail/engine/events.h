@@ -28,11 +28,11 @@ enum class EventKind : std::uint8_t {
   kRegionLeave,       ///< part a left region b
   kHandContactBegin,  ///< hand segment a (its part, `hand.index_distal`) touches part b now
   kHandContactEnd,    ///< hand segment a touched part b in the last frame, not now
-  kGrasp,             ///< reserved: the hand grasped part a
-  kRelease,           ///< reserved: the hand released part a
-  kSlideBegin,        ///< reserved: part a began sliding on part b
-  kSlideEnd,          ///< reserved: part a stopped sliding on part b
-  kMate,              ///< reserved: part a snapped onto part b
+  kGrasp,             ///< the hand grasped part a; b: the grasp type
+  kRelease,           ///< the hand released part a; b: why ("opened", "overstretched")
+  kSlideBegin,        ///< held part a began sliding on part b
+  kSlideEnd,          ///< held part a stopped sliding on part b
+  kMate,              ///< part a snapped onto part b
 };
 
 /// Number of event kinds.
