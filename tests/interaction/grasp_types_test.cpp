@@ -36,15 +36,18 @@ struct GraspRun {
   std::vector<Event> events;
   Vec3 moved = Vec3::Zero();  ///< how far the part moved
   std::optional<GraspType> type_while_moving;
+  std::vector<GloveSample> recorded;
+  std::uint64_t state_hash = 0;
 };
 
 /// The hand open at the origin closes to `posture` in 0.5 s, waits, lifts 50 mm in
 /// 0.5 s, opens in 0.4 s and waits.
-GraspRun run_grasp(engine::PartDesc part, const JointAngles& posture) {
+GraspRun run_grasp(engine::PartDesc part, const JointAngles& posture,
+                   std::shared_ptr<const GloveSource> replay = nullptr, int threads = 1) {
   engine::Scene scene;
   const std::string name = part.name;
   scene.add_part(part);
-  engine::Simulation sim(std::move(scene));
+  engine::Simulation sim(std::move(scene), {.collision_threads = threads});
   GlovePlan plan;
   PlanStep close{.kind = PlanStep::Kind::kClose, .duration = 0.5};
   close.posture = posture;
@@ -53,7 +56,7 @@ GraspRun run_grasp(engine::PartDesc part, const JointAngles& posture) {
   lift.poses = {{Vec3(0, 0.05, 0), Quaternion{}}};
   PlanStep open{.kind = PlanStep::Kind::kOpen, .duration = 0.4};
   plan.steps = {close, wait, lift, open, wait};
-  Hand hand(sim, std::make_shared<SimulatedGlove>(plan));
+  Hand hand(sim, replay ? replay : std::make_shared<SimulatedGlove>(plan));
   Grasping grasping(sim, hand);
   const Vec3 start = sim.scene().world_pose(name).t;
   GraspRun run;
@@ -63,6 +66,8 @@ GraspRun run_grasp(engine::PartDesc part, const JointAngles& posture) {
     if (frame == 100) run.type_while_moving = grasping.grasp_type();
   }
   run.moved = sim.scene().world_pose(name).t - start;
+  run.recorded = hand.recorded();
+  run.state_hash = sim.state_hash();
   return run;
 }
 
@@ -92,6 +97,19 @@ TEST(GraspTypes, ABarAcrossThePalmIsAPowerGrasp) {
       cylinder_part("bar", 0.022, 0.08, Vec3(0.02, -0.0105 - 0.022 - 0.0001, -0.06), Vec3::UnitX()),
       *named_posture("power"));
   expect_carried(run, "bar", "power");
+}
+
+TEST(GraspTypes, AGraspRecordedAndReplayedFromItsTraceIsTheSameRun) {
+  const engine::PartDesc bar =
+      cylinder_part("bar", 0.022, 0.08, Vec3(0.02, -0.0105 - 0.022 - 0.0001, -0.06), Vec3::UnitX());
+  const GraspRun original = run_grasp(bar, *named_posture("power"));
+  const auto trace = std::make_shared<TraceSource>(original.recorded);
+  for (const int threads : {1, 2, 8}) {
+    const GraspRun replay = run_grasp(bar, *named_posture("power"), trace, threads);
+    EXPECT_EQ(replay.state_hash, original.state_hash) << threads << " threads";
+    EXPECT_EQ(replay.events, original.events) << threads << " threads";
+  }
+  EXPECT_EQ(grasp_of(original, "bar"), "power");
 }
 
 TEST(GraspTypes, AnOpenHandBrushingPastGraspsNothing) {

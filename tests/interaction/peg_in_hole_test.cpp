@@ -7,9 +7,11 @@
 #include <cmath>
 #include <numbers>
 
+#include "../support/temp_dir.h"
 #include "dovetail/collision/contacts.h"
 #include "dovetail/collision/primitives.h"
 #include "dovetail/interaction/glove_source.h"
+#include "dovetail/interaction/glove_trace.h"
 #include "dovetail/interaction/grasping.h"
 #include "dovetail/interaction/postures.h"
 
@@ -56,12 +58,14 @@ struct PegRun {
   Transform X_WPeg;
   std::uint64_t state_hash = 0;
   Real max_stretch = 0;
+  std::vector<GloveSample> recorded;  ///< the glove samples the run used
+  std::string report;                 ///< the report's JSON
 };
 
 /// The hand holds the peg from the start, carries it 90 mm down along the
 /// hole's axis (20 mm past the bottom) in 2 s, waits, and opens.
 PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool measure_depth = true,
-               int sides = 64) {
+               int sides = 64, std::shared_ptr<const GloveSource> replay = nullptr) {
   const Transform X_WPeg0 = peg_start(offset, tilt_deg);
   engine::Simulation sim(
       peg_and_block(X_WPeg0, sides),
@@ -90,7 +94,7 @@ PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool mea
                                                              .position_sigma_m = 0.001,
                                                              .orientation_sigma_deg = 0.5});
   }
-  Hand hand(sim, source);
+  Hand hand(sim, replay ? replay : source);
   Grasping grasping(sim, hand);
   grasping.add_mate({.name = "peg_in_hole",
                      .part = "peg",
@@ -122,6 +126,8 @@ PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool mea
   run.X_WPeg = sim.scene().world_pose("peg");
   run.state_hash = sim.state_hash();
   run.max_stretch = grasping.stats().max_stretch_m;
+  run.recorded = hand.recorded();
+  run.report = sim.report().to_json();
   return run;
 }
 
@@ -153,13 +159,17 @@ TEST(PegInHole, GoesInWithGloveNoise) {
   expect_in_the_hole(run);
 }
 
-TEST(PegInHole, ReplaysToTheSameStateAtAnyThreadCount) {
-  const PegRun first = run_peg(0.0015, -2, true, 1, false);
+TEST(PegInHole, ARecordedRunReplaysFromItsTraceIdenticallyAtAnyThreadCount) {
+  const PegRun original = run_peg(0.0015, -2, true, 1, false);
+  const test::TempDir dir("dovetail_peg");
+  write_trace(dir / "peg.csv", original.recorded);
+  const auto trace = std::make_shared<TraceSource>(read_trace(dir / "peg.csv"));
   for (const int threads : {1, 2, 8}) {
-    const PegRun again = run_peg(0.0015, -2, true, threads, false);
-    EXPECT_EQ(again.state_hash, first.state_hash) << threads << " threads";
-    EXPECT_EQ(again.events, first.events) << threads << " threads";
+    const PegRun replay = run_peg(0.0015, -2, true, threads, false, 64, trace);
+    EXPECT_EQ(replay.state_hash, original.state_hash) << threads << " threads";
+    EXPECT_EQ(replay.report, original.report) << threads << " threads";
   }
+  EXPECT_TRUE(has(original.events, EventKind::kMate, "peg", "block"));
 }
 
 TEST(PegInHole, APegFarOffTheHoleIsLeftBehindNotPushedThrough) {
