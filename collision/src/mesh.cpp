@@ -79,4 +79,17 @@ Bounds mesh_bounds(const Mesh& mesh) {
   return b;
 }
 
+Bounds transformed_bounds(const Bounds& local, const Transform& X_WP) {
+  Bounds out{X_WP.apply(local.min), X_WP.apply(local.min)};
+  for (int corner = 1; corner < 8; ++corner) {
+    const Vec3 p(corner & 1 ? local.max.x() : local.min.x(),
+                 corner & 2 ? local.max.y() : local.min.y(),
+                 corner & 4 ? local.max.z() : local.min.z());
+    const Vec3 p_W = X_WP.apply(p);
+    out.min = out.min.cwiseMin(p_W);
+    out.max = out.max.cwiseMax(p_W);
+  }
+  return out;
+}
+
 }  // namespace dovetail::collision

@@ -29,16 +29,8 @@ bool same_bits(const Transform& x, const Transform& y) {
 
 /// World box of a local box under X_WP: the bounds of its 8 transformed corners.
 Box world_box(const Box& local, const Transform& X_WP) {
-  Box out{Vec3::Constant(INFINITY), Vec3::Constant(-INFINITY)};
-  for (int corner = 0; corner < 8; ++corner) {
-    const Vec3 p(corner & 1 ? local.max.x() : local.min.x(),
-                 corner & 2 ? local.max.y() : local.min.y(),
-                 corner & 4 ? local.max.z() : local.min.z());
-    const Vec3 p_W = X_WP.apply(p);
-    out.min = out.min.cwiseMin(p_W);
-    out.max = out.max.cwiseMax(p_W);
-  }
-  return out;
+  const collision::Bounds b = collision::transformed_bounds({local.min, local.max}, X_WP);
+  return {b.min, b.max};
 }
 
 bool overlap(const Box& x, const Box& y) {

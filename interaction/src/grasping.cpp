@@ -60,16 +60,7 @@ Transform relative(const Transform& X_WA, const Transform& X_WB) {
 }
 
 collision::Bounds world_bounds(const collision::Bounds& local, const Transform& X_WP) {
-  collision::Bounds out{Vec3::Constant(INFINITY), Vec3::Constant(-INFINITY)};
-  for (int corner = 0; corner < 8; ++corner) {
-    const Vec3 p(corner & 1 ? local.max.x() : local.min.x(),
-                 corner & 2 ? local.max.y() : local.min.y(),
-                 corner & 4 ? local.max.z() : local.min.z());
-    const Vec3 p_W = X_WP.apply(p);
-    out.min = out.min.cwiseMin(p_W);
-    out.max = out.max.cwiseMax(p_W);
-  }
-  return out;
+  return collision::transformed_bounds(local, X_WP);
 }
 
 bool overlap(const collision::Bounds& a, const collision::Bounds& b, Real margin) {

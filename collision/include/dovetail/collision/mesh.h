@@ -63,5 +63,8 @@ struct Bounds {
   Vec3 max;
 };
 Bounds mesh_bounds(const Mesh& mesh);
+/// Bounds of the 8 corners of `local` moved by X_WP: a box that contains
+/// whatever `local` contains, in the frame W.
+Bounds transformed_bounds(const Bounds& local, const Transform& X_WP);
 
 }  // namespace dovetail::collision
