@@ -324,14 +324,11 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
       opened_since_ = t;
     }
     if (opened && t - opened_since_ >= settings_.grasp.release_time_s - 1e-9) {
-      emit(EventKind::kRelease, *held_, "opened");
       release(simulation, "opened");
     } else {
       carry(simulation);
     }
-    // The carried part's events were emitted in carry and release.
     last_flexion_ = total_flexion;
-    (void)frame;
     return;
   }
 
@@ -426,12 +423,9 @@ void Grasping::carry(engine::Simulation& simulation) {
   contact_parts_ = handles;
   stats_.slide_queries += static_cast<std::uint64_t>(last_slide_.collision_queries);
   stats_.max_stretch_m = std::max(stats_.max_stretch_m, last_slide_.stretch_m);
-  const engine::FrameResult& last = simulation.last_frame();
   const std::uint64_t frame = simulation.frame();
   const Real t = simulation.time();
-  (void)last;
   if (last_slide_.status == SlideStatus::kOverstretched) {
-    pending_.push_back({EventKind::kRelease, frame, t, *held_, "overstretched"});
     release(simulation, "overstretched");
     return;
   }
@@ -485,8 +479,8 @@ Transform Grasping::guided(const engine::Scene& scene, const std::string& part,
 }
 
 void Grasping::release(engine::Simulation& simulation, const std::string& reason) {
-  (void)reason;
   const std::string part = *held_;
+  pending_.push_back({EventKind::kRelease, simulation.frame(), simulation.time(), part, reason});
   if (sliding_) {
     pending_.push_back(
         {EventKind::kSlideEnd, simulation.frame(), simulation.time(), part, sliding_on_});

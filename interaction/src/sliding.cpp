@@ -178,7 +178,6 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
     result.contacts = std::move(kept);
   };
 
-  bool touched = !result.contacts.empty();
   int stalled = 0;
   result.status = SlideStatus::kReached;
   for (int sub = 0; sub < settings.substeps; ++sub) {
@@ -216,7 +215,6 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
       stalled = 0;
       continue;
     }
-    touched = true;
     result.status = SlideStatus::kSliding;
     // Halve until the bracket is under the resolution (a small move needs few steps).
     const Real move = v.norm() + w.norm() * request.size;
@@ -250,7 +248,6 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
   if (result.status == SlideStatus::kReached && !result.contacts.empty()) {
     result.status = SlideStatus::kSliding;
   }
-  (void)touched;
   measure_stretch();
   return result;
 }
