@@ -119,13 +119,6 @@ struct Grasping::Models {
   }
 };
 
-/// A hand segment within the contact gap of a part.
-struct Grasping::Touch {
-  Segment segment = Segment::kPalm;
-  Vec3 p_W = Vec3::Zero();   ///< the witness point on the part
-  Vec3 n_W = Vec3::UnitY();  ///< the part's outward normal there
-};
-
 Grasping::Grasping(engine::Simulation& simulation, Hand& hand)
     : Grasping(simulation, hand, InteractionSettings{}) {}
 
@@ -234,8 +227,8 @@ void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
   }
 }
 
-std::vector<Grasping::Touch> Grasping::touches(const engine::Scene& scene, PartHandle part) {
-  std::vector<Touch> out;
+std::vector<GraspContact> Grasping::touches(const engine::Scene& scene, PartHandle part) {
+  std::vector<GraspContact> out;
   const auto& mesh = scene.collision_mesh(part);
   const collision::DistanceModel& part_model = models_->distance_model(mesh);
   const Transform X_WP = scene.world_pose(part);
@@ -265,12 +258,12 @@ std::vector<Grasping::Touch> Grasping::touches(const engine::Scene& scene, PartH
   return out;
 }
 
-std::optional<GraspType> Grasping::classify(const std::vector<Touch>& touches) const {
-  const Real cos_cone = std::cos(std::atan(settings_.grasp.friction));
-  const Touch* palm = nullptr;
-  const Touch* tip[kDigitCount] = {};
-  std::vector<const Touch*> fingers;  // touching segments of the digits
-  for (const Touch& t : touches) {
+std::optional<GraspType> classify_grasp(std::span<const GraspContact> touches, Real friction) {
+  const Real cos_cone = std::cos(std::atan(friction));
+  const GraspContact* palm = nullptr;
+  const GraspContact* tip[kDigitCount] = {};
+  std::vector<const GraspContact*> fingers;  // touching segments of the digits
+  for (const GraspContact& t : touches) {
     if (t.segment == Segment::kPalm) palm = &t;
     const std::optional<std::size_t> digit = digit_of(t.segment);
     if (!digit) continue;
@@ -278,19 +271,19 @@ std::optional<GraspType> Grasping::classify(const std::vector<Touch>& touches) c
     const DigitJoints d = digit_joints(*digit);
     if (t.segment == d.segments.back()) tip[*digit] = &t;
   }
-  auto opposes = [&](const Touch* a, const Touch* b) {
+  auto opposes = [&](const GraspContact* a, const GraspContact* b) {
     return a && b && oppose(a->p_W, a->n_W, b->p_W, b->n_W, cos_cone);
   };
   if (palm && fingers.size() >= 2) {
-    for (const Touch* f : fingers) {
+    for (const GraspContact* f : fingers) {
       if (opposes(palm, f)) return GraspType::kPower;
     }
   }
   // 3-point pinch: the index and middle tips act as one virtual finger (Feix et al.)
   // that the thumb opposes.
   if (tip[0] && tip[1] && tip[2]) {
-    const Touch pair{Segment::kIndexDistal, (tip[1]->p_W + tip[2]->p_W) / 2,
-                     (tip[1]->n_W + tip[2]->n_W).normalized()};
+    const GraspContact pair{Segment::kIndexDistal, (tip[1]->p_W + tip[2]->p_W) / 2,
+                            (tip[1]->n_W + tip[2]->n_W).normalized()};
     if (opposes(tip[0], &pair)) return GraspType::kTripod;
   }
   if (opposes(tip[0], tip[1]) || opposes(tip[0], tip[2])) return GraspType::kPrecision;
@@ -337,9 +330,9 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   std::string found_part;
   for (const PartHandle part :
        candidates(scene, hand_->X_WH(), 1.2 * hand_->model().hand_length())) {
-    const std::vector<Touch> touching = touches(scene, part);
+    const std::vector<GraspContact> touching = touches(scene, part);
     if (touching.empty()) continue;
-    if (const std::optional<GraspType> type = classify(touching)) {
+    if (const std::optional<GraspType> type = classify_grasp(touching, settings_.grasp.friction)) {
       found = type;
       found_part = scene.name(part);
       break;
@@ -367,9 +360,9 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
       (!still_closing || candidate_frames_ >= 4 * settings_.grasp.onset_frames)) {
     hold(candidate_, candidate_type_);
     // The digits that grasp are those touching the part now.
-    const std::vector<Touch> touching = touches(scene, scene.get(candidate_));
+    const std::vector<GraspContact> touching = touches(scene, scene.get(candidate_));
     grasping_digit_.fill(false);
-    for (const Touch& touch : touching) {
+    for (const GraspContact& touch : touching) {
       if (const std::optional<std::size_t> d = digit_of(touch.segment)) grasping_digit_[*d] = true;
     }
     emit(EventKind::kGrasp, candidate_, std::string(grasp_type_name(candidate_type_)));

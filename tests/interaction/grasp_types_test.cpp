@@ -139,3 +139,55 @@ TEST(GraspTypes, AnOpenHandBrushingPastGraspsNothing) {
 
 }  // namespace
 }  // namespace dovetail::interaction
+
+namespace dovetail::interaction {
+namespace {
+
+// The contact analysis alone, on contacts made by hand: a part 10 mm thick
+// between y = -0.005 and y = 0.005.
+GraspContact below(Segment s, Real x) { return {s, Vec3(x, -0.005, 0), -Vec3::UnitY()}; }
+GraspContact above(Segment s, Real x) { return {s, Vec3(x, 0.005, 0), Vec3::UnitY()}; }
+
+TEST(GraspAnalysis, ThumbTipOpposingIndexTipIsPrecision) {
+  const GraspContact c[] = {below(Segment::kThumbDistal, 0), above(Segment::kIndexDistal, 0.002)};
+  EXPECT_EQ(classify_grasp(c, 0.5), GraspType::kPrecision);
+  const GraspContact middle[] = {below(Segment::kThumbDistal, 0), above(Segment::kMiddleDistal, 0)};
+  EXPECT_EQ(classify_grasp(middle, 0.5), GraspType::kPrecision);
+}
+
+TEST(GraspAnalysis, ContactsOutsideTheFrictionConesDoNotOppose) {
+  // 10 mm thick, 6 mm apart sideways: 31 degrees off the normal, past atan 0.5 = 26.6
+  // degrees; inside atan 1 = 45 degrees.
+  const GraspContact c[] = {below(Segment::kThumbDistal, 0), above(Segment::kIndexDistal, 0.006)};
+  EXPECT_EQ(classify_grasp(c, 0.5), std::nullopt);
+  EXPECT_EQ(classify_grasp(c, 1.0), GraspType::kPrecision);
+  // Both on the same side: nothing opposes.
+  const GraspContact same[] = {above(Segment::kThumbDistal, 0), above(Segment::kIndexDistal, 0)};
+  EXPECT_EQ(classify_grasp(same, 0.5), std::nullopt);
+  // Not tips: a thumb's proximal segment and the index's middle one.
+  const GraspContact inner[] = {below(Segment::kThumbProximal, 0),
+                                above(Segment::kIndexIntermediate, 0)};
+  EXPECT_EQ(classify_grasp(inner, 0.5), std::nullopt);
+}
+
+TEST(GraspAnalysis, ThumbOpposingIndexAndMiddleAsOneIsATripod) {
+  // Index and middle 8 mm either side of the thumb: each alone is 38 degrees off, their
+  // middle straight across.
+  const GraspContact c[] = {below(Segment::kThumbDistal, 0), above(Segment::kIndexDistal, -0.008),
+                            above(Segment::kMiddleDistal, 0.008)};
+  EXPECT_EQ(classify_grasp(c, 0.5), GraspType::kTripod);
+  // Without the middle finger it is no grasp at all (the index alone is outside the cone).
+  EXPECT_EQ(classify_grasp(std::span(c, 2), 0.5), std::nullopt);
+}
+
+TEST(GraspAnalysis, PalmAndFingersAroundIsPower) {
+  const GraspContact c[] = {above(Segment::kPalm, 0), below(Segment::kIndexIntermediate, 0.001),
+                            below(Segment::kMiddleDistal, -0.001),
+                            above(Segment::kThumbDistal, 0.03)};
+  EXPECT_EQ(classify_grasp(c, 0.5), GraspType::kPower);
+  // The palm with one finger only: not power (and no tips oppose).
+  EXPECT_EQ(classify_grasp(std::span(c, 2), 0.5), std::nullopt);
+}
+
+}  // namespace
+}  // namespace dovetail::interaction

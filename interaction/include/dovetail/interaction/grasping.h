@@ -18,6 +18,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -36,6 +37,22 @@ enum class GraspType : std::uint8_t {
 };
 /// "precision", "tripod", "power": the `b` of a grasp event.
 std::string_view grasp_type_name(GraspType type);
+
+/// A hand segment within the contact gap of a part.
+struct GraspContact {
+  Segment segment = Segment::kPalm;
+  Vec3 p_W = Vec3::Zero();   ///< the contact point on the part
+  Vec3 n_W = Vec3::UnitY();  ///< the part's outward unit normal there
+};
+
+/// The grasp that contacts on one part form, or nullopt (the rules of
+/// docs/interaction.md, "Contact analysis"): power (palm and two finger
+/// segments, one opposing the palm), tripod (thumb, index and middle tips, the
+/// thumb opposing index and middle as one virtual finger), precision (the thumb
+/// tip opposing the index or middle tip), in that order. Two contacts oppose
+/// when the line between them lies inside both friction cones, half-angle
+/// atan(friction). A pure function of its arguments.
+std::optional<GraspType> classify_grasp(std::span<const GraspContact> contacts, Real friction);
 
 /// When a grasp begins and ends (defaults: notes/grasping.md).
 struct GraspSettings {
@@ -120,14 +137,12 @@ class Grasping {
 
  private:
   struct Models;
-  struct Touch;
   void limit_fingers(const HandModel& model, const Transform& X_WH, const JointAngles& previous,
                      JointAngles& angles);
   void update(engine::Simulation& simulation, std::uint64_t frame, Real t);
   std::vector<engine::PartHandle> candidates(const engine::Scene& scene, const Transform& X_WH,
                                              Real reach) const;
-  std::vector<Touch> touches(const engine::Scene& scene, engine::PartHandle part);
-  std::optional<GraspType> classify(const std::vector<Touch>& touches) const;
+  std::vector<GraspContact> touches(const engine::Scene& scene, engine::PartHandle part);
   void carry(engine::Simulation& simulation);
   Transform guided(const engine::Scene& scene, const std::string& part,
                    const Transform& X_WP_target);
