@@ -220,6 +220,31 @@ collision::Mesh banded_cylinder(Real radius, Real length, int sides, int rings) 
   return collision::make_mesh(std::move(v), std::move(t), "bench:banded cylinder");
 }
 
+/// A picture of the power grasp of a bar (the scene of the grasp tests), lifted.
+void grasp_picture(const std::string& pictures) {
+  engine::Scene scene;
+  Transform X_bar;
+  X_bar.R << 0, 0, 1, 0, 1, 0, -1, 0, 0;  // the cylinder's z axis along x
+  X_bar.t = Vec3(0.02 - 0.04, -0.0105 - 0.022 - 0.0001, -0.06);
+  scene.add_part({.name = "bar",
+                  .X_PC = X_bar,
+                  .render_mesh = std::make_shared<const collision::Mesh>(
+                      collision::make_cylinder(0.022, 0.08, 48))});
+  engine::Simulation sim(std::move(scene));
+  GlovePlan p;
+  p.steps = {close(0.5, "power"), reach(0.5, Vec3(0, 0.05, 0))};
+  interaction::Hand hand(sim, std::make_shared<interaction::SimulatedGlove>(p));
+  interaction::Grasping grasping(sim, hand);
+  sim.run(90);
+  engine::RenderSettings settings{.width = 480, .height = 360, .camera = "iso"};
+  engine::write_png(engine::render(engine::render_scene(sim.scene()), settings),
+                    pictures + "/power-grasp.png");
+  std::printf("picture: power grasp, %s\n",
+              grasping.grasp_type()
+                  ? std::string(interaction::grasp_type_name(*grasping.grasp_type())).c_str()
+                  : "no grasp");
+}
+
 void sliding(int runs, const std::string& pictures) {
   constexpr Real kTop = 0.03, kDepth = 0.04, kLength = 0.06;
   const auto block = std::make_shared<const collision::Mesh>(
@@ -340,5 +365,6 @@ int main(int argc, char** argv) {
   }
   fk_only();
   sliding(runs, pictures);
+  if (!pictures.empty()) grasp_picture(pictures);
   return 0;
 }
