@@ -100,7 +100,7 @@ TEST_P(HandKinematics, PinchFingertips) {
   expect_near(pose.p_HTip[1], finger_tip(0, hl, 50, 60, 20, 0, 0), "index");
   expect_near(pose.p_HTip[2], finger_tip(1, hl, 10, 10, 5, 0, 0), "middle");
   expect_near(pose.p_HTip[0], thumb_tip(hl, 60, 0, 10, 5), "thumb");
-  // The tips face each other about one thumb and one index pad apart.
+  // The tips' capsule ends come within a few millimetres of each other.
   const Real pads = hand.radius(Segment::kThumbDistal) + hand.radius(Segment::kIndexDistal);
   const Real gap = (pose.p_HTip[0] - pose.p_HTip[1]).norm();
   EXPECT_GT(gap, pads);
