@@ -37,17 +37,6 @@ std::optional<std::size_t> column_index(std::string_view name) {
   return std::nullopt;
 }
 
-/// The comma-separated fields of `line`, each without surrounding blanks.
-void split_commas(std::string_view line, std::vector<std::string_view>& fields) {
-  fields.clear();
-  while (true) {
-    const std::size_t comma = line.find(',');
-    fields.push_back(trim_blanks(line.substr(0, comma)));
-    if (comma == std::string_view::npos) return;
-    line.remove_prefix(comma + 1);
-  }
-}
-
 /// For each field of the header, the canonical column it holds.
 std::vector<std::size_t> parse_header(const LineReader& reader, std::string_view line) {
   std::vector<std::string_view> fields;

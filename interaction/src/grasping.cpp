@@ -54,15 +54,6 @@ std::optional<std::size_t> digit_of(Segment s) {
   return 1 + (i - 4) / 3;
 }
 
-Transform relative(const Transform& X_WA, const Transform& X_WB) {
-  const Transform X_AW = X_WA.inverse();
-  return {X_AW.R * X_WB.R, X_AW.apply(X_WB.t)};
-}
-
-collision::Bounds world_bounds(const collision::Bounds& local, const Transform& X_WP) {
-  return collision::transformed_bounds(local, X_WP);
-}
-
 bool overlap(const collision::Bounds& a, const collision::Bounds& b, Real margin) {
   return (a.min.array() - margin <= b.max.array()).all() &&
          (b.min.array() - margin <= a.max.array()).all();
@@ -163,7 +154,7 @@ void Grasping::hold(const std::string& part, GraspType type) {
   type_ = type;
   last_slide_ = {};
   contact_parts_.clear();
-  X_HO_ = relative(hand_->X_WH(), scene.world_pose(handle));
+  X_HO_ = engine::compose(hand_->X_WH().inverse(), scene.world_pose(handle));
   for (std::size_t d = 0; d < kDigitCount; ++d) {
     flexion_at_grasp_[d] = flexion(hand_->glove_angles(), digit_joints(d));
     grasping_digit_[d] = type == GraspType::kPower || d <= (type == GraspType::kTripod ? 2U : 1U);
@@ -180,7 +171,8 @@ std::vector<PartHandle> Grasping::candidates(const engine::Scene& scene, const T
     if (!mesh || scene.has_tag(part, "hand")) continue;
     const Transform X_WP =
         held_ && scene.name(part) == *held_ ? engine::compose(X_WH, X_HO_) : scene.world_pose(part);
-    if (overlap(world_bounds(models_->mesh_bounds(mesh), X_WP), around, 0)) out.push_back(part);
+    if (overlap(collision::transformed_bounds(models_->mesh_bounds(mesh), X_WP), around, 0))
+      out.push_back(part);
   }
   return out;
 }
@@ -235,19 +227,20 @@ std::vector<GraspContact> Grasping::touches(const engine::Scene& scene, PartHand
   const Transform X_PW = X_WP.inverse();
   const HandModel& model = hand_->model();
   const HandPose& pose = hand_->pose();
-  const collision::Bounds part_box = world_bounds(models_->mesh_bounds(mesh), X_WP);
+  const collision::Bounds part_box =
+      collision::transformed_bounds(models_->mesh_bounds(mesh), X_WP);
   for (std::size_t i = 0; i < kSegmentCount; ++i) {
     const auto segment = static_cast<Segment>(i);
     const Transform X_WS = engine::compose(hand_->X_WH(), pose.X_HS[i]);
     const auto& proxy = model.proxy(segment);
-    if (!overlap(world_bounds(models_->mesh_bounds(proxy), X_WS), part_box,
+    if (!overlap(collision::transformed_bounds(models_->mesh_bounds(proxy), X_WS), part_box,
                  settings_.grasp.contact_gap)) {
       continue;
     }
     ++stats_.contact_queries;
-    const collision::ToleranceResult r = collision::within_tolerance(
-        part_model, models_->distance_model(proxy), {X_PW.R * X_WS.R, X_PW.apply(X_WS.t)},
-        settings_.grasp.contact_gap);
+    const collision::ToleranceResult r =
+        collision::within_tolerance(part_model, models_->distance_model(proxy),
+                                    engine::compose(X_PW, X_WS), settings_.grasp.contact_gap);
     if (!r.within) continue;
     const auto& tri = mesh->triangles[r.triangle_a];
     const Vec3 n_P = (mesh->vertices[tri[1]] - mesh->vertices[tri[0]])
@@ -379,8 +372,8 @@ void Grasping::carry(engine::Simulation& simulation) {
   const Transform X_WO_target = guided(scene, *held_, engine::compose(hand_->X_WH(), X_HO_));
   const collision::Bounds& local = models_->mesh_bounds(mesh);
   // Obstacles: every other part that the swept box of the move reaches.
-  collision::Bounds swept = world_bounds(local, X_WO);
-  const collision::Bounds to = world_bounds(local, X_WO_target);
+  collision::Bounds swept = collision::transformed_bounds(local, X_WO);
+  const collision::Bounds to = collision::transformed_bounds(local, X_WO_target);
   swept.min = swept.min.cwiseMin(to.min);
   swept.max = swept.max.cwiseMax(to.max);
   std::vector<SlideObstacle> obstacles;
@@ -389,7 +382,9 @@ void Grasping::carry(engine::Simulation& simulation) {
     const auto& other_mesh = scene.collision_mesh(other);
     if (other == part || !other_mesh || scene.has_tag(other, "hand")) continue;
     const Transform X_WB = scene.world_pose(other);
-    if (!overlap(world_bounds(models_->mesh_bounds(other_mesh), X_WB), swept, 1e-3)) continue;
+    if (!overlap(collision::transformed_bounds(models_->mesh_bounds(other_mesh), X_WB), swept,
+                 1e-3))
+      continue;
     obstacles.push_back({models_->collision_model(other_mesh), models_->distance_shared(other_mesh),
                          X_WB, static_cast<std::uint32_t>(handles.size())});
     handles.push_back(other);

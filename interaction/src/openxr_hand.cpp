@@ -54,18 +54,6 @@ constexpr std::array<std::string_view, 7> kPoseColumns = {"_px", "_py", "_pz", "
                                                           "_qy", "_qz", "_qw"};
 constexpr std::size_t kColumns = 1 + 7 * kXrJointCount;
 
-std::vector<std::string_view> split_commas(std::string_view line) {
-  std::vector<std::string_view> fields;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', start);
-    fields.push_back(trim_blanks(line.substr(start, comma - start)));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-  return fields;
-}
-
 /// Angle (degrees) of a rotation about X: M = Rx(angle).
 Real angle_about_x(const Mat3& M) { return std::atan2(M(2, 1), M(1, 1)) * kDegreesPerRadian; }
 
@@ -189,7 +177,9 @@ std::vector<GloveSample> read_openxr(std::istream& in, std::string_view name) {
   std::array<std::size_t, kColumns> column_of{};
   std::array<bool, kColumns> seen{};
   std::vector<std::string> names;  // copied: the reader's next line replaces the header's text
-  for (std::string_view field : split_commas(*header)) names.emplace_back(field);
+  std::vector<std::string_view> fields;
+  split_commas(*header, fields);
+  for (std::string_view field : fields) names.emplace_back(field);
   for (std::size_t i = 0; i < names.size(); ++i) {
     std::optional<std::size_t> slot;
     if (names[i] == "t") slot = 0;
@@ -221,7 +211,7 @@ std::vector<GloveSample> read_openxr(std::istream& in, std::string_view name) {
   std::vector<GloveSample> samples;
   std::array<Real, kColumns> v{};
   while (const std::optional<std::string_view> line = reader.next_content()) {
-    const std::vector<std::string_view> fields = split_commas(*line);
+    split_commas(*line, fields);
     if (fields.size() != names.size()) {
       reader.fail("expected " + std::to_string(names.size()) + " fields, found " +
                   std::to_string(fields.size()));

@@ -5,6 +5,8 @@
 #include <numbers>
 #include <optional>
 
+#include "dovetail/engine/scene.h"
+
 namespace dovetail::interaction {
 
 namespace {
@@ -39,8 +41,7 @@ void contacts_at(const SlideRequest& request, const Transform& X_WP_free, const 
                  std::vector<SlideContact>& out, int& queries) {
   const collision::Mesh& part_mesh = request.part->mesh();
   for (const SlideObstacle& o : request.obstacles) {
-    const Transform X_OW = o.X_WO.inverse();
-    const Transform X_OP = {X_OW.R * X_WP_hit.R, X_OW.apply(X_WP_hit.t)};
+    const Transform X_OP = engine::compose(o.X_WO.inverse(), X_WP_hit);
     ++queries;
     const std::vector<collision::ContactPatch> patches =
         collision::compute_contacts(*o.model, *request.part, X_OP, {.estimate_depth = false});
@@ -126,8 +127,7 @@ Mat3 rotation_from_vector(const Vec3& w) {
 bool collides(const collision::CollisionModel& part, const Transform& X_WP,
               std::span<const SlideObstacle> obstacles, int* queries) {
   for (const SlideObstacle& o : obstacles) {
-    const Transform X_OW = o.X_WO.inverse();
-    const Transform X_OP = {X_OW.R * X_WP.R, X_OW.apply(X_WP.t)};
+    const Transform X_OP = engine::compose(o.X_WO.inverse(), X_WP);
     if (queries) ++*queries;
     if (o.model->collide(part, X_OP).colliding) return true;
   }

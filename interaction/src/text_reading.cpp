@@ -64,6 +64,16 @@ std::string_view trim_blanks(std::string_view text) {
   return text;
 }
 
+void split_commas(std::string_view line, std::vector<std::string_view>& fields) {
+  fields.clear();
+  while (true) {
+    const std::size_t comma = line.find(',');
+    fields.push_back(trim_blanks(line.substr(0, comma)));
+    if (comma == std::string_view::npos) return;
+    line.remove_prefix(comma + 1);
+  }
+}
+
 std::optional<Real> parse_number(std::string_view token) { return engine::parse_real(token); }
 
 std::string quoted(std::string_view token) {

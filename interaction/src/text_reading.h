@@ -49,6 +49,9 @@ class LineReader {
 bool is_blank_or_comment(std::string_view line);
 /// `text` without leading and trailing spaces and tabs.
 std::string_view trim_blanks(std::string_view text);
+/// The comma-separated fields of `line` into `fields` (cleared first), each
+/// without surrounding blanks.
+void split_commas(std::string_view line, std::vector<std::string_view>& fields);
 
 /// The whole token as a double (an optional leading '+' allowed, subnormals
 /// kept, overflow giving infinity), or nullopt when it is not a number.
