@@ -321,13 +321,15 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   // Grasp onset: the same part and type for onset_frames frames while the hand closes.
   std::optional<GraspType> found;
   std::string found_part;
+  std::vector<GraspContact> found_contacts;
   for (const PartHandle part :
        candidates(scene, hand_->X_WH(), 1.2 * hand_->model().hand_length())) {
-    const std::vector<GraspContact> touching = touches(scene, part);
+    std::vector<GraspContact> touching = touches(scene, part);
     if (touching.empty()) continue;
     if (const std::optional<GraspType> type = classify_grasp(touching, settings_.grasp.friction)) {
       found = type;
       found_part = scene.name(part);
+      found_contacts = std::move(touching);
       break;
     }
   }
@@ -352,10 +354,10 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   if (candidate_frames_ >= settings_.grasp.onset_frames &&
       (!still_closing || candidate_frames_ >= 4 * settings_.grasp.onset_frames)) {
     hold(candidate_, candidate_type_);
-    // The digits that grasp are those touching the part now.
-    const std::vector<GraspContact> touching = touches(scene, scene.get(candidate_));
+    // The digits that grasp are those touching the part now (a grasp fires only in a
+    // frame that found it, so these are the candidate's contacts).
     grasping_digit_.fill(false);
-    for (const GraspContact& touch : touching) {
+    for (const GraspContact& touch : found_contacts) {
       if (const std::optional<std::size_t> d = digit_of(touch.segment)) grasping_digit_[*d] = true;
     }
     emit(EventKind::kGrasp, candidate_, std::string(grasp_type_name(candidate_type_)));
