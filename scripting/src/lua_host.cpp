@@ -1,0 +1,356 @@
+#include "dovetail/scripting/lua_host.h"
+
+// Lua is compiled as C and raises errors with longjmp, which skips C++
+// destructors. So a lua_CFunction (and the hook and the allocator) written
+// here never has a live object with a non-trivial destructor in scope when it
+// calls lua_error, luaL_error or any API function that can raise: such
+// objects are destroyed first, or C++ exceptions are caught inside and turned
+// into a Lua error afterwards. Host methods that throw ScriptError do so only
+// after the protected Lua call has returned.
+
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <system_error>
+
+#include "host_state.h"
+#include "sandbox_env.h"
+
+namespace dovetail::scripting {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The allocator of the state: counts every byte and, while a host call runs,
+// refuses growth beyond the cap (Lua then collects garbage and retries once,
+// and raises a memory error if that does not help).
+void* allocate(void* data, void* block, std::size_t old_size, std::size_t new_size) noexcept {
+  HostState& host = *static_cast<HostState*>(data);
+  const std::size_t held = block != nullptr ? old_size : 0;
+  if (new_size == 0) {
+    std::free(block);
+    host.bytes -= held;
+    return nullptr;
+  }
+  const bool grows = new_size > held;
+  void* moved = nullptr;
+  if (!grows || !host.active() || new_size - held <= host.memory_left()) {
+    moved = std::realloc(block, new_size);
+  }
+  if (moved == nullptr) {
+    if (grows) {
+      if (host.refusal_pending && host.refused_old == held && host.refused_new == new_size &&
+          host.active()) {
+        host.memory_failed = true;
+      }
+      host.refusal_pending = true;
+      host.refused_old = held;
+      host.refused_new = new_size;
+    }
+    return nullptr;
+  }
+  host.bytes = host.bytes - held + new_size;
+  if (grows) host.refusal_pending = false;
+  return moved;
+}
+
+// Counts instructions in steps of kHookInterval and, during a host call,
+// raises once the budget or the deadline is passed. Coroutines inherit the
+// hook from the thread that creates them, so they are counted too.
+void count_hook(lua_State* L, lua_Debug* ar) {
+  HostState& host = host_of(L);
+  host.instructions_total += kHookInterval;
+  if (!host.active()) return;
+  if (lua_getinfo(L, "Sl", ar) != 0) {
+    if (ar->currentline > 0) {
+      std::snprintf(host.where, sizeof(host.where), "%s:%d: ", ar->short_src, ar->currentline);
+    } else {
+      std::snprintf(host.where, sizeof(host.where), "%s: ", ar->short_src);
+    }
+  }
+  if (!limit_exhausted(host)) {
+    host.instructions_in_call += kHookInterval;
+    if (host.instructions_in_call > host.limits.instructions_per_call) {
+      set_exhausted(host, ScriptError::Kind::kBudget, host.where,
+                    "instruction budget of %llu exceeded",
+                    static_cast<unsigned long long>(host.limits.instructions_per_call));
+    } else if (Clock::now() > host.deadline) {
+      set_exhausted(host, ScriptError::Kind::kTime, host.where, "wall-clock limit of %g s exceeded",
+                    host.limits.wall_seconds_per_call);
+    }
+  }
+  // Once exhausted, every further hook raises again: a swallowed error
+  // leaves at most kHookInterval instructions.
+  if (host.exhausted) raise_exhausted(L);
+}
+
+// The message handler of every host call: the error message (or the
+// exhausted limit's) followed by a traceback.
+int message_handler(lua_State* L) {
+  HostState& host = host_of(L);
+  if (limit_exhausted(host, L)) {
+    lua_pushstring(L, host.exhausted_message);
+  } else if (lua_type(L, 1) == LUA_TSTRING || lua_type(L, 1) == LUA_TNUMBER) {
+    lua_pushvalue(L, 1);
+  } else if (luaL_callmeta(L, 1, "__tostring") == 0 || lua_type(L, -1) != LUA_TSTRING) {
+    lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
+  }
+  luaL_traceback(L, L, lua_tostring(L, -1), 1);
+  return 1;
+}
+
+Clock::time_point deadline_after(double seconds) {
+  if (!(seconds < 1e9)) return Clock::time_point::max();
+  const auto span = std::chrono::duration<double>(seconds > 0 ? seconds : 0);
+  return Clock::now() + std::chrono::duration_cast<Clock::duration>(span);
+}
+
+// One host call. The outermost one starts a fresh budget and deadline and
+// clears the exhausted flag; after a memory failure it collects the garbage
+// the failed script left.
+class CallScope {
+ public:
+  explicit CallScope(HostState& host) : host_(host) {
+    if (host_.depth++ > 0) return;
+    host_.instructions_in_call = 0;
+    host_.deadline = deadline_after(host_.limits.wall_seconds_per_call);
+    host_.exhausted.reset();
+    host_.memory_failed = false;
+    host_.exhausted_message[0] = '\0';
+    host_.where[0] = '\0';
+    host_.refusal_pending = false;
+  }
+  ~CallScope() {
+    if (--host_.depth > 0) return;
+    if (host_.exhausted == ScriptError::Kind::kMemory) lua_gc(host_.L, LUA_GCCOLLECT, 0);
+  }
+  CallScope(const CallScope&) = delete;
+  CallScope& operator=(const CallScope&) = delete;
+
+ private:
+  HostState& host_;
+};
+
+// Pops the error object on top of the stack and makes the ScriptError: the
+// exhausted limit's kind and message when one is set, else `kind`.
+ScriptError take_error(HostState& host, ScriptError::Kind kind) {
+  lua_State* L = host.L;
+  std::string text;
+  if (lua_type(L, -1) == LUA_TSTRING) {
+    std::size_t length = 0;
+    const char* data = lua_tolstring(L, -1, &length);
+    text.assign(data, length);
+  } else {
+    text = std::string("(error object is a ") + luaL_typename(L, -1) + " value)";
+  }
+  lua_pop(L, 1);
+  if (!limit_exhausted(host)) return ScriptError(kind, text);
+  // A memory error carries Lua's own text, and an error re-raised through a
+  // coroutine a position prefix; the limit's message replaces both.
+  const std::string limit_message = host.exhausted_message;
+  if (text.compare(0, limit_message.size(), limit_message) != 0) text = limit_message;
+  return ScriptError(*host.exhausted, text);
+}
+
+// '@' names a file, '=' any other source ("@" + name trips GCC 12's -Wrestrict).
+std::string chunk_name(char kind, const std::string& name) {
+  std::string chunk(1, kind);
+  chunk += name;
+  return chunk;
+}
+
+std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+
+std::string read_script(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) {
+    throw ScriptError(ScriptError::Kind::kRuntime, name + ": file not found");
+  }
+  if (std::filesystem::is_directory(path, error)) {
+    throw ScriptError(ScriptError::Kind::kRuntime, name + ": is a directory");
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  if (in) text << in.rdbuf();
+  if (!in || in.bad()) throw ScriptError(ScriptError::Kind::kRuntime, name + ": cannot be read");
+  std::string code = std::move(text).str();
+  // A UTF-8 byte order mark and a first line such as "#!/usr/bin/env lua"
+  // are skipped; the line break stays so line numbers do not shift.
+  if (code.compare(0, 3, "\xEF\xBB\xBF") == 0) code.erase(0, 3);
+  if (!code.empty() && code[0] == '#') code.erase(0, code.find('\n'));
+  return code;
+}
+
+}  // namespace
+
+HostState& host_of(lua_State* L) {
+  void* data = nullptr;
+  lua_getallocf(L, &data);
+  return *static_cast<HostState*>(data);
+}
+
+void set_exhausted(HostState& host, ScriptError::Kind kind, const char* where, const char* format,
+                   ...) {
+  if (host.exhausted) return;
+  host.exhausted = kind;
+  const int prefix = std::snprintf(host.exhausted_message, sizeof(host.exhausted_message), "%s",
+                                   where != nullptr ? where : "");
+  const std::size_t used = prefix > 0 ? static_cast<std::size_t>(prefix) : 0;
+  if (used >= sizeof(host.exhausted_message)) return;
+  va_list arguments;
+  va_start(arguments, format);
+  std::vsnprintf(host.exhausted_message + used, sizeof(host.exhausted_message) - used, format,
+                 arguments);
+  va_end(arguments);
+}
+
+int raise_exhausted(lua_State* L) {
+  lua_pushstring(L, host_of(L).exhausted_message);
+  return lua_error(L);
+}
+
+void note_memory_error(HostState& host, lua_State* L) {
+  if (!host.active()) return;
+  host.memory_failed = true;
+  limit_exhausted(host, L);
+}
+
+bool limit_exhausted(HostState& host, lua_State* L) {
+  if (host.memory_failed && !host.exhausted) {
+    if (host.where[0] == '\0' && L != nullptr) write_where(L, 1, host.where, sizeof(host.where));
+    set_exhausted(host, ScriptError::Kind::kMemory, host.where,
+                  "memory limit of %zu bytes exceeded", host.limits.memory_bytes);
+  }
+  return host.exhausted.has_value();
+}
+
+void write_where(lua_State* L, int level, char* buffer, std::size_t size) {
+  lua_Debug ar;
+  buffer[0] = '\0';
+  for (; lua_getstack(L, level, &ar) != 0; ++level) {
+    if (lua_getinfo(L, "Sl", &ar) != 0 && ar.currentline > 0) {
+      std::snprintf(buffer, size, "%s:%d: ", ar.short_src, ar.currentline);
+      return;
+    }
+  }
+}
+
+ScriptError::ScriptError(Kind kind, const std::string& what)
+    : std::runtime_error(what), kind_(kind), message_(first_line(what)) {}
+
+const char* kind_name(ScriptError::Kind kind) {
+  switch (kind) {
+    case ScriptError::Kind::kSyntax:
+      return "syntax";
+    case ScriptError::Kind::kRuntime:
+      return "runtime";
+    case ScriptError::Kind::kBudget:
+      return "budget";
+    case ScriptError::Kind::kMemory:
+      return "memory";
+    case ScriptError::Kind::kTime:
+      return "time";
+  }
+  return "runtime";
+}
+
+LuaHost::LuaHost(const SandboxLimits& limits, std::uint64_t seed)
+    : host_(std::make_unique<HostState>()) {
+  host_->limits = limits;
+  host_->seed = seed;
+  host_->random.reseed(seed);
+  lua_State* L = lua_newstate(allocate, host_.get());
+  if (L == nullptr) throw std::bad_alloc();
+  host_->L = L;
+  lua_sethook(L, count_hook, LUA_MASKCOUNT, kHookInterval);
+  lua_pushcfunction(L, open_sandbox);
+  if (lua_pcall(L, 0, 0, 0) != LUA_OK) {
+    const std::string message = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : "?";
+    lua_close(L);
+    throw std::runtime_error("cannot build the Lua sandbox: " + message);
+  }
+}
+
+LuaHost::~LuaHost() { lua_close(host_->L); }
+
+lua_State* LuaHost::state() { return host_->L; }
+
+void LuaHost::push_env() {
+  if (!lua_checkstack(host_->L, 1)) throw std::bad_alloc();
+  push_sandbox_env(host_->L);
+}
+
+void LuaHost::load_chunk(std::string_view code, const std::string& chunk_name) {
+  lua_State* L = host_->L;
+  if (!lua_checkstack(L, 2)) {
+    throw ScriptError(ScriptError::Kind::kMemory, chunk_name.substr(1) + ": Lua stack overflow");
+  }
+  const int status = luaL_loadbufferx(L, code.data(), code.size(), chunk_name.c_str(), "t");
+  if (status != LUA_OK) {
+    if (status == LUA_ERRMEM) note_memory_error(*host_);
+    throw take_error(*host_, ScriptError::Kind::kSyntax);
+  }
+  push_sandbox_env(L);
+  lua_setupvalue(L, -2, 1);  // the chunk's _ENV
+}
+
+void LuaHost::run_file(const std::filesystem::path& path, int nresults) {
+  const std::string code = read_script(path);
+  CallScope scope(*host_);
+  load_chunk(code, chunk_name('@', path.string()));
+  call(0, nresults);
+}
+
+void LuaHost::run_string(std::string_view code, const std::string& name, int nresults) {
+  CallScope scope(*host_);
+  load_chunk(code, chunk_name('=', name));
+  call(0, nresults);
+}
+
+void LuaHost::call(int nargs, int nresults) {
+  lua_State* L = host_->L;
+  const int function_index = lua_gettop(L) - nargs;
+  CallScope scope(*host_);
+  if (!lua_checkstack(L, 2)) {
+    lua_settop(L, function_index - 1);
+    throw ScriptError(ScriptError::Kind::kMemory, "Lua stack overflow");
+  }
+  // Where a memory error is placed when the script was never seen by the
+  // hook: the called function's source.
+  char origin[sizeof(host_->where)] = {};
+  lua_Debug ar;
+  lua_pushvalue(L, function_index);
+  if (lua_getinfo(L, ">S", &ar) != 0 && ar.what[0] != 'C') {
+    if (ar.linedefined > 0) {
+      std::snprintf(origin, sizeof(origin), "%s:%d: ", ar.short_src, ar.linedefined);
+    } else {
+      std::snprintf(origin, sizeof(origin), "%s: ", ar.short_src);
+    }
+  }
+  lua_pushcfunction(L, message_handler);
+  lua_insert(L, function_index);
+  const int status = lua_pcall(L, nargs, nresults, function_index);
+  lua_remove(L, function_index);
+  if (status == LUA_OK) return;
+  if (host_->where[0] == '\0') std::memcpy(host_->where, origin, sizeof(origin));
+  if (status == LUA_ERRMEM) note_memory_error(*host_);
+  throw take_error(*host_, ScriptError::Kind::kRuntime);
+}
+
+const std::vector<std::string>& LuaHost::printed() const { return host_->printed; }
+
+void LuaHost::clear_printed() {
+  host_->printed.clear();
+  host_->printed_bytes = 0;
+}
+
+std::uint64_t LuaHost::instructions_used() const { return host_->instructions_total; }
+
+std::size_t LuaHost::memory_used() const { return host_->bytes; }
+
+}  // namespace dovetail::scripting
