@@ -36,10 +36,14 @@ Args::Args(std::string command, std::span<const std::string> argv,
       help_ = true;
       continue;
     }
-    if (arg.rfind("--", 0) != 0) {
+    // One-letter options the command declares may be written -j as well as --j.
+    const bool short_option =
+        arg.size() == 2 && arg[1] != '-' &&
+        (value_options.count(arg.substr(1)) != 0 || flags.count(arg.substr(1)) != 0);
+    if (arg.rfind("--", 0) != 0 && !short_option) {
       throw UsageError(command_ + ": unknown option '" + arg + "'" + see_help(command_));
     }
-    std::string name = arg.substr(2);
+    std::string name = arg.substr(short_option ? 1 : 2);
     std::optional<std::string> inline_value;
     if (const std::size_t eq = name.find('='); eq != std::string::npos) {
       inline_value = name.substr(eq + 1);

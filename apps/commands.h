@@ -15,8 +15,20 @@ int query_command(std::span<const std::string> args);
 int inspect_command(std::span<const std::string> args);
 /// `dovetail poses A B --out FILE ...`: writes a contact-distance pose list.
 int poses_command(std::span<const std::string> args);
-/// `dovetail run`: the built-in default job (every method against brute force).
+/// `dovetail bench`: every collision method against brute force on a peg and a ring.
+int bench_command(std::span<const std::string> args);
+/// `dovetail run [SCENARIO] ...`: runs a Lua scenario headless (the first shipped one by default).
 int run_command(std::span<const std::string> args);
+/// `dovetail replay SCENARIO TRACE ...`: run with a recorded glove trace.
+int replay_command(std::span<const std::string> args);
+/// `dovetail check SCENARIO`: loads and resolves a scenario without simulating.
+int check_command(std::span<const std::string> args);
+/// `dovetail new NAME`: writes a commented starting scenario.
+int new_command(std::span<const std::string> args);
+/// `dovetail regress DIR ...`: every scenario of a folder, each in its own process.
+int regress_command(std::span<const std::string> args);
+/// `dovetail reference`: the scenario vocabulary as Markdown.
+int reference_command(std::span<const std::string> args);
 /// `dovetail broadphase --boxes FILE ...`: overlapping box pairs, frame by frame.
 int broadphase_command(std::span<const std::string> args);
 /// `dovetail render INPUT --out PNG ...`: draws a mesh or assembly file to PNG.

@@ -13,6 +13,8 @@
 #include "commands.h"
 #include "dovetail/collision/mesh.h"
 #include "dovetail/engine/pose_list.h"
+#include "dovetail/scripting/lua_host.h"
+#include "dovetail/scripting/scenario.h"
 
 namespace {
 
@@ -23,14 +25,20 @@ using dovetail::cli::kExitUsage;
 constexpr const char* kUsage =
     R"(usage: dovetail <command> [arguments]
 
-Headless VR assembly simulator: exact collision queries between meshes, the
-glove-driven hand.
+Headless VR assembly simulator: Lua assembly scenarios, a glove-driven hand,
+exact collision queries between meshes.
 
 commands:
+  run       run a Lua scenario headless (the first shipped one by default)
+  replay    run a scenario with a recorded glove trace
+  regress   run every scenario of a folder, JUnit XML and an HTML report
+  check     load and resolve a scenario without simulating
+  new       write a commented starting scenario
+  reference the scenario vocabulary as Markdown
   query     test mesh B against mesh A at every pose of a pose list
   inspect   mesh statistics and the size of every method's hierarchy
   poses     write a contact-distance pose list for two meshes
-  run       the built-in job: every method against brute force
+  bench     every collision method against brute force on a peg and a ring
   broadphase  overlapping pairs of moving boxes, frame by frame
   render    draw a mesh or assembly file to PNG (with the hand of a glove trace)
   glove     convert glove recordings, sample glove plans, check traces
@@ -57,10 +65,20 @@ int version_command(std::span<const std::string> args) {
 }
 
 constexpr Command kCommands[] = {
-    {"query", dovetail::cli::query_command},           {"inspect", dovetail::cli::inspect_command},
-    {"poses", dovetail::cli::poses_command},           {"run", dovetail::cli::run_command},
-    {"broadphase", dovetail::cli::broadphase_command}, {"render", dovetail::cli::render_command},
-    {"glove", dovetail::cli::glove_command},           {"version", version_command},
+    {"run", dovetail::cli::run_command},
+    {"replay", dovetail::cli::replay_command},
+    {"regress", dovetail::cli::regress_command},
+    {"check", dovetail::cli::check_command},
+    {"new", dovetail::cli::new_command},
+    {"reference", dovetail::cli::reference_command},
+    {"bench", dovetail::cli::bench_command},
+    {"query", dovetail::cli::query_command},
+    {"inspect", dovetail::cli::inspect_command},
+    {"poses", dovetail::cli::poses_command},
+    {"broadphase", dovetail::cli::broadphase_command},
+    {"render", dovetail::cli::render_command},
+    {"glove", dovetail::cli::glove_command},
+    {"version", version_command},
 };
 
 int dispatch(const std::vector<std::string>& args) {
@@ -96,6 +114,10 @@ int main(int argc, char** argv) {
   } catch (const dovetail::cli::UsageError& e) {
     code = report(e.what(), kExitUsage);
   } catch (const dovetail::cli::InputError& e) {
+    code = report(e.what(), kExitInputError);
+  } catch (const dovetail::scripting::ScenarioError& e) {
+    code = report(e.what(), kExitInputError);
+  } catch (const dovetail::scripting::ScriptError& e) {
     code = report(e.what(), kExitInputError);
   } catch (const dovetail::engine::PoseListError& e) {
     code = report(e.what(), kExitInputError);

@@ -119,6 +119,37 @@ Mesh make_cylinder(Real radius, Real height, int sides) {
   return make_mesh(std::move(v), std::move(t), describe("cylinder", sides));
 }
 
+Mesh make_tube(Real outer_radius, Real inner_radius, Real height, int sides) {
+  if (!(inner_radius > 0 && inner_radius < outer_radius && std::isfinite(outer_radius) &&
+        height > 0 && std::isfinite(height))) {
+    throw std::invalid_argument("make_tube: need 0 < inner < outer and a positive height");
+  }
+  if (sides < 3) throw std::invalid_argument("make_tube: sides must be at least 3");
+  std::vector<Vec3> v;
+  Triangles t;
+  // Per side j: outer bottom, outer top, inner bottom, inner top.
+  for (int j = 0; j < sides; ++j) {
+    const Real w = 2 * std::numbers::pi * j / sides;
+    const Real c = std::cos(w), s = std::sin(w);
+    v.emplace_back(outer_radius * c, outer_radius * s, 0);
+    v.emplace_back(outer_radius * c, outer_radius * s, height);
+    v.emplace_back(inner_radius * c, inner_radius * s, 0);
+    v.emplace_back(inner_radius * c, inner_radius * s, height);
+  }
+  for (int j = 0; j < sides; ++j) {
+    const std::size_t a = 4 * j, b = 4 * ((j + 1) % sides);
+    t.push_back(tri(a, b, b + 1));  // outer wall, facing out
+    t.push_back(tri(a, b + 1, a + 1));
+    t.push_back(tri(a + 2, a + 3, b + 3));  // inner wall, facing the axis
+    t.push_back(tri(a + 2, b + 3, b + 2));
+    t.push_back(tri(a + 1, b + 1, b + 3));  // top ring, facing +z
+    t.push_back(tri(a + 1, b + 3, a + 3));
+    t.push_back(tri(a, a + 2, b + 2));  // bottom ring, facing -z
+    t.push_back(tri(a, b + 2, b));
+  }
+  return make_mesh(std::move(v), std::move(t), describe("tube", sides));
+}
+
 Mesh make_block_with_hole(const Vec3& half_extents, Real hole_radius, Real hole_depth, int sides) {
   auto positive = [](Real x) { return std::isfinite(x) && x > 0; };
   if (!positive(half_extents.x()) || !positive(half_extents.y()) || !positive(half_extents.z()) ||

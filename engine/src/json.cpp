@@ -1,6 +1,7 @@
 #include "dovetail/engine/json.h"
 
 #include <cstdio>
+#include <cstdlib>
 
 namespace dovetail::engine {
 
@@ -34,6 +35,15 @@ std::string json_string(std::string_view text) {
     }
   }
   return out + "\"";
+}
+
+std::string json_number(double value) {
+  char buffer[32];
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(buffer, sizeof(buffer), "%.*g", digits, value);
+    if (std::strtod(buffer, nullptr) == value) break;
+  }
+  return buffer;
 }
 
 }  // namespace dovetail::engine

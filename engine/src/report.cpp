@@ -16,15 +16,7 @@ namespace dovetail::engine {
 
 namespace {
 
-/// Shortest text that reads back to the same double.
-std::string number(double value) {
-  char buffer[32];
-  for (int digits = 15; digits <= 17; ++digits) {
-    std::snprintf(buffer, sizeof(buffer), "%.*g", digits, value);
-    if (std::strtod(buffer, nullptr) == value) break;
-  }
-  return buffer;
-}
+std::string number(double value) { return json_number(value); }
 
 std::string hex(std::uint64_t value) {
   char buffer[24];

@@ -188,6 +188,14 @@ const std::optional<std::array<float, 3>>& Scene::color(PartHandle part) const {
   return slot(part).color;
 }
 void Scene::set_movable(PartHandle part, bool movable) { slot(part).movable = movable; }
+void Scene::set_highlight(PartHandle part, const std::optional<std::array<float, 3>>& color) {
+  slot(part).highlight = color;
+}
+const std::optional<std::array<float, 3>>& Scene::highlight(PartHandle part) const {
+  return slot(part).highlight;
+}
+void Scene::set_visible(PartHandle part, bool visible) { slot(part).visible = visible; }
+bool Scene::visible(PartHandle part) const { return slot(part).visible; }
 
 const std::shared_ptr<const Mesh>& Scene::render_mesh(PartHandle part) const {
   return slot(part).render_mesh;

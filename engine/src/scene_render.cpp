@@ -47,11 +47,16 @@ RenderScene render_scene(const Scene& scene, const collision::StepResult* step,
   for (const PartHandle part : scene.parts()) {
     const auto& mesh = scene.render_mesh(part);
     if (!mesh) continue;  // a group node
+    // Hidden or highlighted parts keep their palette place, so the others keep their colours.
+    const auto& own = scene.color(part);
+    const Color palette =
+        own ? Color{(*own)[0], (*own)[1], (*own)[2]} : palette_color(palette_index++);
+    if (!scene.visible(part)) continue;
     RenderItem item;
     item.mesh = mesh;
     item.X_WP = scene.world_pose(part);
-    const auto& own = scene.color(part);
-    item.color = own ? Color{(*own)[0], (*own)[1], (*own)[2]} : palette_color(palette_index++);
+    const auto& highlight = scene.highlight(part);
+    item.color = highlight ? Color{(*highlight)[0], (*highlight)[1], (*highlight)[2]} : palette;
     item.name = scene.name(part);
     if (step != nullptr) {
       const collision::PartId id = collision_id(part);

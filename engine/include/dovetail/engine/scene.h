@@ -119,6 +119,14 @@ class Scene {
 
   const std::string& collision_group(PartHandle part) const;
   const std::optional<std::array<float, 3>>& color(PartHandle part) const;
+  /// A display colour drawn in place of the part's own while set (scripts
+  /// highlight parts this way); nullopt removes it. Rendering only.
+  void set_highlight(PartHandle part, const std::optional<std::array<float, 3>>& color);
+  const std::optional<std::array<float, 3>>& highlight(PartHandle part) const;
+  /// Whether the part is drawn (default true). Rendering only: a hidden part
+  /// still collides.
+  void set_visible(PartHandle part, bool visible);
+  bool visible(PartHandle part) const;
 
   bool movable(PartHandle part) const;
   void set_movable(PartHandle part, bool movable);
@@ -144,6 +152,8 @@ class Scene {
     bool movable = true;
     std::string collision_group;
     std::optional<std::array<float, 3>> color;
+    std::optional<std::array<float, 3>> highlight;
+    bool visible = true;
     std::shared_ptr<const collision::Mesh> render_mesh;
     std::shared_ptr<const collision::Mesh> collision_mesh;
   };

@@ -17,9 +17,9 @@ namespace dovetail::cli {
 namespace {
 
 constexpr const char* kHelp =
-    R"(usage: dovetail run [--directions N] [--seed S] [--threads N]
+    R"(usage: dovetail bench [--directions N] [--seed S] [--threads N]
 
-Runs the built-in job: a peg (closed cylinder, radius 30 mm, 120 mm long)
+Checks every collision method against brute force: a peg (closed cylinder, radius 30 mm, 120 mm long)
 against a ring (torus, 50 mm ring radius, 15 mm tube, so a 35 mm hole).
 Contact-distance poses are generated with the boxtree method, then every
 method answers the same poses and its verdicts are compared with brute force,
@@ -53,17 +53,13 @@ struct MethodOutcome {
 
 }  // namespace
 
-int run_command(std::span<const std::string> argv) {
-  const Args args("run", argv, {"directions", "seed", "threads"}, {});
+int bench_command(std::span<const std::string> argv) {
+  const Args args("bench", argv, {"directions", "seed", "threads"}, {});
   if (args.help()) {
     std::fputs(kHelp, stdout);
     return kExitOk;
   }
-  if (!args.positional().empty()) {
-    throw UsageError(
-        "run: scenario files are not supported yet; run without arguments for the "
-        "built-in job (see 'dovetail run --help')");
-  }
+  args.expect_positional(0, "no arguments");
   collision::ContactPoseSettings settings;
   settings.directions = static_cast<int>(args.integer("directions", 1, 100000).value_or(100));
   settings.seed = args.unsigned_integer("seed").value_or(1);

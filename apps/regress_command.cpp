@@ -1,0 +1,388 @@
+/// \file regress_command.cpp
+/// `dovetail regress DIR`: every scenario of a folder, each in its own
+/// process (`dovetail run`), so a failing or hostile scenario never stops the
+/// others; a summary line per scenario, JUnit XML and a self-contained HTML
+/// report (expectations, event timeline, the final frame of each).
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli.h"
+#include "commands.h"
+
+extern char** environ;
+
+namespace dovetail::cli {
+
+namespace {
+
+constexpr const char* kHelp =
+    R"(usage: dovetail regress DIR [--out OUT] [--junit X.xml] [--html R.html] [-j N]
+                        [--shard K/N] [--threads N] [--timeout S]
+
+Runs every *.lua scenario in DIR (file-name order), each in its own process,
+checks its expectations and prints a line per scenario. Exits 0 when all pass,
+3 when one fails or cannot run.
+
+  --out OUT      per-scenario reports, logs and final frames (default regress-out)
+  --junit X      JUnit XML, one test case per scenario
+  --html R       a self-contained HTML report
+  -j N           scenarios run at once (default 1)
+  --shard K/N    only the scenarios i (0-based, file-name order) with i % N == K - 1,
+                 to spread a folder over N machines
+  --threads N    collision worker threads per scenario (default 1)
+  --timeout S    seconds before a scenario is stopped (default 900)
+)";
+
+struct Job {
+  std::filesystem::path file;
+  std::string stem;
+  pid_t pid = -1;
+  std::chrono::steady_clock::time_point start;
+  double seconds = 0;
+  int exit_code = -1;
+  bool timed_out = false;
+  std::string status;  ///< passed, failed, error
+  std::string log;     ///< what the run wrote on stderr
+  nlohmann::json report;
+};
+
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::string xml_escape(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    switch (c) {
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        // XML 1.0 allows no control characters but tab and line ends.
+        if (static_cast<unsigned char>(c) >= 0x20 || c == '\n' || c == '\t' || c == '\r') out += c;
+    }
+  }
+  return out;
+}
+
+std::string base64(const std::string& bytes) {
+  static constexpr char kTable[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const std::uint32_t b0 = static_cast<unsigned char>(bytes[i]);
+    const std::uint32_t b1 = i + 1 < bytes.size() ? static_cast<unsigned char>(bytes[i + 1]) : 0;
+    const std::uint32_t b2 = i + 2 < bytes.size() ? static_cast<unsigned char>(bytes[i + 2]) : 0;
+    const std::uint32_t n = (b0 << 16) | (b1 << 8) | b2;
+    out += kTable[(n >> 18) & 63];
+    out += kTable[(n >> 12) & 63];
+    out += i + 1 < bytes.size() ? kTable[(n >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? kTable[n & 63] : '=';
+  }
+  return out;
+}
+
+std::string format_seconds(double s) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3f", s);
+  return buffer;
+}
+
+/// The first line of the log that says why, or the status.
+std::string first_reason(const Job& job) {
+  std::istringstream lines(job.log);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.rfind("warning: ", 0) == 0 || line.empty()) continue;
+    return line;
+  }
+  return job.timed_out ? "stopped after the timeout" : job.status;
+}
+
+void start(Job& job, const std::filesystem::path& out, int threads) {
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe");
+  const std::filesystem::path folder = out / job.stem;
+  std::filesystem::create_directories(folder);
+  std::vector<std::string> args = {self.string(),
+                                   "run",
+                                   job.file.string(),
+                                   "--report",
+                                   (out / (job.stem + ".json")).string(),
+                                   "--render",
+                                   folder.string(),
+                                   "--threads",
+                                   std::to_string(threads),
+                                   "--quiet"};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string log = (out / (job.stem + ".log")).string();
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  job.start = std::chrono::steady_clock::now();
+  const int rc = posix_spawn(&job.pid, self.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) throw InputError("regress: cannot start '" + self.string() + "'");
+}
+
+void finish(Job& job, int wait_status, const std::filesystem::path& out) {
+  job.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - job.start).count();
+  job.exit_code = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : 128 + WTERMSIG(wait_status);
+  job.log = read_file(out / (job.stem + ".log"));
+  if (WIFSIGNALED(wait_status) && !job.timed_out) {
+    job.log += "the run ended with signal " + std::to_string(WTERMSIG(wait_status)) + "\n";
+  }
+  job.status = job.exit_code == kExitOk            ? "passed"
+               : job.exit_code == kExitCheckFailed ? "failed"
+                                                   : "error";
+  const std::filesystem::path report = out / (job.stem + ".json");
+  if (std::filesystem::exists(report)) {
+    job.report = nlohmann::json::parse(read_file(report), nullptr, false);
+    if (job.report.is_discarded()) job.report = nlohmann::json();
+  }
+}
+
+void write_junit(const std::vector<Job>& jobs, const std::filesystem::path& path, double total) {
+  std::size_t failures = 0, errors = 0;
+  for (const Job& j : jobs) {
+    failures += j.status == "failed";
+    errors += j.status == "error";
+  }
+  std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  xml += "<testsuites tests=\"" + std::to_string(jobs.size()) + "\" failures=\"" +
+         std::to_string(failures) + "\" errors=\"" + std::to_string(errors) + "\" time=\"" +
+         format_seconds(total) + "\">\n";
+  xml += "  <testsuite name=\"dovetail.regress\" tests=\"" + std::to_string(jobs.size()) +
+         "\" failures=\"" + std::to_string(failures) + "\" errors=\"" + std::to_string(errors) +
+         "\" time=\"" + format_seconds(total) + "\">\n";
+  for (const Job& j : jobs) {
+    xml += "    <testcase classname=\"scenarios\" name=\"" + xml_escape(j.stem) + "\" file=\"" +
+           xml_escape(j.file.generic_string()) + "\" time=\"" + format_seconds(j.seconds) + "\"";
+    if (j.status == "passed") {
+      xml += "/>\n";
+      continue;
+    }
+    xml += ">\n      <" + std::string(j.status == "failed" ? "failure" : "error") + " message=\"" +
+           xml_escape(first_reason(j)) + "\">" + xml_escape(j.log) + "</" +
+           (j.status == "failed" ? "failure" : "error") + ">\n    </testcase>\n";
+  }
+  xml += "  </testsuite>\n</testsuites>\n";
+  std::ofstream out(path, std::ios::binary);
+  out << xml;
+  if (!out.flush()) throw InputError(path.string() + ": cannot be written");
+}
+
+std::string html_text(const nlohmann::json& value) {
+  return value.is_string() ? xml_escape(value.get<std::string>()) : xml_escape(value.dump());
+}
+
+void write_html(const std::vector<Job>& jobs, const std::filesystem::path& path,
+                const std::filesystem::path& out) {
+  std::size_t passed = 0;
+  for (const Job& j : jobs) passed += j.status == "passed";
+  std::string h = R"(<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>Dovetail regression</title>
+<style>
+body{font-family:sans-serif;margin:2em;color:#222;background:#fafafa}
+h1{font-size:1.5em} h2{font-size:1.2em;margin-top:2em}
+.passed{color:#1a7f37} .failed,.error{color:#c62828}
+table{border-collapse:collapse;margin:.5em 0} td,th{border:1px solid #ccc;padding:.2em .6em;text-align:left;font-size:.9em}
+th{background:#eee} .scenario{background:#fff;border:1px solid #ddd;padding:1em;margin:1em 0}
+img{max-width:480px;border:1px solid #ccc} pre{background:#f0f0f0;padding:.5em;white-space:pre-wrap}
+details{margin:.5em 0}
+</style></head><body>
+<h1>Dovetail regression</h1>
+)";
+  h += "<p id=\"summary\">" + std::to_string(passed) + " of " + std::to_string(jobs.size()) +
+       " scenarios "
+       "passed.</p>\n<table><tr><th>scenario</th><th>outcome</th><th>seconds</th><th>reason</th></"
+       "tr>\n";
+  for (const Job& j : jobs) {
+    h += "<tr><td><a href=\"#" + xml_escape(j.stem) + "\">" + xml_escape(j.stem) +
+         "</a></td><td class=\"" + j.status + "\">" + j.status + "</td><td>" +
+         format_seconds(j.seconds) + "</td><td>" +
+         (j.status == "passed" ? "" : xml_escape(first_reason(j))) + "</td></tr>\n";
+  }
+  h += "</table>\n";
+  for (const Job& j : jobs) {
+    const nlohmann::json& r = j.report;
+    h += "<div class=\"scenario\" id=\"" + xml_escape(j.stem) + "\"><h2>" + xml_escape(j.stem);
+    if (r.contains("scenario")) h += ": " + html_text(r["scenario"]);
+    h += " <span class=\"" + j.status + "\">" + j.status + "</span></h2>\n";
+    h += "<p>" + xml_escape(j.file.generic_string()) + "</p>\n";
+    if (!j.log.empty()) h += "<pre>" + xml_escape(j.log) + "</pre>\n";
+    const std::filesystem::path png = out / j.stem / "final.png";
+    if (std::filesystem::exists(png)) {
+      h += "<img alt=\"final frame of " + xml_escape(j.stem) + "\" src=\"data:image/png;base64," +
+           base64(read_file(png)) + "\">\n";
+    }
+    if (r.contains("expectations") && r["expectations"].is_array()) {
+      h += "<table><tr><th>expectation</th><th>where</th><th></th><th>detail</th></tr>\n";
+      for (const auto& e : r["expectations"]) {
+        const bool ok = e.value("passed", false);
+        h += "<tr><td><code>" + html_text(e.value("expect", "")) + "</code></td><td>" +
+             html_text(e.value("where", "")) + "</td><td class=\"" + (ok ? "passed" : "failed") +
+             "\">" + (ok ? "holds" : "fails") + "</td><td>" + html_text(e.value("detail", "")) +
+             "</td></tr>\n";
+      }
+      h += "</table>\n";
+    }
+    if (r.contains("steps") && r["steps"].is_array() && !r["steps"].empty()) {
+      h += "<table><tr><th>step</th><th>done at (s)</th></tr>\n";
+      for (const auto& s : r["steps"]) {
+        h += "<tr><td>" + html_text(s.value("name", "")) + "</td><td>" +
+             (s["done_at"].is_number() ? format_seconds(s["done_at"].get<double>()) : std::string("not done")) +
+             (s.value("out_of_order", false) ? " (out of order)" : "") + "</td></tr>\n";
+      }
+      h += "</table>\n";
+    }
+    if (r.contains("simulation") && r["simulation"].contains("events")) {
+      const auto& events = r["simulation"]["events"];
+      h +=
+          "<details><summary>event timeline (" + std::to_string(events.size()) +
+          " events)</summary><table><tr><th>time (s)</th><th>event</th><th>a</th><th>b</th></tr>\n";
+      for (const auto& e : events) {
+        h += "<tr><td>" + (e["time"].is_number() ? format_seconds(e["time"].get<double>()) : std::string()) +
+             "</td><td>" + html_text(e.value("kind", "")) +
+             "</td><td>" + html_text(e.value("a", "")) + "</td><td>" + html_text(e.value("b", "")) +
+             "</td></tr>\n";
+      }
+      h += "</table></details>\n";
+    }
+    h += "</div>\n";
+  }
+  h += "</body></html>\n";
+  std::ofstream file(path, std::ios::binary);
+  file << h;
+  if (!file.flush()) throw InputError(path.string() + ": cannot be written");
+}
+
+}  // namespace
+
+int regress_command(std::span<const std::string> argv) {
+  const Args args("regress", argv, {"out", "junit", "html", "j", "shard", "threads", "timeout"},
+                  {});
+  if (args.help()) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  args.expect_positional(1, "a folder of scenarios");
+  const std::filesystem::path folder = args.positional()[0];
+  if (!std::filesystem::is_directory(folder)) throw InputError(folder.string() + ": not a folder");
+  const std::filesystem::path out = args.value("out").value_or("regress-out");
+  const auto parallel = static_cast<std::size_t>(args.integer("j", 1, 256).value_or(1));
+  const int threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
+  const double timeout = args.number("timeout", 1).value_or(900);
+  std::size_t shard_k = 1, shard_n = 1;
+  if (auto shard = args.value("shard")) {
+    unsigned long k = 0, n = 0;
+    char extra = 0;
+    if (std::sscanf(shard->c_str(), "%lu/%lu%c", &k, &n, &extra) != 2 || n == 0 || k == 0 ||
+        k > n) {
+      throw UsageError("regress: --shard must be K/N with 1 <= K <= N, not '" + *shard + "'");
+    }
+    shard_k = k;
+    shard_n = n;
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(out, ec);
+  if (!std::filesystem::is_directory(out))
+    throw InputError(out.string() + ": cannot create the folder");
+
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    if (entry.is_regular_file() && entry.path().extension() == ".lua")
+      files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<Job> jobs;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    if (i % shard_n != shard_k - 1) continue;
+    Job job;
+    job.file = files[i];
+    job.stem = files[i].stem().string();
+    jobs.push_back(std::move(job));
+  }
+  if (jobs.empty()) {
+    std::fprintf(stderr, "regress: no scenarios in %s%s\n", folder.string().c_str(),
+                 shard_n > 1 ? " for this shard" : "");
+  }
+
+  const auto begin = std::chrono::steady_clock::now();
+  std::size_t next = 0, running = 0, done = 0;
+  while (done < jobs.size()) {
+    while (running < parallel && next < jobs.size()) {
+      start(jobs[next++], out, threads);
+      ++running;
+    }
+    int wait_status = 0;
+    const pid_t pid = waitpid(-1, &wait_status, WNOHANG);
+    if (pid > 0) {
+      for (Job& job : jobs) {
+        if (job.pid != pid) continue;
+        finish(job, wait_status, out);
+        job.pid = -1;
+        --running;
+        ++done;
+        std::printf("%-6s %-32s %8.2f s  %s\n",
+                    job.status == "passed"   ? "PASS"
+                    : job.status == "failed" ? "FAIL"
+                                             : "ERROR",
+                    job.stem.c_str(), job.seconds,
+                    job.status == "passed" ? "" : first_reason(job).c_str());
+        std::fflush(stdout);
+      }
+      continue;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    for (Job& job : jobs) {
+      if (job.pid > 0 && !job.timed_out &&
+          std::chrono::duration<double>(now - job.start).count() > timeout) {
+        job.timed_out = true;
+        kill(job.pid, SIGKILL);
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  const double total =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  std::size_t passed = 0;
+  for (const Job& j : jobs) passed += j.status == "passed";
+  std::printf("%zu of %zu scenarios passed (%.1f s)\n", passed, jobs.size(), total);
+  if (auto junit = args.value("junit")) write_junit(jobs, *junit, total);
+  if (auto html = args.value("html")) write_html(jobs, *html, out);
+  return passed == jobs.size() ? kExitOk : kExitCheckFailed;
+}
+
+}  // namespace dovetail::cli

@@ -1,0 +1,222 @@
+/// \file scenario_commands.cpp
+/// `dovetail run`, `replay`, `check`, `new` and `reference`: scenarios from
+/// the command line (regress_command.cpp runs whole folders of them).
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "cli.h"
+#include "commands.h"
+#include "dovetail/scripting/scenario_run.h"
+
+namespace dovetail::cli {
+
+namespace {
+
+constexpr const char* kRunHelp =
+    R"(usage: dovetail run [SCENARIO] [--trace T] [--record T] [--report R.json]
+                    [--render DIR [--every N]] [--threads N] [--quiet]
+
+Runs a Lua assembly scenario headless: the scene, the hand driven by the
+scenario's glove (or --trace), the rules and steps frame by frame, then checks
+the expectations. Prints a summary; exits 0 when every expectation holds,
+3 when one fails (the reasons on stderr), 1 when the scenario cannot be loaded
+or its script fails. Without SCENARIO, runs the first shipped scenario
+(scenarios/ in file-name order).
+
+  --trace T       replay this glove trace instead of the scenario's glove
+  --record T      write the glove samples the run used as a trace
+  --report R      write the JSON report (also written when the run fails)
+  --render DIR    write DIR/final.png, and with --every N every N-th frame
+  --threads N     collision worker threads (default 1; the report is the same)
+  --quiet         no progress meter and no summary on stdout
+)";
+
+constexpr const char* kReplayHelp =
+    R"(usage: dovetail replay SCENARIO TRACE [--record T] [--report R.json]
+                       [--render DIR [--every N]] [--threads N] [--quiet]
+
+`dovetail run SCENARIO --trace TRACE`: replays a recorded glove trace in the
+scenario. A trace recorded by `run --record` gives the identical report.
+)";
+
+constexpr const char* kCheckHelp =
+    R"(usage: dovetail check SCENARIO
+
+Loads the scenario and resolves every name without simulating: errors with
+file and line, warnings for rules that can never fire. Exits 0 when it loads.
+)";
+
+constexpr const char* kNewHelp =
+    R"(usage: dovetail new NAME [--out FILE]
+
+Writes a commented starting scenario NAME.lua (or FILE) to edit; refuses to
+overwrite an existing file.
+)";
+
+std::filesystem::path default_scenario() {
+  std::vector<std::filesystem::path> folders = {"scenarios"};
+#ifdef DOVETAIL_SCENARIO_DIR
+  folders.emplace_back(DOVETAIL_SCENARIO_DIR);
+#endif
+  for (const auto& folder : folders) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(folder, ec)) continue;
+    std::vector<std::filesystem::path> files;
+    for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
+      if (entry.path().extension() == ".lua") files.push_back(entry.path());
+    }
+    std::sort(files.begin(), files.end());
+    if (!files.empty()) return files.front();
+  }
+  throw UsageError(
+      "run: no scenario given and no scenarios/ folder found (see 'dovetail run --help')");
+}
+
+int run_scenario_command(const Args& args, const std::filesystem::path& scenario,
+                         std::optional<std::filesystem::path> trace) {
+  scripting::RunOptions options;
+  options.trace = std::move(trace);
+  if (auto v = args.value("record")) options.record = *v;
+  if (auto v = args.value("render")) {
+    options.render_dir = *v;
+    std::error_code ec;
+    std::filesystem::create_directories(*v, ec);
+    if (!std::filesystem::is_directory(*v)) throw InputError(*v + ": cannot create the folder");
+  }
+  options.render_every = args.unsigned_integer("every").value_or(0);
+  if (options.render_every > 0 && !options.render_dir)
+    throw UsageError("run: --every needs --render DIR");
+  options.threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
+  const bool quiet = args.flag("quiet");
+  options.progress = !quiet && stderr_is_terminal();
+  if (!std::filesystem::exists(scenario)) throw InputError(scenario.string() + ": no such file");
+  if (options.trace && !std::filesystem::exists(*options.trace)) {
+    throw InputError(options.trace->string() + ": no such file");
+  }
+
+  const scripting::RunOutcome outcome = scripting::run_scenario(scenario, options);
+  if (auto path = args.value("report")) {
+    std::ofstream out(*path, std::ios::binary);
+    out << outcome.to_json();
+    out.flush();
+    if (!out) throw InputError(*path + ": cannot be written");
+  }
+  for (const std::string& w : outcome.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  const std::string failures = outcome.failure_summary();
+  if (!failures.empty()) std::fputs(failures.c_str(), stderr);
+  if (!quiet) {
+    std::size_t passed = 0;
+    for (const auto& e : outcome.expectations) passed += e.passed ? 1 : 0;
+    std::printf("%s: %s (%zu/%zu expectations, %llu frames, %.2f s wall)\n", outcome.name.c_str(),
+                std::string(scripting::status_name(outcome.status)).c_str(), passed,
+                outcome.expectations.size(), static_cast<unsigned long long>(outcome.report.frames),
+                outcome.wall_seconds);
+    for (const auto& s : outcome.steps) {
+      if (s.done_at) {
+        std::printf("  step %-20s done at t=%.3f s%s\n", s.name.c_str(), *s.done_at,
+                    s.out_of_order ? " (out of order)" : "");
+      } else {
+        std::printf("  step %-20s not done\n", s.name.c_str());
+      }
+    }
+    std::printf("  state_hash 0x%016llx\n",
+                static_cast<unsigned long long>(outcome.report.state_hash));
+    if (outcome.final_frame)
+      std::printf("  final frame: %s\n", outcome.final_frame->string().c_str());
+  }
+  switch (outcome.status) {
+    case scripting::RunOutcome::Status::kPassed:
+      return kExitOk;
+    case scripting::RunOutcome::Status::kFailed:
+      return kExitCheckFailed;
+    case scripting::RunOutcome::Status::kError:
+      return kExitInputError;
+  }
+  return kExitInputError;
+}
+
+}  // namespace
+
+int run_command(std::span<const std::string> argv) {
+  const Args args("run", argv, {"trace", "record", "report", "render", "every", "threads"},
+                  {"quiet"});
+  if (args.help()) {
+    std::fputs(kRunHelp, stdout);
+    return kExitOk;
+  }
+  if (args.positional().size() > 1)
+    throw UsageError("run: one scenario at a time (see 'dovetail regress')");
+  const std::filesystem::path scenario =
+      args.positional().empty() ? default_scenario() : std::filesystem::path(args.positional()[0]);
+  std::optional<std::filesystem::path> trace;
+  if (auto v = args.value("trace")) trace = *v;
+  return run_scenario_command(args, scenario, trace);
+}
+
+int replay_command(std::span<const std::string> argv) {
+  const Args args("replay", argv, {"record", "report", "render", "every", "threads"}, {"quiet"});
+  if (args.help()) {
+    std::fputs(kReplayHelp, stdout);
+    return kExitOk;
+  }
+  args.expect_positional(2, "a scenario and a trace");
+  return run_scenario_command(args, args.positional()[0],
+                              std::filesystem::path(args.positional()[1]));
+}
+
+int check_command(std::span<const std::string> argv) {
+  const Args args("check", argv, {}, {});
+  if (args.help()) {
+    std::fputs(kCheckHelp, stdout);
+    return kExitOk;
+  }
+  args.expect_positional(1, "a scenario");
+  const std::filesystem::path file = args.positional()[0];
+  if (!std::filesystem::exists(file)) throw InputError(file.string() + ": no such file");
+  const scripting::Scenario s = scripting::check_scenario(file);
+  for (const std::string& w : s.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  std::printf("%s: ok: '%s', %zu parts, %zu mates, %zu steps, %zu rules, %zu expectations%s\n",
+              file.string().c_str(), s.name.c_str(), s.parts.size(), s.mates.size(), s.steps.size(),
+              s.rules.size(), s.expectations.size(), s.glove ? ", a hand" : "");
+  return kExitOk;
+}
+
+int new_command(std::span<const std::string> argv) {
+  const Args args("new", argv, {"out"}, {});
+  if (args.help()) {
+    std::fputs(kNewHelp, stdout);
+    return kExitOk;
+  }
+  args.expect_positional(1, "a name");
+  const std::string name = args.positional()[0];
+  const std::filesystem::path out = args.value("out").value_or(name + ".lua");
+  if (std::filesystem::exists(out)) throw InputError(out.string() + ": exists; not overwritten");
+  std::ofstream file(out, std::ios::binary);
+  file << scripting::starting_scenario(name);
+  file.flush();
+  if (!file) throw InputError(out.string() + ": cannot be written");
+  std::printf("wrote %s; try 'dovetail check %s', then 'dovetail run %s'\n", out.string().c_str(),
+              out.string().c_str(), out.string().c_str());
+  return kExitOk;
+}
+
+int reference_command(std::span<const std::string> argv) {
+  const Args args("reference", argv, {}, {});
+  if (args.help()) {
+    std::fputs(
+        "usage: dovetail reference\n\nPrints the scenario vocabulary as Markdown "
+        "(the reference of docs/authoring.md).\n",
+        stdout);
+    return kExitOk;
+  }
+  args.expect_positional(0, "no arguments");
+  std::fputs(scripting::reference_markdown().c_str(), stdout);
+  return kExitOk;
+}
+
+}  // namespace dovetail::cli

@@ -1,0 +1,104 @@
+#pragma once
+/// \file scenario_run.h
+/// Running a scenario headless: the scene, the hand and its glove, the rules
+/// and steps frame by frame, the expectations at the end, and the report.
+///
+/// Why: `dovetail run`, `replay` and `regress` all do the same thing, and a
+/// regression is only worth something if the same scenario and trace give
+/// the same report bits at any thread count. Rules see each frame's sorted
+/// events and fire in file order; what they change applies at the start of
+/// the next frame, so rules cannot cascade within a frame; every time is
+/// simulation time. A scenario that fails to load or whose script fails
+/// still gets a report, with the error and everything up to it.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dovetail/engine/report.h"
+#include "dovetail/scripting/lua_host.h"
+#include "dovetail/scripting/scenario.h"
+
+namespace dovetail::scripting {
+
+/// How to run a scenario.
+struct RunOptions {
+  int threads = 1;  ///< collision worker threads; the report does not depend on them
+  /// Replays this glove trace instead of the scenario's own glove.
+  std::optional<std::filesystem::path> trace{};
+  /// Writes the glove samples the run used here, as a trace.
+  std::optional<std::filesystem::path> record{};
+  /// Writes PNGs here: every `render_every`-th frame (0: none) and final.png.
+  std::optional<std::filesystem::path> render_dir{};
+  std::uint64_t render_every = 0;
+  int render_width = 960;
+  int render_height = 720;
+  bool progress = false;  ///< a progress meter on stderr
+  SandboxLimits limits{};
+};
+
+/// One expectation's verdict.
+struct ExpectationOutcome {
+  std::string text{};  ///< as written: `max_penetration(0.01)`
+  SourceLocation where{};
+  bool passed = false;
+  /// Why it failed (or what was measured): which parts, at what time.
+  std::string detail{};
+};
+
+/// A step as it went.
+struct StepOutcome {
+  std::string name{};
+  std::optional<double> done_at{};  ///< simulated seconds
+  bool out_of_order = false;
+};
+
+/// A line a rule wrote (log, warn, fail) or a violation noticed.
+struct Message {
+  double time = 0;
+  std::string level{};  ///< "log", "warn", "fail", "violation"
+  std::string text{};
+  SourceLocation where{};
+};
+
+/// What a run found.
+struct RunOutcome {
+  enum class Status { kPassed, kFailed, kError };
+  Status status = Status::kError;
+  std::string name{};  ///< the scenario's name (or the file's stem before it loaded)
+  std::filesystem::path file{};
+  std::string error{};  ///< kError: why the run could not go on (file:line: ...)
+  std::vector<ExpectationOutcome> expectations{};
+  std::vector<StepOutcome> steps{};
+  std::vector<Message> messages{};
+  std::vector<std::string> warnings{};  ///< from loading
+  /// Deepest overlap of two parts over the run (metres), when and between which.
+  double max_penetration = 0;
+  double max_penetration_time = 0;
+  std::string max_penetration_a{}, max_penetration_b{};
+  std::uint64_t rules_fired = 0;
+  double metres_per_unit = 0.001;
+  std::string units = "mm";
+  engine::Report report{};  ///< the simulation's report (timeline, contacts, state hash)
+  double wall_seconds = 0;  ///< not in the JSON report
+  std::optional<std::filesystem::path> final_frame{};  ///< the PNG written, if any
+
+  /// The report as JSON: deterministic, no wall-clock times (docs/authoring.md, "Reports").
+  std::string to_json() const;
+  /// One line per failed expectation, error or violation, for stderr.
+  std::string failure_summary() const;
+};
+std::string_view status_name(RunOutcome::Status status);
+
+/// Loads and runs the scenario at `file`. Never throws for a bad scenario or
+/// a failing script: those end as Status::kError with the message. Throws
+/// only for failures of the host itself (an output that cannot be written).
+RunOutcome run_scenario(const std::filesystem::path& file, const RunOptions& options = {});
+
+/// Loads and resolves the scenario without simulating (`dovetail check`);
+/// throws ScenarioError or ScriptError.
+Scenario check_scenario(const std::filesystem::path& file, const SandboxLimits& limits = {});
+
+}  // namespace dovetail::scripting

@@ -1,0 +1,1029 @@
+// Loading a scenario: run the file once in the sandbox, then read the tables
+// the vocabulary's constructors built, check them against the vocabulary and
+// resolve every name.
+//
+// The tables are read with raw access only (lua_rawget, lua_next, type
+// checks before conversions), which never runs a metamethod and raises no
+// Lua error short of running out of memory, so C++ exceptions can carry the
+// loader's errors without crossing Lua's C frames.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <lua.hpp>
+#include <map>
+#include <numbers>
+#include <set>
+
+#include "dovetail/collision/primitives.h"
+#include "dovetail/engine/mesh_import.h"
+#include "dovetail/scripting/lua_host.h"
+#include "dovetail/scripting/scenario.h"
+
+namespace dovetail::scripting {
+
+namespace {
+
+using collision::Mat3;
+using collision::Real;
+
+constexpr const char* kPreludeName = "dovetail prelude";
+
+/// Defines one constructor per word: it packs its arguments and marks the
+/// table with the word's name and where it was called.
+constexpr const char* kPrelude = R"lua(
+local words, where = ...
+local pack = table.pack
+for i = 1, #words do
+  local name = words[i]
+  rawset(_ENV, name, function(...)
+    local t = pack(...)
+    t.__word = name
+    t.__where = where()
+    return t
+  end)
+end
+)lua";
+
+/// `file:line` of the innermost caller outside the prelude. Raises no error
+/// and holds no C++ object (it runs inside Lua).
+int where_function(lua_State* L) {
+  lua_Debug ar;
+  char buffer[1024];
+  buffer[0] = '\0';
+  for (int level = 1; lua_getstack(L, level, &ar) != 0; ++level) {
+    if (lua_getinfo(L, "Sl", &ar) == 0) break;
+    if (ar.currentline <= 0 || ar.source == nullptr) continue;
+    const char* source = ar.source[0] == '@' || ar.source[0] == '=' ? ar.source + 1 : ar.source;
+    if (std::strcmp(source, kPreludeName) == 0) continue;
+    std::snprintf(buffer, sizeof buffer, "%s:%d", source, ar.currentline);
+    break;
+  }
+  lua_pushstring(L, buffer);
+  return 1;
+}
+
+SourceLocation parse_where(const std::string& text, const std::string& fallback_file) {
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos) return {fallback_file, 0};
+  SourceLocation where{text.substr(0, colon), 0};
+  try {
+    where.line = std::stoi(text.substr(colon + 1));
+  } catch (const std::exception&) {
+    return {fallback_file, 0};
+  }
+  return where;
+}
+
+std::string format_number(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.10g", x);
+  return buffer;
+}
+
+const std::map<std::string, std::array<float, 3>, std::less<>>& color_names() {
+  static const std::map<std::string, std::array<float, 3>, std::less<>> names = {
+      {"red", {0.86F, 0.16F, 0.16F}},   {"orange", {1.0F, 0.55F, 0.0F}},
+      {"yellow", {0.95F, 0.85F, 0.1F}}, {"green", {0.2F, 0.7F, 0.25F}},
+      {"blue", {0.2F, 0.4F, 0.9F}},     {"purple", {0.55F, 0.3F, 0.75F}},
+      {"grey", {0.6F, 0.6F, 0.6F}},     {"gray", {0.6F, 0.6F, 0.6F}},
+      {"white", {0.97F, 0.97F, 0.97F}}, {"black", {0.1F, 0.1F, 0.1F}},
+      {"steel", {0.62F, 0.66F, 0.72F}}, {"brass", {0.8F, 0.65F, 0.25F}},
+  };
+  return names;
+}
+
+class Loader {
+ public:
+  Loader(LuaHost& host, const std::filesystem::path& file)
+      : host_(host), L_(host.state()), file_(file.string()), folder_(file.parent_path()) {}
+
+  Scenario load();
+
+ private:
+  [[noreturn]] void fail(const SourceLocation& where, const std::string& message) const {
+    throw ScenarioError(where.str() + ": " + message);
+  }
+
+  // ---- raw table access on absolute stack indices
+  /// t[key] without metamethods, pushed; `table` is an absolute index.
+  int raw_getfield(int table, const char* key) {
+    lua_pushstring(L_, key);
+    return lua_rawget(L_, table);
+  }
+  int type_of_field(int table, const char* key) {
+    lua_pushstring(L_, key);
+    return lua_rawget(L_, table);  // leaves the value on the stack
+  }
+  std::string string_field(int table, const char* key) {
+    std::string out;
+    if (type_of_field(table, key) == LUA_TSTRING) out = lua_tostring(L_, -1);
+    lua_pop(L_, 1);
+    return out;
+  }
+  std::string word_of(int index) {
+    return lua_type(L_, index) == LUA_TTABLE ? string_field(index, "__word") : std::string();
+  }
+  SourceLocation where_of(int index, const SourceLocation& fallback) {
+    if (lua_type(L_, index) != LUA_TTABLE) return fallback;
+    const std::string text = string_field(index, "__where");
+    return text.empty() ? fallback : parse_where(text, file_);
+  }
+  /// The number of positional arguments a word was called with (its `n`).
+  int packed_count(int index) {
+    int n = 0;
+    if (type_of_field(index, "n") == LUA_TNUMBER) n = static_cast<int>(lua_tointeger(L_, -1));
+    lua_pop(L_, 1);
+    return n;
+  }
+  /// A short rendering of the value at `index` for messages.
+  std::string describe(int index) {
+    switch (lua_type(L_, index)) {
+      case LUA_TSTRING:
+        return "\"" + std::string(lua_tostring(L_, index)) + "\"";
+      case LUA_TNUMBER:
+        return format_number(lua_tonumber(L_, index));
+      case LUA_TBOOLEAN:
+        return lua_toboolean(L_, index) ? "true" : "false";
+      case LUA_TNIL:
+        return "nil";
+      case LUA_TFUNCTION:
+        return "function";
+      case LUA_TTABLE: {
+        const std::string word = word_of(index);
+        if (!word.empty()) return word + "(...)";
+        // A short list of names or numbers is shown as written.
+        const lua_Unsigned n = lua_rawlen(L_, index);
+        if (n == 0 || n > 8) return "{...}";
+        std::string list = "{ ";
+        for (lua_Unsigned i = 1; i <= n; ++i) {
+          lua_rawgeti(L_, index, static_cast<lua_Integer>(i));
+          const int item = lua_gettop(L_);
+          const bool simple = lua_type(L_, item) == LUA_TSTRING || lua_type(L_, item) == LUA_TNUMBER;
+          const std::string text = simple ? describe(item) : "";
+          lua_pop(L_, 1);
+          if (!simple) return "{...}";
+          list += (i > 1 ? ", " : "") + text;
+        }
+        return list + " }";
+      }
+      default:
+        return lua_typename(L_, lua_type(L_, index));
+    }
+  }
+  /// Keys of the table at `index`: strings sorted, then the integer keys.
+  void keys_of(int index, std::vector<std::string>& strings, std::vector<lua_Integer>& integers,
+               const SourceLocation& where, const std::string& what) {
+    lua_pushnil(L_);
+    while (lua_next(L_, index) != 0) {
+      lua_pop(L_, 1);
+      if (lua_type(L_, -1) == LUA_TSTRING) {
+        strings.emplace_back(lua_tostring(L_, -1));
+      } else if (lua_isinteger(L_, -1)) {
+        integers.push_back(lua_tointeger(L_, -1));
+      } else {
+        lua_pop(L_, 1);
+        fail(where, what + ": a key that is neither a name nor a position");
+      }
+    }
+    std::sort(strings.begin(), strings.end());
+    std::sort(integers.begin(), integers.end());
+  }
+
+  // ---- values
+  double number_at(int index, const SourceLocation& where, const std::string& what) {
+    if (lua_type(L_, index) != LUA_TNUMBER) {
+      fail(where, what + " must be a number, not " + describe(index));
+    }
+    const double x = lua_tonumber(L_, index);
+    if (!std::isfinite(x)) fail(where, what + " must be finite");
+    return x;
+  }
+  Vec3 vector_at(int index, const SourceLocation& where, const std::string& what) {
+    if (lua_type(L_, index) != LUA_TTABLE || !word_of(index).empty()) {
+      fail(where, what + " must be three numbers { x, y, z }, not " + describe(index));
+    }
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) {
+      lua_rawgeti(L_, index, i + 1);
+      if (lua_type(L_, -1) != LUA_TNUMBER) {
+        lua_pop(L_, 1);
+        fail(where, what + " must be three numbers { x, y, z }");
+      }
+      v[i] = lua_tonumber(L_, -1);
+      lua_pop(L_, 1);
+      if (!std::isfinite(v[i])) fail(where, what + " must be finite");
+    }
+    if (lua_rawlen(L_, index) != 3) fail(where, what + " must be exactly three numbers");
+    return v;
+  }
+  Vec3 direction_at(int index, const SourceLocation& where, const std::string& what) {
+    if (lua_type(L_, index) == LUA_TSTRING) {
+      const std::string s = lua_tostring(L_, index);
+      static const std::map<std::string, Vec3> axes = {
+          {"x", Vec3::UnitX()},   {"y", Vec3::UnitY()},   {"z", Vec3::UnitZ()},
+          {"+x", Vec3::UnitX()},  {"+y", Vec3::UnitY()},  {"+z", Vec3::UnitZ()},
+          {"-x", -Vec3::UnitX()}, {"-y", -Vec3::UnitY()}, {"-z", -Vec3::UnitZ()}};
+      const auto it = axes.find(s);
+      if (it == axes.end())
+        fail(where, what + " must be \"x\", \"-y\", ... or { x, y, z }, not \"" + s + "\"");
+      return it->second;
+    }
+    const Vec3 v = vector_at(index, where, what);
+    if (!(v.norm() > 0)) fail(where, what + " must not be zero");
+    return v.normalized();
+  }
+  std::array<float, 3> color_at(int index, const SourceLocation& where, const std::string& what) {
+    if (lua_type(L_, index) == LUA_TSTRING) {
+      const std::string s = lua_tostring(L_, index);
+      const auto it = color_names().find(s);
+      if (it == color_names().end()) {
+        std::vector<std::string> names;
+        for (const auto& [name, rgb] : color_names()) names.push_back(name);
+        fail(where, what + ": unknown colour '" + s + "'" + did_you_mean(s, names));
+      }
+      return it->second;
+    }
+    const Vec3 v = vector_at(index, where, what);
+    if (v.minCoeff() < 0 || v.maxCoeff() > 1) fail(where, what + " must be in [0, 1]");
+    return {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())};
+  }
+  std::vector<std::string> names_at(int index, const SourceLocation& where,
+                                    const std::string& what) {
+    if (lua_type(L_, index) == LUA_TSTRING) return {lua_tostring(L_, index)};
+    if (lua_type(L_, index) != LUA_TTABLE || !word_of(index).empty()) {
+      fail(where, what + " must be a list of names { \"a\", \"b\" }, not " + describe(index));
+    }
+    std::vector<std::string> names;
+    const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L_, index));
+    for (lua_Integer i = 1; i <= n; ++i) {
+      lua_rawgeti(L_, index, i);
+      if (lua_type(L_, -1) != LUA_TSTRING) {
+        lua_pop(L_, 1);
+        fail(where, what + " must be a list of names");
+      }
+      names.emplace_back(lua_tostring(L_, -1));
+      lua_pop(L_, 1);
+    }
+    return names;
+  }
+
+  /// Reads the value at `index` as `param` says into an Arg (not for kWord/kList/kMap/kTable).
+  Arg arg_at(int index, const Param& param, const SourceLocation& where, const std::string& what) {
+    Arg arg;
+    arg.given = true;
+    const std::string name = what + " '" + std::string(param.name) + "'";
+    switch (param.type) {
+      case ArgType::kPart:
+      case ArgType::kPartOrHand:
+      case ArgType::kMate:
+      case ArgType::kStep:
+      case ArgType::kRegion:
+      case ArgType::kText:
+      case ArgType::kGraspType:
+      case ArgType::kFile:
+        if (lua_type(L_, index) != LUA_TSTRING) {
+          fail(where, name + " must be " +
+                          (param.type == ArgType::kText ? std::string("text in quotes")
+                                                        : "a name in quotes") +
+                          ", not " + describe(index));
+        }
+        arg.text = lua_tostring(L_, index);
+        if (param.type == ArgType::kGraspType && arg.text != "precision" && arg.text != "tripod" &&
+            arg.text != "power") {
+          fail(where,
+               name + " must be \"precision\", \"tripod\" or \"power\", not \"" + arg.text + "\"");
+        }
+        break;
+      case ArgType::kSeconds:
+      case ArgType::kLength:
+      case ArgType::kNumber:
+      case ArgType::kCount:
+        arg.number = number_at(index, where, name);
+        if (param.type != ArgType::kNumber && arg.number < 0)
+          fail(where, name + " must not be negative");
+        if (param.type == ArgType::kCount && arg.number != std::floor(arg.number)) {
+          fail(where, name + " must be a whole number");
+        }
+        if (param.type == ArgType::kLength) arg.number *= scenario_.metres_per_unit;
+        break;
+      case ArgType::kVector:
+        arg.vector = vector_at(index, where, name) * scenario_.metres_per_unit;
+        break;
+      case ArgType::kDirection:
+        arg.vector = direction_at(index, where, name);
+        break;
+      case ArgType::kTurn: {
+        if (lua_type(L_, index) != LUA_TTABLE)
+          fail(where, name + " must be { x = deg, y = deg, z = deg }");
+        std::vector<std::string> keys;
+        std::vector<lua_Integer> positions;
+        keys_of(index, keys, positions, where, name);
+        if (!positions.empty()) fail(where, name + " must name its axes: { x = 90 }");
+        for (const std::string& key : keys) {
+          if (key != "x" && key != "y" && key != "z")
+            fail(where, name + ": unknown axis '" + key + "'");
+          raw_getfield(index, key.c_str());
+          const double deg = number_at(lua_gettop(L_), where, name + "." + key);
+          lua_pop(L_, 1);
+          arg.vector[key[0] - 'x'] = deg;
+        }
+        break;
+      }
+      case ArgType::kColor:
+        arg.color = color_at(index, where, name);
+        break;
+      case ArgType::kFunction:
+        if (lua_type(L_, index) != LUA_TFUNCTION) fail(where, name + " must be a function");
+        lua_pushvalue(L_, index);
+        arg.function_ref = luaL_ref(L_, LUA_REGISTRYINDEX);
+        break;
+      case ArgType::kFlag:
+        if (lua_type(L_, index) != LUA_TBOOLEAN) fail(where, name + " must be true or false");
+        arg.number = lua_toboolean(L_, index) ? 1 : 0;
+        break;
+      case ArgType::kNames:
+        arg.names = names_at(index, where, name);
+        break;
+      case ArgType::kTable:
+      case ArgType::kList:
+      case ArgType::kMap:
+      case ArgType::kWord:
+        fail(where, name + ": internal error, structured field read as a value");
+    }
+    return arg;
+  }
+
+  /// A use of an event/state/action/expectation word at `index`, of one of `kinds`.
+  Clause clause_at(int index, std::initializer_list<WordKind> kinds, const SourceLocation& outer,
+                   const std::string& what) {
+    const std::string word_name = word_of(index);
+    const Word* word = word_name.empty() ? nullptr : find_word(word_name);
+    std::string expected;
+    for (const WordKind k : kinds) {
+      expected += (expected.empty() ? "" : " or ") +
+                  std::string(k == WordKind::kEvent ? "an " : "a ") +
+                  std::string(word_kind_name(k));
+    }
+    if (word == nullptr) {
+      fail(outer, what + " must be " + expected + ", not " + describe(index));
+    }
+    const SourceLocation where = where_of(index, outer);
+    if (std::find(kinds.begin(), kinds.end(), word->kind) == kinds.end()) {
+      fail(where, what + " must be " + expected + "; '" + word_name + "' is " +
+                      (word->kind == WordKind::kEvent || word->kind == WordKind::kAction ||
+                               word->kind == WordKind::kExpectation
+                           ? "an "
+                           : "a ") +
+                      std::string(word_kind_name(word->kind)));
+    }
+    Clause clause;
+    clause.word = word;
+    clause.where = where;
+    clause.args.resize(word->params.size());
+    const int n = packed_count(index);
+    if (n > static_cast<int>(word->params.size())) {
+      fail(where, word_name + " takes at most " + std::to_string(word->params.size()) +
+                      " argument(s), got " + std::to_string(n));
+    }
+    clause.text = word_name + "(";
+    for (int i = 0; i < n; ++i) {
+      lua_rawgeti(L_, index, i + 1);
+      const int value = lua_gettop(L_);
+      clause.text += (i ? ", " : "") + describe(value);
+      if (lua_type(L_, value) != LUA_TNIL) {
+        clause.args[static_cast<std::size_t>(i)] =
+            arg_at(value, word->params[static_cast<std::size_t>(i)], where, word_name);
+      }
+      lua_pop(L_, 1);
+    }
+    clause.text += ")";
+    for (std::size_t i = 0; i < word->params.size(); ++i) {
+      if (!word->params[i].optional && !clause.args[i].given) {
+        fail(where, word_name + ": missing argument '" + std::string(word->params[i].name) + "'");
+      }
+    }
+    return clause;
+  }
+
+  /// Checks that the declaration at `index` is `word_name { ... }` and pushes its field table.
+  SourceLocation open_declaration(int index, const char* word_name, const SourceLocation& outer,
+                                  const std::string& what) {
+    const std::string word = word_of(index);
+    if (word != word_name) {
+      fail(outer, what + " must be " + word_name + " { ... }, not " + describe(index));
+    }
+    const SourceLocation where = where_of(index, outer);
+    if (packed_count(index) != 1)
+      fail(where, std::string(word_name) + " takes one table: " + word_name + " { ... }");
+    lua_rawgeti(L_, index, 1);
+    if (lua_type(L_, -1) != LUA_TTABLE || !word_of(lua_gettop(L_)).empty()) {
+      fail(where, std::string(word_name) + " takes one table: " + word_name + " { ... }");
+    }
+    return where;
+  }
+
+  /// Checks the field names of the table at `index` against `word`; integer keys allowed up to
+  /// `positional`.
+  void check_fields(int index, const Word& word, const SourceLocation& where,
+                    const std::string& what, lua_Integer positional = 0) {
+    std::vector<std::string> keys;
+    std::vector<lua_Integer> positions;
+    keys_of(index, keys, positions, where, what);
+    std::vector<std::string> known;
+    for (const Param& p : word.params) known.emplace_back(p.name);
+    for (const std::string& key : keys) {
+      if (std::find(known.begin(), known.end(), key) == known.end()) {
+        fail(where, what + ": unknown field '" + key + "'" + did_you_mean(key, known));
+      }
+    }
+    for (const lua_Integer p : positions) {
+      if (p < 1 || p > positional) fail(where, what + ": unexpected item " + std::to_string(p));
+    }
+  }
+  const Param& param(const Word& word, std::string_view name) {
+    for (const Param& p : word.params) {
+      if (p.name == name) return p;
+    }
+    throw ScenarioError("internal error: no field " + std::string(name));
+  }
+  /// Reads field `name` of the table at `index` as its Param says; not given when absent.
+  Arg field(int index, const Word& word, std::string_view name, const SourceLocation& where,
+            const std::string& what) {
+    const Param& p = param(word, name);
+    Arg arg;
+    raw_getfield(index, std::string(name).c_str());
+    if (lua_type(L_, -1) != LUA_TNIL) {
+      arg = arg_at(lua_gettop(L_), p, where, what);
+    } else if (!p.optional) {
+      lua_pop(L_, 1);
+      fail(where, what + ": missing field '" + std::string(name) + "'");
+    }
+    lua_pop(L_, 1);
+    return arg;
+  }
+
+  void read_scenario_fields(int table, const SourceLocation& where);
+  void read_parts(int map, const SourceLocation& where);
+  std::shared_ptr<const collision::Mesh> read_shape(int index, const SourceLocation& where,
+                                                    const std::string& what);
+  void read_mates(int map, const SourceLocation& where);
+  void read_regions(int map, const SourceLocation& where);
+  void read_glove(int index, const SourceLocation& where);
+  void read_steps(int list, const SourceLocation& where);
+  void read_rules(int list, const SourceLocation& where);
+  void read_expectations(int list, const SourceLocation& where);
+  void resolve();
+  void resolve_clause(const Clause& clause);
+
+  LuaHost& host_;
+  lua_State* L_;
+  std::string file_;
+  std::filesystem::path folder_;
+  Scenario scenario_;
+};
+
+Scenario Loader::load() {
+  scenario_.file = file_;
+  // Define the vocabulary's constructors in the sandbox.
+  host_.run_string("return function(...) " + std::string(kPrelude) + " end", kPreludeName, 1);
+  lua_createtable(L_, static_cast<int>(vocabulary().size()), 0);
+  int i = 1;
+  for (const Word& word : vocabulary()) {
+    lua_pushlstring(L_, word.name.data(), word.name.size());
+    lua_rawseti(L_, -2, i++);
+  }
+  lua_pushcfunction(L_, where_function);
+  host_.call(2, 0);
+
+  const int base = lua_gettop(L_);
+  host_.run_file(file_, 1);
+  const int top = base + 1;
+  const SourceLocation file_only{file_, 0};
+  if (word_of(top) != "scenario") {
+    fail(file_only,
+         "the file must end with `return scenario { ... }`; it returned " + describe(top));
+  }
+  const SourceLocation where = open_declaration(top, "scenario", file_only, "the file's result");
+  read_scenario_fields(lua_gettop(L_), where);
+  lua_settop(L_, base);
+  resolve();
+  return std::move(scenario_);
+}
+
+void Loader::read_scenario_fields(int table, const SourceLocation& where) {
+  const Word& word = *find_word("scenario");
+  check_fields(table, word, where, "scenario");
+  scenario_.name = field(table, word, "name", where, "scenario").text;
+  // Units first: every length depends on them.
+  const Arg units = field(table, word, "units", where, "scenario");
+  if (units.given) {
+    scenario_.units = units.text;
+    if (units.text == "mm") {
+      scenario_.metres_per_unit = 0.001;
+    } else if (units.text == "cm") {
+      scenario_.metres_per_unit = 0.01;
+    } else if (units.text == "m") {
+      scenario_.metres_per_unit = 1;
+    } else {
+      fail(where, "scenario: units must be \"mm\", \"cm\" or \"m\", not \"" + units.text + "\"");
+    }
+  }
+  if (const Arg a = field(table, word, "seed", where, "scenario"); a.given) {
+    scenario_.seed = static_cast<std::uint64_t>(a.number);
+  }
+  if (const Arg a = field(table, word, "duration", where, "scenario"); a.given) {
+    scenario_.duration = a.number;
+  }
+  if (const Arg a = field(table, word, "time_step", where, "scenario"); a.given) {
+    if (!(a.number >= 1e-4 && a.number <= 1))
+      fail(where, "scenario: time_step must be in [0.0001, 1] s");
+    scenario_.time_step = a.number;
+  }
+  auto with_field = [&](const char* name, auto read) {
+    raw_getfield(table, name);
+    if (lua_type(L_, -1) != LUA_TNIL) read(lua_gettop(L_));
+    lua_pop(L_, 1);
+  };
+  raw_getfield(table, "parts");
+  if (lua_type(L_, -1) == LUA_TNIL) fail(where, "scenario: missing field 'parts'");
+  lua_pop(L_, 1);
+  with_field("parts", [&](int i) { read_parts(i, where); });
+  with_field("mates", [&](int i) { read_mates(i, where); });
+  with_field("regions", [&](int i) { read_regions(i, where); });
+  with_field("hand", [&](int i) { read_glove(i, where); });
+  with_field("steps", [&](int i) { read_steps(i, where); });
+  with_field("rules", [&](int i) { read_rules(i, where); });
+  with_field("expect", [&](int i) { read_expectations(i, where); });
+}
+
+void Loader::read_parts(int map, const SourceLocation& where) {
+  if (lua_type(L_, map) != LUA_TTABLE || !word_of(map).empty()) {
+    fail(where, "scenario: parts must be a table of named parts: parts = { peg = part { ... } }");
+  }
+  std::vector<std::string> names;
+  std::vector<lua_Integer> positions;
+  keys_of(map, names, positions, where, "parts");
+  if (!positions.empty())
+    fail(where, "parts: every part needs a name: parts = { peg = part { ... } }");
+  if (names.empty()) fail(where, "scenario: parts is empty");
+  const Word& word = *find_word("part");
+  for (const std::string& name : names) {
+    raw_getfield(map, name.c_str());
+    const int declaration = lua_gettop(L_);
+    const std::string what = "part '" + name + "'";
+    PartSpec part;
+    part.name = name;
+    part.where = open_declaration(declaration, "part", where, what);
+    const int t = lua_gettop(L_);
+    check_fields(t, word, part.where, what);
+    if (name == "hand" || name.rfind("hand.", 0) == 0) {
+      fail(part.where, what + ": the names 'hand' and 'hand.*' belong to the hand");
+    }
+    raw_getfield(t, "shape");
+    const bool has_shape = lua_type(L_, -1) != LUA_TNIL;
+    if (has_shape) part.mesh = read_shape(lua_gettop(L_), part.where, what);
+    lua_pop(L_, 1);
+    const Arg mesh = field(t, word, "mesh", part.where, what);
+    if (has_shape == mesh.given)
+      fail(part.where, what + ": give either shape = ... or mesh = \"file\"");
+    if (mesh.given) {
+      const std::filesystem::path path = folder_ / mesh.text;
+      collision::Mesh loaded;
+      try {
+        loaded = engine::import_mesh(path);
+      } catch (const std::exception& e) {
+        fail(part.where, what + ": " + e.what());
+      }
+      for (Vec3& v : loaded.vertices) v *= scenario_.metres_per_unit;
+      part.mesh = std::make_shared<const collision::Mesh>(std::move(loaded));
+    }
+    if (const Arg at = field(t, word, "at", part.where, what); at.given) part.X_WP.t = at.vector;
+    if (const Arg turn = field(t, word, "turn", part.where, what); turn.given) {
+      const Vec3 rad = turn.vector * (std::numbers::pi / 180);
+      part.X_WP.R =
+          (Eigen::AngleAxisd(rad.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rad.y(), Vec3::UnitY()) *
+           Eigen::AngleAxisd(rad.x(), Vec3::UnitX()))
+              .toRotationMatrix();
+    }
+    part.fixed = field(t, word, "fixed", part.where, what).number != 0;
+    if (const Arg c = field(t, word, "color", part.where, what); c.given) part.color = c.color;
+    part.tags = field(t, word, "tags", part.where, what).names;
+    lua_pop(L_, 2);
+    scenario_.parts.push_back(std::move(part));
+  }
+}
+
+std::shared_ptr<const collision::Mesh> Loader::read_shape(int index, const SourceLocation& outer,
+                                                          const std::string& what) {
+  const std::string word_name = word_of(index);
+  const Word* word = word_name.empty() ? nullptr : find_word(word_name);
+  if (word == nullptr || word->kind != WordKind::kShape) {
+    fail(outer, what +
+                    ": shape must be box, cylinder, block_with_hole, tube or sphere { ... }, not " +
+                    describe(index));
+  }
+  const SourceLocation where = open_declaration(index, word_name.c_str(), outer, what);
+  const int t = lua_gettop(L_);
+  check_fields(t, *word, where, word_name);
+  auto get = [&](std::string_view name) { return field(t, *word, name, where, word_name); };
+  auto sides = [&](int fallback) {
+    const Arg a = get("sides");
+    if (!a.given) return fallback;
+    if (a.number < 3 || a.number > 4096) fail(where, word_name + ": sides must be in [3, 4096]");
+    return static_cast<int>(a.number);
+  };
+  auto positive = [&](const Arg& a, const char* name) {
+    if (!(a.number > 0)) fail(where, word_name + ": " + name + " must be positive");
+    return a.number;
+  };
+  collision::Mesh mesh;
+  try {
+    if (word_name == "box") {
+      const Vec3 size = get("size").vector;
+      if (!(size.minCoeff() > 0)) fail(where, "box: every edge of size must be positive");
+      mesh = collision::make_box(size / 2);
+    } else if (word_name == "cylinder") {
+      mesh = collision::make_cylinder(positive(get("diameter"), "diameter") / 2,
+                                      positive(get("length"), "length"), sides(64));
+    } else if (word_name == "block_with_hole") {
+      const Vec3 size = get("size").vector;
+      if (!(size.minCoeff() > 0))
+        fail(where, "block_with_hole: every edge of size must be positive");
+      mesh = collision::make_block_with_hole(size / 2, positive(get("hole"), "hole") / 2,
+                                             positive(get("depth"), "depth"), sides(64));
+    } else if (word_name == "tube") {
+      mesh = collision::make_tube(positive(get("outer"), "outer") / 2,
+                                  positive(get("inner"), "inner") / 2,
+                                  positive(get("length"), "length"), sides(64));
+    } else {
+      mesh = collision::make_sphere(positive(get("diameter"), "diameter") / 2, 3);
+    }
+  } catch (const std::invalid_argument& e) {
+    fail(where, word_name + ": " + e.what());
+  }
+  lua_pop(L_, 1);
+  return std::make_shared<const collision::Mesh>(std::move(mesh));
+}
+
+void Loader::read_mates(int map, const SourceLocation& where) {
+  std::vector<std::string> names;
+  std::vector<lua_Integer> positions;
+  if (lua_type(L_, map) != LUA_TTABLE || !word_of(map).empty()) {
+    fail(where, "scenario: mates must be a table of named mates: mates = { fit = mate { ... } }");
+  }
+  keys_of(map, names, positions, where, "mates");
+  if (!positions.empty())
+    fail(where, "mates: every mate needs a name: mates = { fit = mate { ... } }");
+  const Word& word = *find_word("mate");
+  for (const std::string& name : names) {
+    raw_getfield(map, name.c_str());
+    const std::string what = "mate '" + name + "'";
+    MateSpec spec;
+    spec.where = open_declaration(lua_gettop(L_), "mate", where, what);
+    const int t = lua_gettop(L_);
+    check_fields(t, word, spec.where, what);
+    interaction::Mate& m = spec.mate;
+    m.name = name;
+    m.part = field(t, word, "part", spec.where, what).text;
+    m.p_PF = field(t, word, "point", spec.where, what).vector;
+    m.axis_P = field(t, word, "axis", spec.where, what).vector;
+    m.other = field(t, word, "into", spec.where, what).text;
+    m.p_OF = field(t, word, "at", spec.where, what).vector;
+    m.axis_O = field(t, word, "along", spec.where, what).vector;
+    if (const Arg a = field(t, word, "tolerance", spec.where, what); a.given)
+      m.position_tolerance = a.number;
+    if (const Arg a = field(t, word, "angle", spec.where, what); a.given)
+      m.angle_tolerance_deg = a.number;
+    if (m.part == m.other) fail(spec.where, what + ": a part cannot mate with itself");
+    lua_pop(L_, 2);
+    scenario_.mates.push_back(std::move(spec));
+  }
+}
+
+void Loader::read_regions(int map, const SourceLocation& where) {
+  std::vector<std::string> names;
+  std::vector<lua_Integer> positions;
+  if (lua_type(L_, map) != LUA_TTABLE || !word_of(map).empty()) {
+    fail(where, "scenario: regions must be a table of named regions");
+  }
+  keys_of(map, names, positions, where, "regions");
+  if (!positions.empty())
+    fail(where, "regions: every region needs a name: regions = { tray = region { ... } }");
+  const Word& word = *find_word("region");
+  for (const std::string& name : names) {
+    raw_getfield(map, name.c_str());
+    const std::string what = "region '" + name + "'";
+    RegionSpec spec;
+    spec.where = open_declaration(lua_gettop(L_), "region", where, what);
+    const int t = lua_gettop(L_);
+    check_fields(t, word, spec.where, what);
+    spec.region.name = name;
+    spec.region.box.min = field(t, word, "min", spec.where, what).vector;
+    spec.region.box.max = field(t, word, "max", spec.where, what).vector;
+    spec.region.parts = field(t, word, "parts", spec.where, what).names;
+    if ((spec.region.box.max - spec.region.box.min).minCoeff() < 0) {
+      fail(spec.where, what + ": max must not be below min on any axis");
+    }
+    lua_pop(L_, 2);
+    scenario_.regions.push_back(std::move(spec));
+  }
+}
+
+void Loader::read_glove(int index, const SourceLocation& outer) {
+  const Word& word = *find_word("glove");
+  GloveSpec glove;
+  glove.where = open_declaration(index, "glove", outer, "hand");
+  const int t = lua_gettop(L_);
+  check_fields(t, word, glove.where, "glove");
+  const Arg plan = field(t, word, "plan", glove.where, "glove");
+  const Arg trace = field(t, word, "trace", glove.where, "glove");
+  if (plan.given == trace.given)
+    fail(glove.where, "glove: give either plan = \"file\" or trace = \"file\"");
+  if (plan.given) glove.plan = folder_ / plan.text;
+  if (trace.given) glove.trace = folder_ / trace.text;
+  glove.holding = field(t, word, "holding", glove.where, "glove").text;
+  if (const Arg a = field(t, word, "grasp", glove.where, "glove"); a.given) {
+    glove.grasp = a.text == "precision" ? interaction::GraspType::kPrecision
+                  : a.text == "tripod"  ? interaction::GraspType::kTripod
+                                        : interaction::GraspType::kPower;
+  }
+  if (const Arg a = field(t, word, "hand_length", glove.where, "glove"); a.given) {
+    if (a.number < 0.12 || a.number > 0.26)
+      fail(glove.where, "glove: hand_length must be 120 to 260 mm");
+    glove.hand_length = a.number;
+  }
+  raw_getfield(t, "noise");
+  if (lua_type(L_, -1) != LUA_TNIL) {
+    const int n = lua_gettop(L_);
+    if (lua_type(L_, n) != LUA_TTABLE) fail(glove.where, "glove: noise must be a table");
+    std::vector<std::string> keys;
+    std::vector<lua_Integer> positions;
+    keys_of(n, keys, positions, glove.where, "glove noise");
+    interaction::GloveNoise noise;
+    noise.donning_sigma_deg = 0;
+    for (const std::string& key : keys) {
+      raw_getfield(n, key.c_str());
+      const double x = number_at(lua_gettop(L_), glove.where, "glove noise " + key);
+      lua_pop(L_, 1);
+      if (x < 0) fail(glove.where, "glove noise " + key + " must not be negative");
+      if (key == "position") {
+        noise.position_sigma_m = x * scenario_.metres_per_unit;
+      } else if (key == "angle") {
+        noise.orientation_sigma_deg = x;
+      } else if (key == "joints") {
+        noise.joint_sigma_deg = x;
+      } else if (key == "seed") {
+        noise.seed = static_cast<std::uint64_t>(x);
+      } else {
+        const std::vector<std::string> known = {"position", "angle", "joints", "seed"};
+        fail(glove.where, "glove noise: unknown field '" + key + "'" + did_you_mean(key, known));
+      }
+    }
+    glove.noise = noise;
+  }
+  lua_pop(L_, 2);
+  scenario_.glove = std::move(glove);
+}
+
+void Loader::read_steps(int list, const SourceLocation& where) {
+  if (lua_type(L_, list) != LUA_TTABLE || !word_of(list).empty()) {
+    fail(where, "scenario: steps must be a list: steps = { step { ... }, ... }");
+  }
+  const Word& word = *find_word("step");
+  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L_, list));
+  for (lua_Integer i = 1; i <= n; ++i) {
+    lua_rawgeti(L_, list, i);
+    const std::string what = "step " + std::to_string(i);
+    StepSpec step;
+    step.where = open_declaration(lua_gettop(L_), "step", where, what);
+    const int t = lua_gettop(L_);
+    check_fields(t, word, step.where, what, 2);
+    auto text_at = [&](lua_Integer position, const char* key) {
+      lua_rawgeti(L_, t, position);
+      raw_getfield(t, key);
+      std::string out;
+      if (lua_type(L_, -2) != LUA_TNIL && lua_type(L_, -1) != LUA_TNIL) {
+        fail(step.where, what + ": its " + key + " is given twice");
+      }
+      const int v = lua_type(L_, -2) != LUA_TNIL ? -2 : -1;
+      if (lua_type(L_, v) != LUA_TNIL) {
+        if (lua_type(L_, v) != LUA_TSTRING)
+          fail(step.where, what + ": its " + key + " must be text");
+        out = lua_tostring(L_, v);
+      }
+      lua_pop(L_, 2);
+      return out;
+    };
+    step.name = text_at(1, "name");
+    step.text = text_at(2, "text");
+    if (step.name.empty())
+      fail(step.where, what + ": a step needs a name: step { \"insert\", ... }");
+    for (const StepSpec& other : scenario_.steps) {
+      if (other.name == step.name) fail(step.where, "step '" + step.name + "' is declared twice");
+    }
+    raw_getfield(t, "done");
+    if (lua_type(L_, -1) != LUA_TNIL) {
+      step.done = clause_at(lua_gettop(L_), {WordKind::kEvent}, step.where,
+                            "step '" + step.name + "': done");
+    }
+    lua_pop(L_, 3);
+    scenario_.steps.push_back(std::move(step));
+  }
+}
+
+void Loader::read_rules(int list, const SourceLocation& where) {
+  if (lua_type(L_, list) != LUA_TTABLE || !word_of(list).empty()) {
+    fail(where, "scenario: rules must be a list: rules = { rule { ... }, ... }");
+  }
+  const Word& word = *find_word("rule");
+  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L_, list));
+  for (lua_Integer i = 1; i <= n; ++i) {
+    lua_rawgeti(L_, list, i);
+    const std::string what = "rule " + std::to_string(i);
+    RuleSpec rule;
+    rule.where = open_declaration(lua_gettop(L_), "rule", where, what);
+    const int t = lua_gettop(L_);
+    check_fields(t, word, rule.where, what);
+    raw_getfield(t, "when");
+    if (lua_type(L_, -1) == LUA_TNIL) fail(rule.where, what + ": missing field 'when'");
+    rule.when = clause_at(lua_gettop(L_), {WordKind::kEvent}, rule.where, what + ": when");
+    lua_pop(L_, 1);
+    for (const char* key : {"unless", "only_if"}) {
+      raw_getfield(t, key);
+      if (lua_type(L_, -1) != LUA_TNIL) {
+        Clause c = clause_at(lua_gettop(L_), {WordKind::kState}, rule.where, what + ": " + key);
+        (std::strcmp(key, "unless") == 0 ? rule.unless : rule.only_if) = std::move(c);
+      }
+      lua_pop(L_, 1);
+    }
+    raw_getfield(t, "act");
+    const int act = lua_gettop(L_);
+    if (lua_type(L_, act) == LUA_TTABLE && word_of(act).empty()) {
+      const lua_Integer m = static_cast<lua_Integer>(lua_rawlen(L_, act));
+      for (lua_Integer k = 1; k <= m; ++k) {
+        lua_rawgeti(L_, act, k);
+        rule.act.push_back(
+            clause_at(lua_gettop(L_), {WordKind::kAction}, rule.where, what + ": act"));
+        lua_pop(L_, 1);
+      }
+    } else if (lua_type(L_, act) == LUA_TTABLE) {
+      rule.act.push_back(clause_at(act, {WordKind::kAction}, rule.where, what + ": act"));
+    } else {
+      fail(rule.where, what + ": act must be a list of actions: act = { highlight \"block\" }");
+    }
+    if (rule.act.empty()) fail(rule.where, what + ": act lists no action");
+    lua_pop(L_, 1);
+    if (const Arg a = field(t, word, "cooldown", rule.where, what); a.given)
+      rule.cooldown = a.number;
+    rule.once = field(t, word, "once", rule.where, what).number != 0;
+    lua_pop(L_, 2);
+    scenario_.rules.push_back(std::move(rule));
+  }
+}
+
+void Loader::read_expectations(int list, const SourceLocation& where) {
+  if (lua_type(L_, list) != LUA_TTABLE || !word_of(list).empty()) {
+    fail(where, "scenario: expect must be a list: expect = { max_penetration(0.01), ... }");
+  }
+  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L_, list));
+  for (lua_Integer i = 1; i <= n; ++i) {
+    lua_rawgeti(L_, list, i);
+    scenario_.expectations.push_back(clause_at(lua_gettop(L_), {WordKind::kExpectation}, where,
+                                               "expect item " + std::to_string(i)));
+    lua_pop(L_, 1);
+  }
+}
+
+void Loader::resolve_clause(const Clause& clause) {
+  std::vector<std::string> parts, mates, steps, regions;
+  for (const PartSpec& p : scenario_.parts) parts.push_back(p.name);
+  for (const MateSpec& m : scenario_.mates) mates.push_back(m.mate.name);
+  for (const StepSpec& s : scenario_.steps) steps.push_back(s.name);
+  for (const RegionSpec& r : scenario_.regions) regions.push_back(r.region.name);
+  auto check = [&](const std::string& name, const std::vector<std::string>& known,
+                   const char* kind) {
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      fail(clause.where, std::string(clause.word->name) + ": no " + kind + " '" + name + "'" +
+                             did_you_mean(name, known));
+    }
+  };
+  for (std::size_t i = 0; i < clause.args.size(); ++i) {
+    const Arg& arg = clause.args[i];
+    if (!arg.given) continue;
+    switch (clause.word->params[i].type) {
+      case ArgType::kPartOrHand:
+        if (arg.text == "hand") {
+          if (!scenario_.glove)
+            fail(clause.where, std::string(clause.word->name) + ": the scenario has no hand");
+          break;
+        }
+        check(arg.text, parts, "part");
+        break;
+      case ArgType::kPart:
+        check(arg.text, parts, "part");
+        break;
+      case ArgType::kMate:
+        check(arg.text, mates, "mate");
+        break;
+      case ArgType::kStep:
+        check(arg.text, steps, "step");
+        break;
+      case ArgType::kRegion:
+        check(arg.text, regions, "region");
+        break;
+      case ArgType::kNames:
+        if (clause.word->name == "steps_in_order") {
+          for (const std::string& name : arg.names) check(name, steps, "step");
+        }
+        break;
+      default:
+        break;
+    }
+  }
+}
+
+void Loader::resolve() {
+  std::vector<std::string> parts;
+  for (const PartSpec& p : scenario_.parts) parts.push_back(p.name);
+  auto fixed = [&](const std::string& name) {
+    for (const PartSpec& p : scenario_.parts) {
+      if (p.name == name) return p.fixed;
+    }
+    return false;
+  };
+  auto check_part = [&](const std::string& name, const SourceLocation& where,
+                        const std::string& what) {
+    if (std::find(parts.begin(), parts.end(), name) == parts.end()) {
+      fail(where, what + ": no part '" + name + "'" + did_you_mean(name, parts));
+    }
+  };
+  for (const MateSpec& m : scenario_.mates) {
+    check_part(m.mate.part, m.where, "mate '" + m.mate.name + "'");
+    check_part(m.mate.other, m.where, "mate '" + m.mate.name + "'");
+    if (fixed(m.mate.part))
+      fail(m.where, "mate '" + m.mate.name + "': its part '" + m.mate.part + "' is fixed");
+  }
+  for (const RegionSpec& r : scenario_.regions) {
+    for (const std::string& p : r.region.parts)
+      check_part(p, r.where, "region '" + r.region.name + "'");
+  }
+  if (scenario_.glove && !scenario_.glove->holding.empty()) {
+    check_part(scenario_.glove->holding, scenario_.glove->where, "glove: holding");
+    if (fixed(scenario_.glove->holding)) {
+      fail(scenario_.glove->where,
+           "glove: the hand cannot hold the fixed part '" + scenario_.glove->holding + "'");
+    }
+  }
+  auto can_never = [&](const Clause& c, const std::string& context) {
+    const std::string_view w = c.word->name;
+    if ((w == "touches" || w == "separates" || w == "touching" || w == "no_contact") &&
+        c.args[0].text != "hand" && fixed(c.args[0].text) && fixed(c.args[1].text)) {
+      scenario_.warnings.push_back(c.where.str() + ": " + context + c.text +
+                                   " can never happen: '" + c.args[0].text + "' and '" +
+                                   c.args[1].text + "' are both fixed");
+    }
+    if ((w == "touches" || w == "separates" || w == "touching") &&
+        c.args[0].text == c.args[1].text) {
+      scenario_.warnings.push_back(c.where.str() + ": " + context + c.text +
+                                   " can never happen: a part does not touch itself");
+    }
+    if ((w == "grasped" || w == "released" || w == "holding" || w == "slides" ||
+         w == "grasped_as") &&
+        (fixed(c.args[0].text) || !scenario_.glove)) {
+      scenario_.warnings.push_back(c.where.str() + ": " + context + c.text + " can never happen: " +
+                                   (scenario_.glove ? "'" + c.args[0].text + "' is fixed"
+                                                    : std::string("the scenario has no hand")));
+    }
+  };
+  for (const StepSpec& s : scenario_.steps) {
+    if (s.done) {
+      resolve_clause(*s.done);
+      can_never(*s.done, "step '" + s.name + "': ");
+    }
+  }
+  for (const RuleSpec& r : scenario_.rules) {
+    resolve_clause(r.when);
+    can_never(r.when, "rule: ");
+    if (r.unless) resolve_clause(*r.unless);
+    if (r.only_if) {
+      resolve_clause(*r.only_if);
+      can_never(*r.only_if, "rule: ");
+    }
+    for (const Clause& c : r.act) resolve_clause(c);
+  }
+  for (const Clause& c : scenario_.expectations) {
+    resolve_clause(c);
+    can_never(c, "expectation: ");
+  }
+}
+
+}  // namespace
+
+Scenario load_scenario(LuaHost& host, const std::filesystem::path& file) {
+  Loader loader(host, file);
+  return loader.load();
+}
+
+}  // namespace dovetail::scripting

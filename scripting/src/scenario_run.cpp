@@ -1,0 +1,933 @@
+#include "dovetail/scripting/scenario_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <lua.hpp>
+#include <map>
+#include <set>
+
+#include "dovetail/collision/contacts.h"
+#include "dovetail/collision/model.h"
+#include "dovetail/engine/json.h"
+#include "dovetail/engine/render.h"
+#include "dovetail/engine/scene_render.h"
+#include "dovetail/interaction/glove_plan.h"
+#include "dovetail/interaction/glove_trace.h"
+#include "dovetail/interaction/grasping.h"
+#include "dovetail/interaction/hand.h"
+
+namespace dovetail::scripting {
+
+namespace {
+
+using engine::Event;
+using engine::EventKind;
+using engine::PartHandle;
+
+/// What a rule or a step can wait for, after the engine's events have been
+/// turned into the scenario's (the hand as one, mates by name, timers).
+enum class Happening {
+  kTouch,
+  kSeparate,
+  kGrasp,
+  kRelease,
+  kMated,
+  kSlide,
+  kEnter,
+  kLeave,
+  kCompleted
+};
+
+struct Occurrence {
+  Happening kind;
+  std::string a{}, b{};
+};
+
+std::string format_time(double t) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3f", t);
+  return buffer;
+}
+
+std::string format_length(double metres, const RunOutcome& o) {
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "%.4g %s", metres / o.metres_per_unit, o.units.c_str());
+  return buffer;
+}
+
+std::pair<std::string, std::string> ordered(const std::string& a, const std::string& b) {
+  return a < b ? std::pair(a, b) : std::pair(b, a);
+}
+
+bool is_hand_part(const std::string& name) { return name.rfind("hand.", 0) == 0; }
+
+constexpr const char* kRunnerKey = "dovetail.runner";
+constexpr std::array<float, 3> kHighlight = {1.0F, 0.55F, 0.0F};
+
+class Runner {
+ public:
+  Runner(const std::filesystem::path& file, const RunOptions& options, RunOutcome& outcome)
+      : file_(file), options_(options), out_(outcome), host_(options.limits, 1) {}
+
+  void run();
+
+  // ---- the low-level API of custom actions (called from Lua through C functions)
+  /// Fills `error` and returns false for an unknown part.
+  bool part_pose(const char* name, Transform& X, char* error, std::size_t size);
+  bool set_part_pose(const char* name, const Transform& X, char* error, std::size_t size);
+  double time() const { return sim_ ? sim_->time() : 0; }
+  void log(const char* text) { out_.messages.push_back({time(), "log", text, current_where_}); }
+  double metres_per_unit() const { return scenario_.metres_per_unit; }
+
+ private:
+  void build();
+  void start_frame(std::uint64_t frame, double t);
+  void end_frame(const engine::FrameResult& result, double previous_time);
+  std::vector<Occurrence> occurrences(const engine::FrameResult& result, double previous_time);
+  bool matches(const Clause& when, const Occurrence& o) const;
+  bool timer_fires(const Clause& when, double now, double previous) const;
+  bool holds(const Clause& state) const;
+  bool near(const interaction::Mate& mate) const;
+  void complete_step(std::size_t index, double now, std::vector<Occurrence>& occurrences);
+  void apply(const Clause& action, double now);
+  void measure_penetration(double now);
+  void evaluate_expectations();
+  void render(const std::filesystem::path& path);
+  const MateSpec* mate(const std::string& name) const;
+
+  std::filesystem::path file_;
+  RunOptions options_;
+  RunOutcome& out_;
+  LuaHost host_;
+  Scenario scenario_;
+  std::unique_ptr<engine::Simulation> sim_;
+  std::unique_ptr<interaction::Hand> hand_;
+  std::unique_ptr<interaction::Grasping> grasping_;
+
+  std::set<std::pair<std::string, std::string>> touching_;  ///< part pairs, ordered names
+  std::map<std::string, int> hand_touching_;                ///< part -> hand segments touching it
+  std::set<std::pair<std::string, std::string>> inside_;    ///< (part, region)
+  std::map<std::pair<std::string, std::string>, double> first_contact_;
+  std::vector<std::optional<double>> step_done_;
+  std::vector<std::size_t> completion_order_;  ///< step indices in the order completed
+  std::vector<std::optional<double>> rule_last_;
+  std::vector<std::pair<const Clause*, double>> pending_;  ///< actions for the next frame
+  std::vector<std::size_t> forced_steps_;                  ///< `complete` actions this frame
+  std::vector<Event> injected_;                            ///< `snap` mate events this frame
+  struct Motion {
+    std::string part;
+    Vec3 from, to;
+    double t0, t1;
+  };
+  std::vector<Motion> motions_;
+  std::vector<std::pair<std::string, double>> grasps_;  ///< part + type, time
+  std::map<const collision::Mesh*, std::shared_ptr<const collision::CollisionModel>> models_;
+  std::optional<engine::Camera> camera_;
+  /// Poses at which each touching pair's depth was last measured.
+  std::map<std::pair<std::string, std::string>, std::optional<std::pair<Transform, Transform>>>
+      measured_;
+  SourceLocation current_where_{};
+  bool failed_by_rule_ = false;
+};
+
+// ---- Lua side of the low-level API. These functions hold no C++ object with a
+// destructor when they raise a Lua error (Lua unwinds with longjmp).
+
+Runner* runner_of(lua_State* L) {
+  lua_getfield(L, LUA_REGISTRYINDEX, kRunnerKey);
+  auto* runner = static_cast<Runner*>(lua_touserdata(L, -1));
+  lua_pop(L, 1);
+  return runner;
+}
+
+const char* part_name_of(lua_State* L) {
+  luaL_checktype(L, 1, LUA_TTABLE);
+  lua_rawgeti(L, 1, 1);
+  const char* name = lua_tostring(L, -1);
+  lua_pop(L, 1);
+  if (name == nullptr) luaL_error(L, "call part methods with ':' : dt.part(\"peg\"):translation()");
+  return name;
+}
+
+int api_translation(lua_State* L) {
+  const char* name = part_name_of(L);
+  Runner* runner = runner_of(L);
+  Transform X;
+  char error[256];
+  if (!runner->part_pose(name, X, error, sizeof error)) return luaL_error(L, "%s", error);
+  const double s = 1 / runner->metres_per_unit();
+  lua_pushnumber(L, X.t.x() * s);
+  lua_pushnumber(L, X.t.y() * s);
+  lua_pushnumber(L, X.t.z() * s);
+  return 3;
+}
+
+int api_set_translation(lua_State* L) {
+  const char* name = part_name_of(L);
+  const double x = luaL_checknumber(L, 2), y = luaL_checknumber(L, 3), z = luaL_checknumber(L, 4);
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+    return luaL_error(L, "set_translation: coordinates must be finite");
+  }
+  Runner* runner = runner_of(L);
+  Transform X;
+  char error[256];
+  if (!runner->part_pose(name, X, error, sizeof error)) return luaL_error(L, "%s", error);
+  X.t = Vec3(x, y, z) * runner->metres_per_unit();
+  if (!runner->set_part_pose(name, X, error, sizeof error)) return luaL_error(L, "%s", error);
+  return 0;
+}
+
+int api_matrix(lua_State* L) {
+  const char* name = part_name_of(L);
+  Runner* runner = runner_of(L);
+  Transform X;
+  char error[256];
+  if (!runner->part_pose(name, X, error, sizeof error)) return luaL_error(L, "%s", error);
+  lua_createtable(L, 16, 0);
+  const double s = 1 / runner->metres_per_unit();
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      const double v = r == 3 ? (c == 3 ? 1 : 0) : c == 3 ? X.t[r] * s : X.R(r, c);
+      lua_pushnumber(L, v);
+      lua_rawseti(L, -2, 4 * r + c + 1);
+    }
+  }
+  return 1;
+}
+
+int api_set_matrix(lua_State* L) {
+  const char* name = part_name_of(L);
+  luaL_checktype(L, 2, LUA_TTABLE);
+  double m[16];
+  for (int i = 0; i < 16; ++i) {
+    lua_rawgeti(L, 2, i + 1);
+    if (lua_type(L, -1) != LUA_TNUMBER)
+      return luaL_error(L, "set_matrix: needs 16 numbers, row by row");
+    m[i] = lua_tonumber(L, -1);
+    lua_pop(L, 1);
+    if (!std::isfinite(m[i])) return luaL_error(L, "set_matrix: numbers must be finite");
+  }
+  Runner* runner = runner_of(L);
+  Transform X;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) X.R(r, c) = m[4 * r + c];
+    X.t[r] = m[4 * r + 3] * runner->metres_per_unit();
+  }
+  const double orthogonality = (X.R.transpose() * X.R - collision::Mat3::Identity()).norm();
+  if (!(orthogonality < 1e-6) || X.R.determinant() < 0) {
+    return luaL_error(L, "set_matrix: the upper 3x3 is not a rotation");
+  }
+  char error[256];
+  if (!runner->set_part_pose(name, X, error, sizeof error)) return luaL_error(L, "%s", error);
+  return 0;
+}
+
+int api_part(lua_State* L) {
+  const char* name = luaL_checkstring(L, 1);
+  Runner* runner = runner_of(L);
+  Transform X;
+  char error[256];
+  if (!runner->part_pose(name, X, error, sizeof error)) return luaL_error(L, "%s", error);
+  lua_createtable(L, 1, 0);
+  lua_pushstring(L, name);
+  lua_rawseti(L, -2, 1);
+  lua_getfield(L, LUA_REGISTRYINDEX, "dovetail.part_methods");
+  lua_setmetatable(L, -2);
+  return 1;
+}
+
+int api_time(lua_State* L) {
+  lua_pushnumber(L, runner_of(L)->time());
+  return 1;
+}
+
+int api_log(lua_State* L) {
+  const char* text = luaL_checkstring(L, 1);
+  runner_of(L)->log(text);  // copies into a std::string; no error raised after
+  return 0;
+}
+
+/// Registers the runner and pushes the `dt` table of custom actions.
+void push_api(lua_State* L) {
+  lua_getfield(L, LUA_REGISTRYINDEX, "dovetail.dt");
+  if (lua_type(L, -1) == LUA_TTABLE) return;
+  lua_pop(L, 1);
+  // Part methods: a protected metatable whose __index is the method table.
+  lua_createtable(L, 0, 3);
+  lua_createtable(L, 0, 4);
+  const luaL_Reg methods[] = {{"translation", api_translation},
+                              {"set_translation", api_set_translation},
+                              {"matrix", api_matrix},
+                              {"set_matrix", api_set_matrix},
+                              {nullptr, nullptr}};
+  luaL_setfuncs(L, methods, 0);
+  lua_setfield(L, -2, "__index");
+  lua_pushboolean(L, 0);
+  lua_setfield(L, -2, "__metatable");
+  lua_setfield(L, LUA_REGISTRYINDEX, "dovetail.part_methods");
+  lua_createtable(L, 0, 3);
+  const luaL_Reg functions[] = {
+      {"part", api_part}, {"time", api_time}, {"log", api_log}, {nullptr, nullptr}};
+  luaL_setfuncs(L, functions, 0);
+  lua_pushvalue(L, -1);
+  lua_setfield(L, LUA_REGISTRYINDEX, "dovetail.dt");
+}
+
+// ---- the runner
+
+bool Runner::part_pose(const char* name, Transform& X, char* error, std::size_t size) {
+  const PartHandle p = sim_->scene().find(name);
+  if (!p.valid()) {
+    std::snprintf(error, size, "dt.part: no part '%s'", name);
+    return false;
+  }
+  X = sim_->scene().world_pose(p);
+  return true;
+}
+
+bool Runner::set_part_pose(const char* name, const Transform& X, char* error, std::size_t size) {
+  const PartHandle p = sim_->scene().find(name);
+  if (!p.valid()) {
+    std::snprintf(error, size, "dt.part: no part '%s'", name);
+    return false;
+  }
+  if (!sim_->scene().movable(p)) {
+    std::snprintf(error, size, "dt.part: '%s' is fixed", name);
+    return false;
+  }
+  sim_->scene().set_world_pose(p, X);
+  return true;
+}
+
+const MateSpec* Runner::mate(const std::string& name) const {
+  for (const MateSpec& m : scenario_.mates) {
+    if (m.mate.name == name) return &m;
+  }
+  return nullptr;
+}
+
+void Runner::build() {
+  engine::Scene scene;
+  for (const PartSpec& p : scenario_.parts) {
+    engine::PartDesc desc;
+    desc.name = p.name;
+    desc.tags = p.tags;
+    desc.X_PC = p.X_WP;
+    desc.movable = !p.fixed;
+    desc.render_mesh = p.mesh;
+    desc.color = p.color;
+    scene.add_part(desc);
+  }
+  engine::SimulationSettings settings;
+  settings.time_step = scenario_.time_step;
+  settings.collision_threads = options_.threads;
+  sim_ = std::make_unique<engine::Simulation>(std::move(scene), settings);
+  for (const RegionSpec& r : scenario_.regions) sim_->add_region(r.region);
+  // Actions of the last frame, then moves in progress: before the hand and grasping.
+  sim_->set_frame_hook(
+      [this](engine::Simulation&, std::uint64_t frame, double t) { start_frame(frame, t); });
+
+  if (scenario_.glove || options_.trace) {
+    std::shared_ptr<const interaction::GloveSource> source;
+    const GloveSpec glove = scenario_.glove.value_or(GloveSpec{});
+    if (options_.trace) {
+      source = std::make_shared<interaction::TraceSource>(interaction::read_trace(*options_.trace));
+    } else if (!glove.trace.empty()) {
+      source = std::make_shared<interaction::TraceSource>(interaction::read_trace(glove.trace));
+    } else {
+      source = std::make_shared<interaction::SimulatedGlove>(interaction::read_plan(glove.plan));
+    }
+    if (glove.noise && !options_.trace)
+      source = std::make_shared<interaction::NoisyGlove>(source, *glove.noise);
+    interaction::HandSettings hand_settings;
+    hand_settings.model.hand_length = glove.hand_length;
+    hand_ = std::make_unique<interaction::Hand>(*sim_, source, hand_settings);
+    grasping_ = std::make_unique<interaction::Grasping>(*sim_, *hand_);
+    for (const MateSpec& m : scenario_.mates) grasping_->add_mate(m.mate);
+    if (!glove.holding.empty()) grasping_->hold(glove.holding, glove.grasp);
+  }
+  // Mates snapped by a rule appear among the frame's events.
+  sim_->add_event_filter([this](engine::Simulation&, std::vector<Event>& events) {
+    events.insert(events.end(), injected_.begin(), injected_.end());
+    injected_.clear();
+  });
+}
+
+void Runner::start_frame(std::uint64_t, double t) {
+  std::vector<std::pair<const Clause*, double>> actions;
+  actions.swap(pending_);
+  for (const auto& [action, fired] : actions) apply(*action, t);
+  engine::Scene& scene = sim_->scene();
+  for (auto it = motions_.begin(); it != motions_.end();) {
+    const PartHandle p = scene.find(it->part);
+    const double s = it->t1 > it->t0 ? std::clamp((t - it->t0) / (it->t1 - it->t0), 0.0, 1.0) : 1.0;
+    if (p.valid()) {
+      Transform X = scene.world_pose(p);
+      X.t = it->from + (it->to - it->from) * s;
+      scene.set_world_pose(p, X);
+    }
+    it = s >= 1 ? motions_.erase(it) : it + 1;
+  }
+}
+
+void Runner::apply(const Clause& action, double now) {
+  engine::Scene& scene = sim_->scene();
+  const std::string_view w = action.word->name;
+  const std::string& a = action.args[0].text;
+  current_where_ = action.where;
+  if (w == "highlight") {
+    scene.set_highlight(scene.get(a), action.args[1].given ? action.args[1].color : kHighlight);
+  } else if (w == "unhighlight") {
+    scene.set_highlight(scene.get(a), std::nullopt);
+  } else if (w == "show" || w == "hide") {
+    scene.set_visible(scene.get(a), w == "show");
+  } else if (w == "move") {
+    const PartHandle p = scene.get(a);
+    if (!scene.movable(p)) {
+      out_.messages.push_back({now, "warn", "move: '" + a + "' is fixed and stays", action.where});
+      return;
+    }
+    std::erase_if(motions_, [&](const Motion& m) { return m.part == a; });
+    const double over = action.args[2].given ? action.args[2].number : 0;
+    motions_.push_back({a, scene.world_pose(p).t, action.args[1].vector, now, now + over});
+  } else if (w == "attach") {
+    scene.set_parent(scene.get(a), scene.get(action.args[1].text), true);
+  } else if (w == "detach") {
+    scene.set_parent(scene.get(a), PartHandle{}, true);
+  } else if (w == "snap") {
+    const interaction::Mate& m = mate(a)->mate;
+    const Transform X_WP = scene.world_pose(m.part), X_WO = scene.world_pose(m.other);
+    const Vec3 a_W = (X_WP.R * m.axis_P).normalized(), b_W = (X_WO.R * m.axis_O).normalized();
+    const Vec3 axis = a_W.cross(b_W);
+    const double angle = std::atan2(axis.norm(), a_W.dot(b_W));
+    Transform X = X_WP;
+    if (axis.norm() > 0)
+      X.R = Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix() * X_WP.R;
+    else if (angle > 1)
+      X.R = Eigen::AngleAxisd(std::numbers::pi, a_W.unitOrthogonal()).toRotationMatrix() * X_WP.R;
+    X.t = X_WO.apply(m.p_OF) - X.R * m.p_PF;
+    scene.set_world_pose(scene.get(m.part), X);
+    injected_.push_back({EventKind::kMate, sim_->frame(), now, m.part, m.other});
+  } else if (w == "complete") {
+    for (std::size_t i = 0; i < scenario_.steps.size(); ++i) {
+      if (scenario_.steps[i].name == a) forced_steps_.push_back(i);
+    }
+  } else if (w == "custom") {
+    lua_State* L = host_.state();
+    lua_rawgeti(L, LUA_REGISTRYINDEX, action.args[0].function_ref);
+    push_api(L);
+    host_.call(1, 0);
+  }
+}
+
+bool Runner::near(const interaction::Mate& m) const {
+  const engine::Scene& scene = sim_->scene();
+  const Transform X_WP = scene.world_pose(m.part), X_WO = scene.world_pose(m.other);
+  const Vec3 a_W = (X_WP.R * m.axis_P).normalized(), b_W = (X_WO.R * m.axis_O).normalized();
+  const double angle = std::atan2(a_W.cross(b_W).norm(), a_W.dot(b_W)) * 180 / std::numbers::pi;
+  return (X_WP.apply(m.p_PF) - X_WO.apply(m.p_OF)).norm() <= m.position_tolerance &&
+         angle <= m.angle_tolerance_deg;
+}
+
+bool Runner::holds(const Clause& state) const {
+  const std::string_view w = state.word->name;
+  const std::string& a = state.args[0].text;
+  if (w == "holding") return grasping_ && grasping_->held() && *grasping_->held() == a;
+  if (w == "touching") {
+    const std::string& b = state.args[1].text;
+    if (a == "hand") {
+      const auto it = hand_touching_.find(b);
+      return it != hand_touching_.end() && it->second > 0;
+    }
+    return touching_.count(ordered(a, b)) != 0;
+  }
+  if (w == "near") return near(mate(a)->mate);
+  if (w == "done") {
+    for (std::size_t i = 0; i < scenario_.steps.size(); ++i) {
+      if (scenario_.steps[i].name == a) return step_done_[i].has_value();
+    }
+    return false;
+  }
+  if (w == "inside") return inside_.count({a, state.args[1].text}) != 0;
+  return false;
+}
+
+std::vector<Occurrence> Runner::occurrences(const engine::FrameResult& result, double) {
+  std::vector<Occurrence> out;
+  for (const Event& e : result.events) {
+    switch (e.kind) {
+      case EventKind::kContactBegin:
+        touching_.insert(ordered(e.a, e.b));
+        first_contact_.try_emplace(ordered(e.a, e.b), e.time);
+        out.push_back({Happening::kTouch, e.a, e.b});
+        break;
+      case EventKind::kContactEnd:
+        touching_.erase(ordered(e.a, e.b));
+        out.push_back({Happening::kSeparate, e.a, e.b});
+        break;
+      case EventKind::kHandContactBegin:
+        first_contact_.try_emplace(ordered("hand", e.b), e.time);
+        if (hand_touching_[e.b]++ == 0) out.push_back({Happening::kTouch, "hand", e.b});
+        break;
+      case EventKind::kHandContactEnd:
+        if (--hand_touching_[e.b] == 0) out.push_back({Happening::kSeparate, "hand", e.b});
+        break;
+      case EventKind::kGrasp:
+        grasps_.push_back({e.a + "\n" + e.b, e.time});
+        out.push_back({Happening::kGrasp, e.a, e.b});
+        break;
+      case EventKind::kRelease:
+        out.push_back({Happening::kRelease, e.a, e.b});
+        break;
+      case EventKind::kSlideBegin:
+        out.push_back({Happening::kSlide, e.a, e.b});
+        break;
+      case EventKind::kMate:
+        for (const MateSpec& m : scenario_.mates) {
+          if (m.mate.part == e.a && m.mate.other == e.b)
+            out.push_back({Happening::kMated, m.mate.name, ""});
+        }
+        break;
+      case EventKind::kRegionEnter:
+        inside_.insert({e.a, e.b});
+        out.push_back({Happening::kEnter, e.a, e.b});
+        break;
+      case EventKind::kRegionLeave:
+        inside_.erase({e.a, e.b});
+        out.push_back({Happening::kLeave, e.a, e.b});
+        break;
+      default:
+        break;
+    }
+  }
+  return out;
+}
+
+bool Runner::matches(const Clause& when, const Occurrence& o) const {
+  const std::string_view w = when.word->name;
+  const auto& args = when.args;
+  switch (o.kind) {
+    case Happening::kTouch:
+    case Happening::kSeparate:
+      if (w != (o.kind == Happening::kTouch ? "touches" : "separates")) return false;
+      return ordered(args[0].text, args[1].text) == ordered(o.a, o.b);
+    case Happening::kGrasp:
+      return w == "grasped" && args[0].text == o.a && (!args[1].given || args[1].text == o.b);
+    case Happening::kRelease:
+      return w == "released" && args[0].text == o.a;
+    case Happening::kSlide:
+      return w == "slides" && args[0].text == o.a && (!args[1].given || args[1].text == o.b);
+    case Happening::kMated:
+      return w == "mated" && args[0].text == o.a;
+    case Happening::kEnter:
+      return w == "enters" && args[0].text == o.a && args[1].text == o.b;
+    case Happening::kLeave:
+      return w == "leaves" && args[0].text == o.a && args[1].text == o.b;
+    case Happening::kCompleted:
+      return w == "completed" && args[0].text == o.a;
+  }
+  return false;
+}
+
+bool Runner::timer_fires(const Clause& when, double now, double previous) const {
+  const std::string_view w = when.word->name;
+  const double t = when.args[0].number;
+  if (w == "after") return now >= t && previous < t;
+  if (w == "every") {
+    if (!(t > 0)) return false;
+    const double k = std::floor(now / t);
+    return k >= 1 && k > std::floor(previous / t);
+  }
+  return false;
+}
+
+void Runner::complete_step(std::size_t i, double now, std::vector<Occurrence>& occurrences) {
+  if (step_done_[i]) return;
+  step_done_[i] = now;
+  completion_order_.push_back(i);
+  for (std::size_t j = 0; j < i; ++j) {
+    if (!step_done_[j]) {
+      out_.messages.push_back({now, "violation",
+                               "step '" + scenario_.steps[i].name + "' completed before step '" +
+                                   scenario_.steps[j].name + "'",
+                               scenario_.steps[i].where});
+      out_.steps[i].out_of_order = true;
+      break;
+    }
+  }
+  out_.steps[i].done_at = now;
+  occurrences.push_back({Happening::kCompleted, scenario_.steps[i].name, ""});
+}
+
+void Runner::measure_penetration(double now) {
+  const engine::Scene& scene = sim_->scene();
+  for (const auto& [a, b] : touching_) {
+    if (is_hand_part(a) || is_hand_part(b)) continue;  // the hand passes through parts
+    const PartHandle pa = scene.find(a), pb = scene.find(b);
+    if (!pa.valid() || !pb.valid()) continue;
+    const auto& ma = scene.collision_mesh(pa);
+    const auto& mb = scene.collision_mesh(pb);
+    if (!ma || !mb) continue;
+    auto model = [&](const std::shared_ptr<const collision::Mesh>& mesh) {
+      auto& slot = models_[mesh.get()];
+      if (!slot) slot = collision::build_model(collision::Method::kObb, mesh);
+      return slot;
+    };
+    const auto model_a = model(ma), model_b = model(mb);
+    const Transform X_WA = scene.world_pose(pa), X_WB = scene.world_pose(pb);
+    // Parts that have not moved since they were last measured overlap as deep as then.
+    auto& last = measured_[{a, b}];
+    if (last && last->first.R == X_WA.R && last->first.t == X_WA.t && last->second.R == X_WB.R &&
+        last->second.t == X_WB.t) {
+      continue;
+    }
+    last = std::pair(X_WA, X_WB);
+    const Transform X_AB{X_WA.R.transpose() * X_WB.R, X_WA.R.transpose() * (X_WB.t - X_WA.t)};
+    for (const collision::ContactPatch& patch :
+         collision::compute_contacts(*model_a, *model_b, X_AB)) {
+      if (patch.depth > out_.max_penetration) {
+        out_.max_penetration = patch.depth;
+        out_.max_penetration_time = now;
+        out_.max_penetration_a = a;
+        out_.max_penetration_b = b;
+      }
+    }
+  }
+}
+
+void Runner::end_frame(const engine::FrameResult& result, double previous_time) {
+  const double now = result.time;
+  std::vector<Occurrence> happened = occurrences(result, previous_time);
+  measure_penetration(now);
+  // Steps first: their completions are events the rules of this frame see.
+  for (const std::size_t i : forced_steps_) complete_step(i, now, happened);
+  forced_steps_.clear();
+  for (std::size_t i = 0; i < scenario_.steps.size(); ++i) {
+    const auto& done = scenario_.steps[i].done;
+    if (!done || step_done_[i]) continue;
+    const bool fired = timer_fires(*done, now, previous_time) ||
+                       std::any_of(happened.begin(), happened.end(),
+                                   [&](const Occurrence& o) { return matches(*done, o); });
+    if (fired) complete_step(i, now, happened);
+  }
+  // Rules in file order; their actions apply at the start of the next frame.
+  for (std::size_t r = 0; r < scenario_.rules.size(); ++r) {
+    const RuleSpec& rule = scenario_.rules[r];
+    const bool fired = timer_fires(rule.when, now, previous_time) ||
+                       std::any_of(happened.begin(), happened.end(),
+                                   [&](const Occurrence& o) { return matches(rule.when, o); });
+    if (!fired) continue;
+    if (rule.once && rule_last_[r]) continue;
+    if (rule_last_[r] && now - *rule_last_[r] < rule.cooldown) continue;
+    if (rule.unless && holds(*rule.unless)) continue;
+    if (rule.only_if && !holds(*rule.only_if)) continue;
+    rule_last_[r] = now;
+    ++out_.rules_fired;
+    for (const Clause& action : rule.act) {
+      const std::string_view w = action.word->name;
+      if (w == "log" || w == "warn" || w == "fail") {
+        out_.messages.push_back({now, std::string(w), action.args[0].text, action.where});
+        if (w == "fail") failed_by_rule_ = true;
+      } else {
+        pending_.push_back({&action, now});
+      }
+    }
+  }
+}
+
+void Runner::render(const std::filesystem::path& path) {
+  engine::RenderScene scene = engine::render_scene(*sim_);
+  const double aspect = static_cast<double>(options_.render_width) / options_.render_height;
+  if (!camera_) camera_ = engine::auto_camera(scene, aspect);
+  scene.cameras.push_back({"dovetail.run", *camera_});
+  engine::RenderSettings settings;
+  settings.width = options_.render_width;
+  settings.height = options_.render_height;
+  settings.camera = "dovetail.run";
+  engine::write_png(engine::render(scene, settings), path);
+}
+
+void Runner::evaluate_expectations() {
+  for (const Clause& c : scenario_.expectations) {
+    ExpectationOutcome e{c.text, c.where, true, ""};
+    const std::string_view w = c.word->name;
+    const auto& args = c.args;
+    if (w == "steps_in_order") {
+      std::optional<double> last;
+      std::size_t last_order = 0;
+      std::string previous;
+      for (const std::string& name : args[0].names) {
+        std::size_t i = 0;
+        while (scenario_.steps[i].name != name) ++i;
+        if (!step_done_[i]) {
+          e.passed = false;
+          e.detail = "step '" + name + "' was never completed";
+          break;
+        }
+        const std::size_t order = static_cast<std::size_t>(
+            std::find(completion_order_.begin(), completion_order_.end(), i) -
+            completion_order_.begin());
+        if (last && order < last_order) {
+          e.passed = false;
+          e.detail = "step '" + name + "' was completed at t=" + format_time(*step_done_[i]) +
+                     " s, before step '" + previous + "' (t=" + format_time(*last) + " s)";
+          break;
+        }
+        if (out_.steps[i].out_of_order) {
+          e.passed = false;
+          e.detail = "step '" + name +
+                     "' was completed out of order at t=" + format_time(*step_done_[i]) + " s";
+          break;
+        }
+        last = step_done_[i];
+        last_order = order;
+        previous = name;
+      }
+      if (e.passed && last) e.detail = "last step completed at t=" + format_time(*last) + " s";
+    } else if (w == "finished_within") {
+      for (std::size_t i = 0; i < scenario_.steps.size() && e.passed; ++i) {
+        if (!step_done_[i]) {
+          e.passed = false;
+          e.detail = "step '" + scenario_.steps[i].name + "' was never completed (run ended at t=" +
+                     format_time(sim_->report().frames * scenario_.time_step) + " s)";
+        } else if (*step_done_[i] > args[0].number) {
+          e.passed = false;
+          e.detail = "step '" + scenario_.steps[i].name +
+                     "' was completed at t=" + format_time(*step_done_[i]) + " s, after " +
+                     format_time(args[0].number) + " s";
+        }
+      }
+    } else if (w == "max_penetration") {
+      e.passed = out_.max_penetration <= args[0].number;
+      e.detail = out_.max_penetration > 0
+                     ? "'" + out_.max_penetration_a + "' and '" + out_.max_penetration_b +
+                           "' overlapped " + format_length(out_.max_penetration, out_) +
+                           " at t=" + format_time(out_.max_penetration_time) + " s (allowed " +
+                           format_length(args[0].number, out_) + ")"
+                     : "no two parts overlapped";
+    } else if (w == "no_contact") {
+      const auto it = first_contact_.find(ordered(args[0].text, args[1].text));
+      if (it != first_contact_.end()) {
+        e.passed = false;
+        e.detail = "'" + args[0].text + "' touched '" + args[1].text +
+                   "' at t=" + format_time(it->second) + " s";
+      }
+    } else if (w == "warnings_at_most") {
+      std::size_t count = 0;
+      for (const Message& m : out_.messages) {
+        if (m.level != "warn") continue;
+        if (++count > static_cast<std::size_t>(args[0].number) && e.passed) {
+          e.passed = false;
+          e.detail =
+              "warning at t=" + format_time(m.time) + " s (" + m.where.str() + "): " + m.text;
+        }
+      }
+      if (!e.passed)
+        e.detail = std::to_string(count) + " warnings; first over the limit: " + e.detail;
+    } else if (w == "mate_made") {
+      const MateSpec* m = mate(args[0].text);
+      bool mated = false;
+      double at = 0;
+      for (const Event& ev : sim_->report().events) {
+        if (ev.kind == EventKind::kMate && ev.a == m->mate.part && ev.b == m->mate.other) {
+          mated = true;
+          at = ev.time;
+        }
+      }
+      if (!mated) {
+        e.passed = false;
+        e.detail = "'" + m->mate.part + "' never snapped into '" + m->mate.other + "'";
+      } else if (!near(m->mate)) {
+        e.passed = false;
+        e.detail = "'" + m->mate.part + "' snapped at t=" + format_time(at) +
+                   " s but was moved out of place";
+      } else {
+        e.detail = "snapped at t=" + format_time(at) + " s";
+      }
+    } else if (w == "grasped_as") {
+      const std::string key = args[0].text + "\n" + args[1].text;
+      const auto it = std::find_if(grasps_.begin(), grasps_.end(),
+                                   [&](const auto& g) { return g.first == key; });
+      if (it == grasps_.end()) {
+        e.passed = false;
+        std::string seen;
+        for (const auto& g : grasps_) {
+          if (g.first.rfind(args[0].text + "\n", 0) == 0) {
+            seen = "; it was grasped as " + g.first.substr(args[0].text.size() + 1) +
+                   " at t=" + format_time(g.second) + " s";
+            break;
+          }
+        }
+        e.detail = "'" + args[0].text + "' was never grasped as " + args[1].text + seen;
+      } else {
+        e.detail = "at t=" + format_time(it->second) + " s";
+      }
+    }
+    out_.expectations.push_back(std::move(e));
+  }
+}
+
+void Runner::run() {
+  const auto start = std::chrono::steady_clock::now();
+  out_.file = file_;
+  out_.name = file_.stem().string();
+  try {
+    scenario_ = load_scenario(host_, file_);
+    out_.name = scenario_.name;
+    out_.units = scenario_.units;
+    out_.metres_per_unit = scenario_.metres_per_unit;
+    out_.warnings = scenario_.warnings;
+    host_.run_string("math.randomseed(" + std::to_string(scenario_.seed) + ")", "seed", 0);
+    lua_pushlightuserdata(host_.state(), this);
+    lua_setfield(host_.state(), LUA_REGISTRYINDEX, kRunnerKey);
+    for (const StepSpec& s : scenario_.steps) out_.steps.push_back({s.name, std::nullopt, false});
+    step_done_.assign(scenario_.steps.size(), std::nullopt);
+    rule_last_.assign(scenario_.rules.size(), std::nullopt);
+    build();
+  } catch (const std::exception& e) {
+    out_.status = RunOutcome::Status::kError;
+    out_.error = e.what();
+    out_.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return;
+  }
+  double end_time = scenario_.duration.value_or(0);
+  if (!scenario_.duration) {
+    end_time = hand_ ? hand_->source().end_time() +
+                           (options_.trace || !scenario_.glove->trace.empty() ? 0 : 1)
+                     : 1;
+  }
+  const auto frames =
+      static_cast<std::uint64_t>(std::floor(end_time / scenario_.time_step + 1e-9)) + 1;
+  std::optional<engine::ProgressMeter> meter;
+  if (options_.progress) meter.emplace(frames);
+  try {
+    double previous = -1;
+    for (std::uint64_t f = 0; f < frames && !failed_by_rule_; ++f) {
+      const engine::FrameResult& result = sim_->step();
+      end_frame(result, previous);
+      previous = result.time;
+      if (options_.render_dir && options_.render_every > 0 && f % options_.render_every == 0) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%06llu.png", static_cast<unsigned long long>(f));
+        render(*options_.render_dir / name);
+      }
+      if (meter) meter->update(f + 1);
+    }
+    if (meter) meter->finish();
+    evaluate_expectations();
+    out_.status = RunOutcome::Status::kPassed;
+    if (failed_by_rule_) out_.status = RunOutcome::Status::kFailed;
+    for (const ExpectationOutcome& e : out_.expectations) {
+      if (!e.passed) out_.status = RunOutcome::Status::kFailed;
+    }
+  } catch (const std::exception& e) {
+    out_.status = RunOutcome::Status::kError;
+    out_.error = e.what();
+  }
+  out_.report = sim_->report();
+  out_.report.timings.clear();
+  if (options_.record && hand_) interaction::write_trace(*options_.record, hand_->recorded());
+  if (options_.render_dir) {
+    const std::filesystem::path final_frame = *options_.render_dir / "final.png";
+    render(final_frame);
+    out_.final_frame = final_frame;
+  }
+  out_.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+std::string_view status_name(RunOutcome::Status status) {
+  switch (status) {
+    case RunOutcome::Status::kPassed:
+      return "passed";
+    case RunOutcome::Status::kFailed:
+      return "failed";
+    case RunOutcome::Status::kError:
+      return "error";
+  }
+  return "error";
+}
+
+std::string RunOutcome::to_json() const {
+  using engine::json_number;
+  using engine::json_string;
+  std::string out = "{\n  \"format\": \"dovetail-scenario-report\",\n  \"version\": 1,\n";
+  out += "  \"scenario\": " + json_string(name) + ",\n";
+  out += "  \"file\": " + json_string(file.generic_string()) + ",\n";
+  out += "  \"outcome\": " + json_string(status_name(status)) + ",\n";
+  if (!error.empty()) out += "  \"error\": " + json_string(error) + ",\n";
+  out += "  \"units\": " + json_string(units) + ",\n";
+  out += "  \"expectations\": [";
+  for (std::size_t i = 0; i < expectations.size(); ++i) {
+    const ExpectationOutcome& e = expectations[i];
+    out += (i ? ",\n    " : "\n    ") + std::string("{\"expect\": ") + json_string(e.text) +
+           ", \"where\": " + json_string(e.where.str()) +
+           ", \"passed\": " + (e.passed ? "true" : "false") +
+           ", \"detail\": " + json_string(e.detail) + "}";
+  }
+  out += expectations.empty() ? "],\n" : "\n  ],\n";
+  out += "  \"steps\": [";
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const StepOutcome& s = steps[i];
+    out += (i ? ",\n    " : "\n    ") + std::string("{\"name\": ") + json_string(s.name) +
+           ", \"done_at\": " + (s.done_at ? json_number(*s.done_at) : "null") +
+           ", \"out_of_order\": " + (s.out_of_order ? "true" : "false") + "}";
+  }
+  out += steps.empty() ? "],\n" : "\n  ],\n";
+  out += "  \"messages\": [";
+  for (std::size_t i = 0; i < messages.size(); ++i) {
+    const Message& m = messages[i];
+    out += (i ? ",\n    " : "\n    ") + std::string("{\"time\": ") + json_number(m.time) +
+           ", \"level\": " + json_string(m.level) + ", \"text\": " + json_string(m.text) +
+           ", \"where\": " + json_string(m.where.str()) + "}";
+  }
+  out += messages.empty() ? "],\n" : "\n  ],\n";
+  out += "  \"warnings\": [";
+  for (std::size_t i = 0; i < warnings.size(); ++i)
+    out += (i ? ", " : "") + json_string(warnings[i]);
+  out += "],\n";
+  out += "  \"rules_fired\": " + std::to_string(rules_fired) + ",\n";
+  out += "  \"max_penetration\": {\"depth\": " + json_number(max_penetration / metres_per_unit) +
+         ", \"time\": " + json_number(max_penetration_time) +
+         ", \"a\": " + json_string(max_penetration_a) +
+         ", \"b\": " + json_string(max_penetration_b) + "},\n";
+  std::string simulation = report.to_json();
+  while (!simulation.empty() && simulation.back() == '\n') simulation.pop_back();
+  out += "  \"simulation\": " + simulation + "\n}\n";
+  return out;
+}
+
+std::string RunOutcome::failure_summary() const {
+  std::string out;
+  if (status == Status::kError) out += "error: " + error + "\n";
+  for (const ExpectationOutcome& e : expectations) {
+    if (!e.passed) out += e.where.str() + ": expectation " + e.text + " failed: " + e.detail + "\n";
+  }
+  for (const Message& m : messages) {
+    if (m.level == "fail")
+      out += m.where.str() + ": failed at t=" + format_time(m.time) + " s: " + m.text + "\n";
+    if (m.level == "violation")
+      out += m.where.str() + ": at t=" + format_time(m.time) + " s: " + m.text + "\n";
+  }
+  return out;
+}
+
+RunOutcome run_scenario(const std::filesystem::path& file, const RunOptions& options) {
+  RunOutcome outcome;
+  Runner runner(file, options, outcome);
+  runner.run();
+  return outcome;
+}
+
+Scenario check_scenario(const std::filesystem::path& file, const SandboxLimits& limits) {
+  LuaHost host(limits, 1);
+  return load_scenario(host, file);
+}
+
+}  // namespace dovetail::scripting

@@ -1,0 +1,92 @@
+# ---- scenarios: run, replay, check, new, regress, reference
+
+set(scenarios ${PROJECT_SOURCE_DIR}/scenarios)
+set(scenario_data ${data}/scenarios)
+
+# Every shipped scenario is a test of its own.
+file(GLOB shipped_scenarios CONFIGURE_DEPENDS ${scenarios}/*.lua)
+foreach(file ${shipped_scenarios})
+  get_filename_component(stem ${file} NAME_WE)
+  dovetail_cli_test(scenario_${stem} EXIT 0 ARGS run ${file} --quiet)
+endforeach()
+
+# The README's run: the first shipped scenario, its report and final frame.
+dovetail_cli_test(run_default EXIT 0 ARGS run --report ${out}/run_default.json --render ${out}/run_default
+                  STDOUT "Peg in hole: passed&&final frame: "
+                  FILE ${out}/run_default.json MATCHES "\"outcome\": \"passed\"&&\"state_hash\""
+                  REMOVE ${out}/run_default.json)
+add_test(NAME cli.run_default_png
+         COMMAND ${CMAKE_COMMAND} -DPNG=${out}/run_default/final.png -DWIDTH=960 -DHEIGHT=720
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/check_png.cmake)
+set_tests_properties(cli.run_default PROPERTIES FIXTURES_SETUP run_default)
+set_tests_properties(cli.run_default_png PROPERTIES FIXTURES_REQUIRED run_default)
+
+# Record, then replay: the same report.
+dovetail_cli_test(run_record EXIT 0 ARGS run ${scenarios}/01_peg_in_hole.lua --record ${out}/peg.csv
+                  --report ${out}/peg_recorded.json --quiet)
+dovetail_cli_test(replay_recorded EXIT 0
+                  ARGS replay ${scenarios}/01_peg_in_hole.lua ${out}/peg.csv --threads 2
+                       --report ${out}/peg_replayed.json --quiet)
+set_tests_properties(cli.run_record PROPERTIES FIXTURES_SETUP peg_recorded)
+set_tests_properties(cli.replay_recorded PROPERTIES FIXTURES_SETUP peg_replayed FIXTURES_REQUIRED peg_recorded)
+add_test(NAME cli.replay_same_report
+         COMMAND ${CMAKE_COMMAND} -E compare_files ${out}/peg_recorded.json ${out}/peg_replayed.json)
+set_tests_properties(cli.replay_same_report PROPERTIES FIXTURES_REQUIRED "peg_recorded;peg_replayed")
+dovetail_cli_test(replay_missing_trace EXIT 1 ARGS replay ${scenarios}/01_peg_in_hole.lua ${out}/no_such.csv
+                  STDERR "no_such.csv: no such file")
+
+# check and new
+dovetail_cli_test(check_shipped EXIT 0 ARGS check ${scenarios}/01_peg_in_hole.lua
+                  STDOUT "ok: 'Peg in hole', 2 parts, 1 mates, 1 steps, 3 rules, 5 expectations, a hand")
+dovetail_cli_test(check_syntax_error EXIT 1 ARGS check ${scenario_data}/hostile/syntax_error.lua
+                  STDERR "syntax_error.lua:2: ")
+dovetail_cli_test(check_missing EXIT 1 ARGS check ${out}/no_such.lua STDERR "no_such.lua: no such file")
+dovetail_cli_test(new_scenario EXIT 0 ARGS new my_first --out ${out}/my_first.lua
+                  STDOUT "wrote .*my_first.lua" REMOVE ${out}/my_first.lua)
+set_tests_properties(cli.new_scenario PROPERTIES FIXTURES_SETUP new_scenario)
+dovetail_cli_test(new_scenario_checks EXIT 0 ARGS check ${out}/my_first.lua STDOUT "ok: 'my_first'")
+dovetail_cli_test(new_scenario_runs EXIT 0 ARGS run ${out}/my_first.lua STDOUT "my_first: passed")
+dovetail_cli_test(new_refuses_to_overwrite EXIT 1 ARGS new x --out ${scenarios}/01_peg_in_hole.lua
+                  STDERR "exists; not overwritten")
+set_tests_properties(cli.new_scenario_checks cli.new_scenario_runs PROPERTIES FIXTURES_REQUIRED new_scenario)
+
+# Scenarios that should fail say which expectation, when, with which parts.
+dovetail_cli_test(fails_mate_impossible EXIT 3 ARGS run ${scenario_data}/failing/mate_impossible.lua --quiet
+                  STDERR "expectation mate_made\\(\"peg_in_hole\"\\) failed: 'peg' never snapped into 'block'&&expectation steps_in_order")
+dovetail_cli_test(fails_step_out_of_order EXIT 3 ARGS run ${scenario_data}/failing/step_out_of_order.lua --quiet
+                  STDERR "expectation steps_in_order\\({ .inspect., .insert. }\\) failed: step 'insert' was completed at t=[0-9.]+ s, before step 'inspect' \\(t=3.000 s\\)")
+dovetail_cli_test(fails_pushed_through EXIT 3 ARGS run ${scenario_data}/failing/pushed_through.lua --quiet
+                  STDERR "expectation max_penetration\\(0.01\\) failed: 'block' and 'cover' overlapped [0-9.]+ mm at t=[0-9.]+ s")
+
+# regress: hostile scripts end with clear errors, the others still run, every report is written.
+dovetail_cli_test(regress_hostile EXIT 3
+                  ARGS regress ${scenario_data}/hostile --out ${out}/hostile -j 2 --junit ${out}/hostile.xml
+                  STDOUT "PASS   well_behaved&&ERROR  infinite_loop .*instruction budget&&ERROR  string_rep .*string.rep&&ERROR  memory_bomb .*memory&&ERROR  deep_recursion .*stack overflow&&ERROR  coroutine_loop .*instruction budget&&ERROR  os_exit .*'os'&&ERROR  io_open .*'io'&&ERROR  require_module .*'require'&&ERROR  debug_sethook .*'debug'&&ERROR  binary_chunk .*binary chunk&&ERROR  setmetatable_G .*protected metatable&&ERROR  syntax_error .*syntax_error.lua:2:&&ERROR  pcall_swallow .*instruction budget&&ERROR  endless_custom_action .*endless_custom_action.lua:5: .*instruction budget&&1 of 15 scenarios passed"
+                  FILE ${out}/hostile.xml MATCHES "tests=\"15\" failures=\"0\" errors=\"14\"")
+set_tests_properties(cli.regress_hostile PROPERTIES FIXTURES_SETUP regress_hostile)
+add_test(NAME cli.regress_hostile_reports_written
+         COMMAND ${CMAKE_COMMAND} -DDIR=${out}/hostile -DCOUNT=15 -P ${CMAKE_CURRENT_SOURCE_DIR}/count_reports.cmake)
+set_tests_properties(cli.regress_hostile_reports_written PROPERTIES FIXTURES_REQUIRED regress_hostile)
+
+dovetail_cli_test(regress_bad_shard EXIT 2 ARGS regress ${scenarios} --shard 3/2 STDERR "--shard must be K/N")
+dovetail_cli_test(regress_not_a_folder EXIT 1 ARGS regress ${out}/no_such_folder STDERR "not a folder")
+
+# The shipped scenarios: every one passes, the same reports at 1, 2 and 8 threads, twice.
+add_test(NAME cli.regress_shipped_deterministic
+         COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:dovetail> -DSCENARIOS=${scenarios}
+                 -DOUT=${out}/regress_shipped -P ${CMAKE_CURRENT_SOURCE_DIR}/regress_determinism.cmake)
+set_tests_properties(cli.regress_shipped_deterministic PROPERTIES TIMEOUT 1800 FIXTURES_SETUP regress_shipped)
+
+# The HTML report opens in a real headless browser; its screenshot is kept for a look by eye.
+find_program(DOVETAIL_CHROMIUM NAMES chromium chromium-browser)
+if(DOVETAIL_CHROMIUM)
+  add_test(NAME cli.regress_html_in_browser
+           COMMAND ${CMAKE_COMMAND} -DCHROMIUM=${DOVETAIL_CHROMIUM} -DHTML=${out}/regress_shipped/1/report.html
+                   -DSHOT=${out}/regress_report.png -P ${CMAKE_CURRENT_SOURCE_DIR}/html_in_browser.cmake)
+  set_tests_properties(cli.regress_html_in_browser PROPERTIES FIXTURES_REQUIRED regress_shipped TIMEOUT 300)
+endif()
+
+# The reference in docs/authoring.md is the vocabulary's own.
+add_test(NAME cli.reference_matches_docs
+         COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:dovetail> -DDOC=${PROJECT_SOURCE_DIR}/docs/authoring.md
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/reference_in_docs.cmake)

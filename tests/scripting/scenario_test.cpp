@@ -1,0 +1,241 @@
+// Scenarios: loading (errors with file, line and "did you mean"), running
+// (rules, steps, expectations), failing for the right reason, and the same
+// report bits at any thread count and on replay.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+
+#include "../support/temp_dir.h"
+#include "dovetail/scripting/lua_host.h"
+#include "dovetail/scripting/scenario_run.h"
+
+namespace dovetail::scripting {
+namespace {
+
+const std::filesystem::path kScenarios = DOVETAIL_SCENARIO_DIR;
+
+std::filesystem::path write(const test::TempDir& dir, const std::string& name,
+                            const std::string& text) {
+  const auto path = dir / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+/// A scene without a hand: the peg is moved into the hole by a rule.
+std::string moved_peg(const std::string& rules, const std::string& expect,
+                      const std::string& extra = "") {
+  return R"(return scenario {
+  name = "moved peg", units = "mm", duration = 1,
+  parts = {
+    block = part { shape = block_with_hole { size = { 80, 60, 80 }, hole = 20.5, depth = 40 }, fixed = true },
+    peg = part { shape = cylinder { diameter = 20, length = 60 }, at = { 0, 100, 0 }, turn = { x = 90 } },
+    lid = part { shape = box { size = { 10, 10, 10 } }, at = { 100, 0, 0 }, fixed = true },
+  },
+  mates = {
+    peg_in_hole = mate { part = "peg", point = { 0, 0, 60 }, axis = "z",
+                         into = "block", at = { 0, -10, 0 }, along = "-y" },
+  },
+  steps = {
+    step { "insert", done = mated "peg_in_hole" },
+    step { "check", done = after(0.5) },
+  },
+  rules = {
+)" + rules +
+         R"(
+  },
+  expect = {
+)" + expect +
+         R"(
+  },
+)" + extra +
+         "}\n";
+}
+
+TEST(ScenarioLoad, AMisspeltPartIsAnErrorWithFileLineAndASuggestion) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file =
+      write(dir, "bad.lua",
+            moved_peg("    rule { when = touches(\"peg\", \"blok\"), act = { log \"x\" } },", ""));
+  LuaHost host({}, 1);
+  try {
+    load_scenario(host, file);
+    FAIL() << "loaded";
+  } catch (const ScenarioError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("bad.lua:17: touches: no part 'blok' (did you mean 'block'?)"),
+              std::string::npos)
+        << what;
+  }
+}
+
+TEST(ScenarioLoad, AnUnknownFieldAndAWrongKindAreNamed) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto typo =
+      write(dir, "typo.lua",
+            moved_peg("    rule { when = after(1), act = { log \"x\" }, cooldwn = 1 },", ""));
+  LuaHost host({}, 1);
+  EXPECT_THROW(
+      {
+        try {
+          load_scenario(host, typo);
+        } catch (const ScenarioError& e) {
+          EXPECT_NE(
+              std::string(e.what()).find("unknown field 'cooldwn' (did you mean 'cooldown'?)"),
+              std::string::npos)
+              << e.what();
+          throw;
+        }
+      },
+      ScenarioError);
+  const auto kind =
+      write(dir, "kind.lua",
+            moved_peg("    rule { when = highlight \"peg\", act = { log \"x\" } },", ""));
+  LuaHost host2({}, 1);
+  try {
+    load_scenario(host2, kind);
+    FAIL();
+  } catch (const ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "kind.lua:17: rule 1: when must be an event; 'highlight' is an action"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ScenarioLoad, ARuleThatCanNeverFireIsAWarning) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file =
+      write(dir, "never.lua",
+            moved_peg("    rule { when = touches(\"block\", \"lid\"), act = { log \"x\" } },", ""));
+  LuaHost host({}, 1);
+  const Scenario s = load_scenario(host, file);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("never.lua:17: rule: touches(\"block\", \"lid\") can never happen"),
+            std::string::npos)
+      << s.warnings[0];
+}
+
+TEST(ScenarioLoad, TheFileMustReturnAScenario) {
+  const test::TempDir dir("dovetail_scenario");
+  LuaHost host({}, 1);
+  EXPECT_THROW(load_scenario(host, write(dir, "plain.lua", "return { name = 'x' }")),
+               ScenarioError);
+  LuaHost host2({}, 1);
+  EXPECT_THROW(load_scenario(host2, write(dir, "syntax.lua", "return scenario {")), ScriptError);
+}
+
+TEST(ScenarioRun, RulesStepsAndExpectationsOfAMovedPeg) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(
+      dir, "moved.lua",
+      moved_peg(
+          "    rule { when = after(0.2), act = { snap \"peg_in_hole\" } },\n"
+          "    rule { when = mated \"peg_in_hole\", act = { highlight \"block\", "
+          "log \"seated\" } },",
+          "    steps_in_order { \"insert\", \"check\" }, finished_within(0.6),\n"
+          "    mate_made \"peg_in_hole\", max_penetration(0.01), no_contact(\"peg\", \"lid\"),"));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary();
+  ASSERT_EQ(o.steps.size(), 2u);
+  // after(0.2) fires in frame 18 (t = 0.2); the snap applies at the start of frame 19.
+  EXPECT_DOUBLE_EQ(*o.steps[0].done_at, 19.0 / 90.0);
+  ASSERT_FALSE(o.messages.empty());
+  EXPECT_EQ(o.messages[0].text, "seated");
+  EXPECT_EQ(o.messages[0].where.line, 18);
+}
+
+TEST(ScenarioRun, AStepOutOfOrderFailsNamingTheStepsAndTimes) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file =
+      write(dir, "order.lua",
+            moved_peg("    rule { when = after(0.7), act = { snap \"peg_in_hole\" } },",
+                      "    steps_in_order { \"insert\", \"check\" },"));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed);
+  const std::string summary = o.failure_summary();
+  EXPECT_NE(summary.find("steps_in_order"), std::string::npos) << summary;
+  EXPECT_NE(
+      summary.find("step 'check' was completed at t=0.500 s, before step 'insert' (t=0.711 s)"),
+      std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("order.lua:14: at t=0.500 s: step 'check' completed before step 'insert'"),
+            std::string::npos)
+      << summary;
+}
+
+TEST(ScenarioRun, APartPushedThroughAnotherFailsMaxPenetrationNamingThePartsAndTime) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(
+      dir, "through.lua",
+      moved_peg("    rule { when = after(0.1), act = { move(\"peg\", { 0, -60, 0 }, 0.5) } },",
+                "    max_penetration(0.01),"));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed);
+  ASSERT_EQ(o.expectations.size(), 1u);
+  EXPECT_FALSE(o.expectations[0].passed);
+  EXPECT_NE(o.expectations[0].detail.find("'block' and 'peg' overlapped"), std::string::npos)
+      << o.expectations[0].detail;
+  EXPECT_GT(o.max_penetration, 0.001);
+}
+
+TEST(ScenarioRun, AFailingCustomActionEndsWithAnErrorAndAReport) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(dir, "custom.lua",
+                          moved_peg("    rule { when = after(0.1), act = { custom(function(dt)\n"
+                                    "      dt.part(\"peg\"):set_translation(0, 120, 0)\n"
+                                    "      while true do end end) } },",
+                                    "    max_penetration(0.01),"));
+  RunOptions options;
+  options.limits.instructions_per_call = 100000;
+  const RunOutcome o = run_scenario(file, options);
+  ASSERT_EQ(o.status, RunOutcome::Status::kError);
+  EXPECT_NE(o.error.find("custom.lua:19"), std::string::npos) << o.error;
+  EXPECT_GT(o.report.frames, 9u);
+  EXPECT_NE(o.to_json().find("\"outcome\": \"error\""), std::string::npos);
+}
+
+TEST(ScenarioRun, CustomActionsUseTheLowLevelApi) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file =
+      write(dir, "api.lua",
+            moved_peg("    rule { when = after(0.1), act = { custom(function(dt)\n"
+                      "      local x, y, z = dt.part(\"peg\"):translation()\n"
+                      "      dt.log(string.format(\"%g %g %g\", x, y, z))\n"
+                      "      local m = dt.part(\"peg\"):matrix()\n"
+                      "      m[8] = 250\n"
+                      "      dt.part(\"peg\"):set_matrix(m)\n"
+                      "    end) } },\n"
+                      "    rule { when = after(0.2), act = { custom(function(dt)\n"
+                      "      dt.log(string.format(\"%g %g %g\", dt.part(\"peg\"):translation()))\n"
+                      "    end) } },",
+                      ""));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+  std::vector<std::string> logged;
+  for (const Message& m : o.messages) {
+    if (m.level == "log") logged.push_back(m.text);
+  }
+  EXPECT_EQ(logged, (std::vector<std::string>{"0 100 0", "0 250 0"})) << o.to_json();
+}
+
+TEST(ShippedScenarios, PegInHolePassesAndGivesTheSameReportAtAnyThreadCountAndOnReplay) {
+  const test::TempDir dir("dovetail_scenario");
+  RunOptions options;
+  options.record = dir / "peg.csv";
+  const RunOutcome first = run_scenario(kScenarios / "01_peg_in_hole.lua", options);
+  ASSERT_EQ(first.status, RunOutcome::Status::kPassed) << first.failure_summary();
+  for (const int threads : {2, 8}) {
+    RunOptions again;
+    again.threads = threads;
+    EXPECT_EQ(run_scenario(kScenarios / "01_peg_in_hole.lua", again).to_json(), first.to_json())
+        << threads;
+  }
+  RunOptions replay;
+  replay.trace = dir / "peg.csv";
+  EXPECT_EQ(run_scenario(kScenarios / "01_peg_in_hole.lua", replay).to_json(), first.to_json());
+}
+
+}  // namespace
+}  // namespace dovetail::scripting
