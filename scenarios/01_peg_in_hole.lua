@@ -45,4 +45,6 @@ return scenario {
     max_penetration(0.01),
     warnings_at_most(0),
   },
+
+  camera = { from = { 160, 170, 260 }, to = { 0, 20, 0 } },
 }

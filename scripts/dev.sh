@@ -1,6 +1,7 @@
 #!/bin/sh
 # One entry point for users and CI:
-#   scripts/dev.sh run     install what is missing, build Release, run the default job
+#   scripts/dev.sh run     install what is missing, build Release, run the first shipped
+#                          scenario (report and final frame in build/run/)
 #   scripts/dev.sh test    install what is missing, build Release, run every test
 #   scripts/dev.sh build   install what is missing, build Release
 #   scripts/dev.sh bench   build, then run the polygon-level benchmark on built-in meshes
@@ -34,7 +35,7 @@ cmake --build "$build_dir" -j "$jobs"
 
 case "$command" in
   build) ;;
-  run) "$build_dir/apps/dovetail" run ;;
+  run) "$build_dir/apps/dovetail" run --report "$build_dir/run/report.json" --render "$build_dir/run" ;;
   test) ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" ;;
   bench) "$build_dir/bench/polygon_bench" ;;
   *) echo "dev.sh: unknown command '$command' (run, test, build, bench, tsan)" >&2; exit 2 ;;

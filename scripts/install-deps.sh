@@ -4,9 +4,11 @@
 set -eu
 
 # Build and library dependencies.
-packages="g++ cmake make pkg-config ccache libeigen3-dev libassimp-dev libtbb-dev libgtest-dev libqhull-dev libosmesa6-dev libpng-dev liblua5.4-dev"
+packages="g++ cmake make pkg-config ccache libeigen3-dev libassimp-dev libtbb-dev libgtest-dev libqhull-dev libosmesa6-dev libpng-dev liblua5.4-dev nlohmann-json3-dev"
 # Test-only: exact oracle for the triangle test, and the model files of the import tests.
 packages="$packages libcgal-dev assimp-testmodels"
+# Test-only: a real headless browser opens the regress HTML report.
+packages="$packages chromium"
 # Bench-only peers (optional for the library, used by bench/).
 packages="$packages libfcl-dev libbullet-dev libccd-dev"
 

@@ -160,7 +160,8 @@ class Loader {
         for (lua_Unsigned i = 1; i <= n; ++i) {
           lua_rawgeti(L_, index, static_cast<lua_Integer>(i));
           const int item = lua_gettop(L_);
-          const bool simple = lua_type(L_, item) == LUA_TSTRING || lua_type(L_, item) == LUA_TNUMBER;
+          const bool simple =
+              lua_type(L_, item) == LUA_TSTRING || lua_type(L_, item) == LUA_TNUMBER;
           const std::string text = simple ? describe(item) : "";
           lua_pop(L_, 1);
           if (!simple) return "{...}";
@@ -556,6 +557,26 @@ void Loader::read_scenario_fields(int table, const SourceLocation& where) {
   with_field("steps", [&](int i) { read_steps(i, where); });
   with_field("rules", [&](int i) { read_rules(i, where); });
   with_field("expect", [&](int i) { read_expectations(i, where); });
+  with_field("camera", [&](int i) {
+    if (lua_type(L_, i) != LUA_TTABLE)
+      fail(where, "scenario: camera must be { from = {x, y, z}, to = {x, y, z} }");
+    std::vector<std::string> keys;
+    std::vector<lua_Integer> positions;
+    keys_of(i, keys, positions, where, "camera");
+    if (keys != std::vector<std::string>{"from", "to"} || !positions.empty()) {
+      fail(where, "scenario: camera must be { from = {x, y, z}, to = {x, y, z} }");
+    }
+    engine::Camera camera;
+    raw_getfield(i, "from");
+    camera.eye = vector_at(lua_gettop(L_), where, "camera 'from'") * scenario_.metres_per_unit;
+    lua_pop(L_, 1);
+    raw_getfield(i, "to");
+    camera.target = vector_at(lua_gettop(L_), where, "camera 'to'") * scenario_.metres_per_unit;
+    lua_pop(L_, 1);
+    if (!((camera.eye - camera.target).norm() > 0))
+      fail(where, "scenario: camera 'from' and 'to' are the same point");
+    scenario_.camera = camera;
+  });
 }
 
 void Loader::read_parts(int map, const SourceLocation& where) {

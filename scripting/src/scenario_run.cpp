@@ -107,9 +107,12 @@ class Runner {
   std::unique_ptr<interaction::Hand> hand_;
   std::unique_ptr<interaction::Grasping> grasping_;
 
-  std::set<std::pair<std::string, std::string>> touching_;  ///< part pairs, ordered names
-  std::map<std::string, int> hand_touching_;                ///< part -> hand segments touching it
-  std::set<std::pair<std::string, std::string>> inside_;    ///< (part, region)
+  std::set<std::pair<std::string, std::string>>
+      touching_;  ///< part pairs in contact, ordered names
+  /// Per part pair: how many of (contact, sliding) hold; touching while > 0.
+  std::map<std::pair<std::string, std::string>, int> contact_sources_;
+  std::map<std::string, int> hand_touching_;              ///< part -> hand segments touching it
+  std::set<std::pair<std::string, std::string>> inside_;  ///< (part, region)
   std::map<std::pair<std::string, std::string>, double> first_contact_;
   std::vector<std::optional<double>> step_done_;
   std::vector<std::size_t> completion_order_;  ///< step indices in the order completed
@@ -442,7 +445,8 @@ bool Runner::holds(const Clause& state) const {
       const auto it = hand_touching_.find(b);
       return it != hand_touching_.end() && it->second > 0;
     }
-    return touching_.count(ordered(a, b)) != 0;
+    const auto it = contact_sources_.find(ordered(a, b));
+    return it != contact_sources_.end() && it->second > 0;
   }
   if (w == "near") return near(mate(a)->mate);
   if (w == "done") {
@@ -462,11 +466,13 @@ std::vector<Occurrence> Runner::occurrences(const engine::FrameResult& result, d
       case EventKind::kContactBegin:
         touching_.insert(ordered(e.a, e.b));
         first_contact_.try_emplace(ordered(e.a, e.b), e.time);
-        out.push_back({Happening::kTouch, e.a, e.b});
+        if (contact_sources_[ordered(e.a, e.b)]++ == 0)
+          out.push_back({Happening::kTouch, e.a, e.b});
         break;
       case EventKind::kContactEnd:
         touching_.erase(ordered(e.a, e.b));
-        out.push_back({Happening::kSeparate, e.a, e.b});
+        if (--contact_sources_[ordered(e.a, e.b)] == 0)
+          out.push_back({Happening::kSeparate, e.a, e.b});
         break;
       case EventKind::kHandContactBegin:
         first_contact_.try_emplace(ordered("hand", e.b), e.time);
@@ -483,7 +489,16 @@ std::vector<Occurrence> Runner::occurrences(const engine::FrameResult& result, d
         out.push_back({Happening::kRelease, e.a, e.b});
         break;
       case EventKind::kSlideBegin:
+        // A part sliding along another touches it (the band keeps a skin of
+        // micrometres, so the collision layer may see no contact).
         out.push_back({Happening::kSlide, e.a, e.b});
+        first_contact_.try_emplace(ordered(e.a, e.b), e.time);
+        if (contact_sources_[ordered(e.a, e.b)]++ == 0)
+          out.push_back({Happening::kTouch, e.a, e.b});
+        break;
+      case EventKind::kSlideEnd:
+        if (--contact_sources_[ordered(e.a, e.b)] == 0)
+          out.push_back({Happening::kSeparate, e.a, e.b});
         break;
       case EventKind::kMate:
         for (const MateSpec& m : scenario_.mates) {
@@ -639,9 +654,10 @@ void Runner::end_frame(const engine::FrameResult& result, double previous_time) 
 }
 
 void Runner::render(const std::filesystem::path& path) {
-  engine::RenderScene scene = engine::render_scene(*sim_);
+  // The parts in their own colours and the rules' highlights (contacts are not marked).
+  engine::RenderScene scene = engine::render_scene(sim_->scene());
   const double aspect = static_cast<double>(options_.render_width) / options_.render_height;
-  if (!camera_) camera_ = engine::auto_camera(scene, aspect);
+  if (!camera_) camera_ = scenario_.camera ? *scenario_.camera : engine::auto_camera(scene, aspect);
   scene.cameras.push_back({"dovetail.run", *camera_});
   engine::RenderSettings settings;
   settings.width = options_.render_width;
@@ -804,6 +820,7 @@ void Runner::run() {
       static_cast<std::uint64_t>(std::floor(end_time / scenario_.time_step + 1e-9)) + 1;
   std::optional<engine::ProgressMeter> meter;
   if (options_.progress) meter.emplace(frames);
+  const auto loop_start = std::chrono::steady_clock::now();
   try {
     double previous = -1;
     for (std::uint64_t f = 0; f < frames && !failed_by_rule_; ++f) {
@@ -818,6 +835,8 @@ void Runner::run() {
       if (meter) meter->update(f + 1);
     }
     if (meter) meter->finish();
+    out_.loop_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
     evaluate_expectations();
     out_.status = RunOutcome::Status::kPassed;
     if (failed_by_rule_) out_.status = RunOutcome::Status::kFailed;
@@ -829,7 +848,6 @@ void Runner::run() {
     out_.error = e.what();
   }
   out_.report = sim_->report();
-  out_.report.timings.clear();
   if (options_.record && hand_) interaction::write_trace(*options_.record, hand_->recorded());
   if (options_.render_dir) {
     const std::filesystem::path final_frame = *options_.render_dir / "final.png";

@@ -30,7 +30,10 @@ std::vector<Word> make_vocabulary() {
         {"steps", kList, kOptional, "the assembly steps, in the order they should be done"},
         {"rules", kList, kOptional,
          "what should happen when: `rule { ... }`, checked in file order"},
-        {"expect", kList, kOptional, "expectations; the scenario passes when all hold"}},
+        {"expect", kList, kOptional, "expectations; the scenario passes when all hold"},
+        {"camera", kTable, kOptional,
+         "where pictures are taken from: { from = {x, y, z}, to = {x, y, z} } (default: "
+         "the whole scene, obliquely from above)"}},
        "The whole scenario; the file returns it.",
        "return scenario { name = \"Peg into block\", units = \"mm\", parts = { ... } }"});
   w.push_back(
@@ -138,13 +141,14 @@ std::vector<Word> make_vocabulary() {
                WordKind::kEvent,
                {{"a", kPartOrHand, kRequired, "a part, or \"hand\""},
                 {"b", kPart, kRequired, "another part"}},
-               "a and b begin to touch.",
+               "a and b begin to touch: their surfaces meet, or a held part begins to slide "
+               "along the other (\"hand\": any segment of the hand).",
                "touches(\"peg\", \"block\")"});
   w.push_back({"separates",
                WordKind::kEvent,
                {{"a", kPartOrHand, kRequired, "a part, or \"hand\""},
                 {"b", kPart, kRequired, "another part"}},
-               "a and b stop touching.",
+               "a and b stop touching (the last contact or slide between them ends).",
                "separates(\"peg\", \"block\")"});
   w.push_back({"grasped",
                WordKind::kEvent,

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "dovetail/collision/mesh.h"
+#include "dovetail/engine/camera.h"
 #include "dovetail/engine/simulation.h"
 #include "dovetail/interaction/glove_source.h"
 #include "dovetail/interaction/grasping.h"
@@ -129,6 +130,8 @@ struct Scenario {
   std::vector<StepSpec> steps{};  ///< in the file's order
   std::vector<RuleSpec> rules{};  ///< in the file's order
   std::vector<Clause> expectations{};
+  /// The camera of rendered frames; none: auto_camera of the first frame rendered.
+  std::optional<engine::Camera> camera{};
   /// Things that load but look wrong (a rule that can never fire), `file:line: ...`.
   std::vector<std::string> warnings{};
 };

@@ -82,7 +82,9 @@ struct RunOutcome {
   double metres_per_unit = 0.001;
   std::string units = "mm";
   engine::Report report{};  ///< the simulation's report (timeline, contacts, state hash)
-  double wall_seconds = 0;  ///< not in the JSON report
+  double wall_seconds = 0;  ///< the whole run, loading included; not in the JSON report
+  /// The frame loop alone (simulation, rules, steps, penetration), for benchmarks.
+  double loop_seconds = 0;
   std::optional<std::filesystem::path> final_frame{};  ///< the PNG written, if any
 
   /// The report as JSON: deterministic, no wall-clock times (docs/authoring.md, "Reports").
