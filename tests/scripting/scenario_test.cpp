@@ -220,6 +220,44 @@ TEST(ScenarioRun, CustomActionsUseTheLowLevelApi) {
   EXPECT_EQ(logged, (std::vector<std::string>{"0 100 0", "0 250 0"})) << o.to_json();
 }
 
+TEST(ScenarioRun, RegionsTimersAttachAndCompletedEventsAsDescribed) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(dir, "words.lua", R"(return scenario {
+  name = "words", units = "mm", duration = 1,
+  parts = {
+    a = part { shape = box { size = { 10, 10, 10 } } },
+    c = part { shape = box { size = { 4, 4, 4 } }, at = { 0, 20, 0 } },
+    base = part { shape = box { size = { 10, 10, 10 } }, at = { 0, 0, -100 }, fixed = true },
+  },
+  regions = { tray = region { min = { -20, -20, 80 }, max = { 20, 20, 120 } } },
+  steps = { step { "arrive", done = enters("a", "tray") } },
+  rules = {
+    rule { when = after(0.1), act = { attach("c", "a"), move("a", { 0, 0, 100 }, 0.2) } },
+    rule { when = enters("a", "tray"), act = { log "entered", hide "a" } },
+    rule { when = completed "arrive", act = { log "arrived" } },
+    rule { when = every(0.25), act = { log "tick" }, cooldown = 0 },
+    rule { when = after(0.6), act = { detach "c", move("a", { 0, 0, 300 }, 0.1) } },
+    rule { when = leaves("a", "tray"), only_if = done "arrive", act = { custom(function(dt)
+      local x, y, z = dt.part("c"):translation()
+      dt.log(string.format("c at %g %g %g", x, y, z))
+    end) } },
+  },
+  expect = { steps_in_order { "arrive" }, no_contact("a", "base") },
+})");
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+  std::vector<std::string> logged;
+  for (const Message& m : o.messages) logged.push_back(m.text);
+  // a reaches the tray (z >= 80 - 5 mm) during its move; c rode along 20 mm
+  // above it and stayed where it was when detached at 0.6 s, while a left.
+  const std::vector<std::string> expected = {"tick",          "entered", "arrived", "tick",
+                                             "c at 0 20 100", "tick",    "tick"};
+  EXPECT_EQ(logged, expected) << o.to_json();
+  ASSERT_TRUE(o.steps[0].done_at);
+  EXPECT_GT(*o.steps[0].done_at, 0.2);
+  EXPECT_LT(*o.steps[0].done_at, 0.3);
+}
+
 TEST(ShippedScenarios, PegInHolePassesAndGivesTheSameReportAtAnyThreadCountAndOnReplay) {
   const test::TempDir dir("dovetail_scenario");
   RunOptions options;
