@@ -5,7 +5,7 @@
 #   scripts/dev.sh test    install what is missing, build Release, run every test
 #   scripts/dev.sh build   install what is missing, build Release
 #   scripts/dev.sh bench   build, then run the polygon-level benchmark on built-in meshes
-#   scripts/dev.sh tsan    build the collision and interaction tests with ThreadSanitizer
+#   scripts/dev.sh tsan    build the collision, interaction and scripting tests with ThreadSanitizer
 #                          (build-tsan/) and run the parallel ones
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores),
 # DOVETAIL_WERROR=ON to treat warnings as errors (CI does).
@@ -21,12 +21,15 @@ sh scripts/install-deps.sh
 if [ "$command" = tsan ]; then
   cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDOVETAIL_SANITIZE=thread \
     -DDOVETAIL_BUILD_BENCH=OFF -DDOVETAIL_WERROR="${DOVETAIL_WERROR:-OFF}" >/dev/null
-  cmake --build build-tsan -j "$jobs" --target collision_tests interaction_tests
+  cmake --build build-tsan -j "$jobs" --target collision_tests interaction_tests scripting_tests
   TSAN_OPTIONS="halt_on_error=1 ${TSAN_OPTIONS:-}" build-tsan/tests/collision_tests \
     --gtest_filter='CollisionWorld.*:WorldDistance.*:Hierarchies.ParallelQueries*:TaskSystem.*'
   # The hand in a simulation at 2 and 8 collision threads.
   TSAN_OPTIONS="halt_on_error=1 ${TSAN_OPTIONS:-}" build-tsan/tests/interaction_tests \
     --gtest_filter='HandReplay.*:PegInHole.ARecorded*:GraspTypes.AGrasp*'
+  # A shipped scenario at 1, 2 and 8 collision threads, and replayed.
+  TSAN_OPTIONS="halt_on_error=1 ${TSAN_OPTIONS:-}" build-tsan/tests/scripting/scripting_tests \
+    --gtest_filter='ShippedScenarios.*'
   exit 0
 fi
 
