@@ -336,12 +336,19 @@ void Runner::build() {
   if (scenario_.glove || options_.trace) {
     std::shared_ptr<const interaction::GloveSource> source;
     const GloveSpec glove = scenario_.glove.value_or(GloveSpec{});
-    if (options_.trace) {
-      source = std::make_shared<interaction::TraceSource>(interaction::read_trace(*options_.trace));
-    } else if (!glove.trace.empty()) {
-      source = std::make_shared<interaction::TraceSource>(interaction::read_trace(glove.trace));
-    } else {
-      source = std::make_shared<interaction::SimulatedGlove>(interaction::read_plan(glove.plan));
+    try {
+      if (options_.trace) {
+        source =
+            std::make_shared<interaction::TraceSource>(interaction::read_trace(*options_.trace));
+      } else if (!glove.trace.empty()) {
+        source = std::make_shared<interaction::TraceSource>(interaction::read_trace(glove.trace));
+      } else {
+        source = std::make_shared<interaction::SimulatedGlove>(interaction::read_plan(glove.plan));
+      }
+    } catch (const std::exception& e) {
+      // The file's own message names it (and its line); say which glove asked for it.
+      throw ScenarioError(options_.trace ? std::string(e.what())
+                                         : glove.where.str() + ": glove: " + e.what());
     }
     if (glove.noise && !options_.trace)
       source = std::make_shared<interaction::NoisyGlove>(source, *glove.noise);

@@ -90,3 +90,8 @@ endif()
 add_test(NAME cli.reference_matches_docs
          COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:dovetail> -DDOC=${PROJECT_SOURCE_DIR}/docs/authoring.md
                  -P ${CMAKE_CURRENT_SOURCE_DIR}/reference_in_docs.cmake)
+
+# A glove plan that is missing: the error names the scenario's line and the file.
+file(WRITE ${out}/missing_plan.lua "return scenario {\n  name = \"x\", duration = 1,\n  parts = { a = part { shape = box { size = { 1, 1, 1 } } } },\n  hand = glove { plan = \"no_such.plan\" },\n}\n")
+dovetail_cli_test(run_missing_plan EXIT 1 ARGS run ${out}/missing_plan.lua --quiet
+                  STDERR "missing_plan.lua:4: glove: .*no_such.plan")
