@@ -421,7 +421,9 @@ void Grasping::carry(engine::Simulation& simulation) {
   }
   scene.set_world_pose(part, last_slide_.X_WP);
   const bool in_contact = last_slide_.status != SlideStatus::kReached;
-  if (in_contact && !sliding_) {
+  // A part whose start pose already touches (just snapped, then grasped again) can
+  // be blocked with no contact found; it slides on nothing named.
+  if (in_contact && !sliding_ && !last_slide_.contacts.empty()) {
     sliding_ = true;
     sliding_on_ = scene.name(handles[last_slide_.contacts.front().obstacle]);
     pending_.push_back({EventKind::kSlideBegin, frame, t, *held_, sliding_on_});

@@ -95,3 +95,8 @@ add_test(NAME cli.reference_matches_docs
 file(WRITE ${out}/missing_plan.lua "return scenario {\n  name = \"x\", duration = 1,\n  parts = { a = part { shape = box { size = { 1, 1, 1 } } } },\n  hand = glove { plan = \"no_such.plan\" },\n}\n")
 dovetail_cli_test(run_missing_plan EXIT 1 ARGS run ${out}/missing_plan.lua --quiet
                   STDERR "missing_plan.lua:4: glove: .*no_such.plan")
+
+# The open hand drawn back along a part that has just snapped grasps it again:
+# this once crashed (a blocked slide with no contact); now it runs to the end.
+dovetail_cli_test(regrasp_after_snap EXIT 3 ARGS run ${scenario_data}/regrasp/regrasp_after_snap.lua --quiet
+                  STDERR "the hand took hold of the piston again")
