@@ -467,6 +467,42 @@ class Loader {
     return arg;
   }
 
+  /// The named nodes of a mesh file (or all but them) as one mesh in the file's frame.
+  collision::Mesh select_nodes(const std::filesystem::path& path,
+                               const std::vector<std::string>& names, bool keep,
+                               const SourceLocation& where, const std::string& what) {
+    auto [it, fresh] = imports_.try_emplace(path.string());
+    if (fresh) {
+      engine::ImportOptions options;
+      options.merge = false;
+      it->second = engine::import_file(path, options);
+    }
+    const engine::ImportReport& report = it->second;
+    std::vector<std::string> known;
+    for (const engine::ImportedPart& p : report.parts) known.push_back(p.name);
+    for (const std::string& name : names) {
+      if (std::find(known.begin(), known.end(), name) == known.end()) {
+        fail(where, what + ": " + path.filename().string() + " has no node '" + name + "'" +
+                        did_you_mean(name, known));
+      }
+    }
+    std::vector<Vec3> vertices;
+    std::vector<collision::TriangleIndices> triangles;
+    for (const engine::ImportedPart& p : report.parts) {
+      const bool listed = std::find(names.begin(), names.end(), p.name) != names.end();
+      if (listed != keep) continue;
+      const auto base = static_cast<std::uint32_t>(vertices.size());
+      vertices.insert(vertices.end(), p.mesh.vertices.begin(), p.mesh.vertices.end());
+      for (collision::TriangleIndices tri : p.mesh.triangles) {
+        for (auto& index : tri) index += base;
+        triangles.push_back(tri);
+      }
+    }
+    if (triangles.empty())
+      fail(where, what + ": no triangles are left of " + path.filename().string());
+    return collision::make_mesh(std::move(vertices), std::move(triangles), path.string());
+  }
+
   void read_scenario_fields(int table, const SourceLocation& where);
   void read_parts(int map, const SourceLocation& where);
   std::shared_ptr<const collision::Mesh> read_shape(int index, const SourceLocation& where,
@@ -485,6 +521,7 @@ class Loader {
   std::string file_;
   std::filesystem::path folder_;
   Scenario scenario_;
+  std::map<std::string, engine::ImportReport> imports_;  ///< mesh files read by node
 };
 
 Scenario Loader::load() {
@@ -614,11 +651,24 @@ void Loader::read_parts(int map, const SourceLocation& where) {
     const Arg mesh = field(t, word, "mesh", part.where, what);
     if (has_shape == mesh.given)
       fail(part.where, what + ": give either shape = ... or mesh = \"file\"");
+    const Arg nodes = field(t, word, "nodes", part.where, what);
+    const Arg without = field(t, word, "without", part.where, what);
+    if ((nodes.given || without.given) && !mesh.given) {
+      fail(part.where, what + ": nodes and without select from a mesh file");
+    }
+    if (nodes.given && without.given) fail(part.where, what + ": give either nodes or without");
     if (mesh.given) {
       const std::filesystem::path path = folder_ / mesh.text;
       collision::Mesh loaded;
       try {
-        loaded = engine::import_mesh(path);
+        if (nodes.given || without.given) {
+          loaded = select_nodes(path, nodes.given ? nodes.names : without.names, nodes.given,
+                                part.where, what);
+        } else {
+          loaded = engine::import_mesh(path);
+        }
+      } catch (const ScenarioError&) {
+        throw;
       } catch (const std::exception& e) {
         fail(part.where, what + ": " + e.what());
       }

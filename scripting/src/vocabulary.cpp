@@ -42,6 +42,10 @@ std::vector<Word> make_vocabulary() {
        {{"shape", kWord, kOptional, "a generated shape: `cylinder { ... }`, `box { ... }`, ..."},
         {"mesh", kFile, kOptional,
          "or a mesh file (OBJ, STL, PLY, glTF, ... in the scenario's units)"},
+        {"nodes", kNames, kOptional,
+         "only these nodes of the mesh file, as `dovetail inspect --parts` names them; "
+         "the part's frame stays the file's"},
+        {"without", kNames, kOptional, "or every node of the mesh file but these"},
         {"at", kVector, kOptional, "position of the part's origin (default {0, 0, 0})"},
         {"turn", kTurn, kOptional, "orientation: degrees about x, then y, then z"},
         {"fixed", kFlag, kOptional, "true: the part never moves (default false)"},

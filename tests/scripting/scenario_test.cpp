@@ -258,6 +258,42 @@ TEST(ScenarioRun, RegionsTimersAttachAndCompletedEventsAsDescribed) {
   EXPECT_LT(*o.steps[0].done_at, 0.3);
 }
 
+TEST(ScenarioLoad, NodesOfAMeshFileBecomeTheirOwnParts) {
+  const std::string engine =
+      "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+  if (!std::filesystem::exists(engine))
+    GTEST_SKIP() << engine << " (assimp-testmodels) is not installed";
+  const test::TempDir dir("dovetail_scenario");
+  const std::string parts = "  parts = {\n    block = part { mesh = \"" + engine +
+                            "\", without = { \"nodes[5]\", \"nodes[5]_2\" }, fixed = true },\n"
+                            "    piston = part { mesh = \"" +
+                            engine +
+                            "\", nodes = { \"nodes[5]\", \"nodes[5]_2\" } },\n"
+                            "    whole = part { mesh = \"" +
+                            engine + "\", at = { 0, 1000, 0 } },\n  },\n";
+  LuaHost host({}, 1);
+  const Scenario s = load_scenario(
+      host, write(dir, "nodes.lua", "return scenario {\n  name = \"n\",\n" + parts + "}\n"));
+  ASSERT_EQ(s.parts.size(), 3u);
+  const auto& block = *s.parts[0].mesh;
+  const auto& piston = *s.parts[1].mesh;
+  const auto& whole = *s.parts[2].mesh;
+  EXPECT_GT(piston.triangles.size(), 100u);
+  EXPECT_EQ(block.triangles.size() + piston.triangles.size(), whole.triangles.size());
+  LuaHost host2({}, 1);
+  try {
+    load_scenario(host2, write(dir, "typo.lua",
+                               "return scenario { name = \"n\", parts = { p = part { mesh = \"" +
+                                   engine + "\", nodes = { \"node[5]\" } } } }\n"));
+    FAIL();
+  } catch (const ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "2CylinderEngine.glb has no node 'node[5]' (did you mean 'nodes[5]'?)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(ShippedScenarios, PegInHolePassesAndGivesTheSameReportAtAnyThreadCountAndOnReplay) {
   const test::TempDir dir("dovetail_scenario");
   RunOptions options;
