@@ -409,6 +409,7 @@ void Grasping::carry(engine::Simulation& simulation) {
     previous.push_back(renumbered);
   }
   request.previous_contacts = previous;
+  request.start_proof = &last_slide_.proof;
   last_slide_ = slide(request, settings_.sliding);
   contact_parts_ = handles;
   stats_.slide_queries += static_cast<std::uint64_t>(last_slide_.collision_queries);

@@ -5,6 +5,7 @@
 #include <numbers>
 #include <optional>
 
+#include "dovetail/collision/tri_tri.h"
 #include "dovetail/engine/scene.h"
 
 namespace dovetail::interaction {
@@ -25,6 +26,13 @@ Transform moved(const Transform& X, const Vec3& c, const Vec3& v, const Vec3& w)
 }
 
 using Triangle = std::array<Vec3, 3>;
+
+/// Where a pose of the part collides: the first intersecting triangle pair
+/// that an obstacle's query found (the obstacle's triangle, the part's).
+struct Hit {
+  std::size_t obstacle = 0;  ///< index into the request's obstacles
+  collision::TrianglePair pair;
+};
 
 /// Most triangle pairs of one patch whose closest points are measured.
 constexpr std::size_t kPairsPerPatch = 64;
@@ -73,6 +81,24 @@ void contacts_at(const SlideRequest& request, const Transform& X_WP_free, const 
   }
 }
 
+/// The contact of one colliding triangle pair, measured at the free pose X_WP_free as in
+/// contacts_at; nothing when the pair still touches there.
+std::optional<SlideContact> pair_contact(const SlideRequest& request, const Hit& hit,
+                                         const Transform& X_WP_free) {
+  const SlideObstacle& o = request.obstacles[hit.obstacle];
+  const collision::Mesh& obstacle_mesh = o.model->mesh();
+  const collision::Mesh& part_mesh = request.part->mesh();
+  Triangle ta, tb;
+  for (int k = 0; k < 3; ++k) {
+    ta[k] = o.X_WO.apply(obstacle_mesh.vertices[obstacle_mesh.triangles[hit.pair.a][k]]);
+    tb[k] = X_WP_free.apply(part_mesh.vertices[part_mesh.triangles[hit.pair.b][k]]);
+  }
+  const collision::TrianglePairDistance d = collision::triangle_pair_distance(ta, tb);
+  if (!(d.distance > 0)) return std::nullopt;
+  return SlideContact{o.id, (d.p + d.q) / 2, (d.q - d.p) / d.distance,
+                      collision::ContactKind::kPoint, 0};
+}
+
 /// The motion x = (v, w) closest to x_d in the metric diag(1, 1, 1, L^2, L^2, L^2) with
 /// a_i . x >= b_i for every contact: Hildreth's dual coordinate ascent, a fixed number of
 /// sweeps in a fixed order.
@@ -94,6 +120,126 @@ Vec6 project(const Vec6& x_d, const std::vector<Vec6>& a, const std::vector<Real
     }
   }
   return x;
+}
+
+/// The part at X_WP against every obstacle, exact first-hit queries: the
+/// first hit, or nothing when the pose is collision-free.
+std::optional<Hit> first_hit(const collision::CollisionModel& part, const Transform& X_WP,
+                             std::span<const SlideObstacle> obstacles, int* queries) {
+  for (std::size_t i = 0; i < obstacles.size(); ++i) {
+    const SlideObstacle& o = obstacles[i];
+    const Transform X_OP = engine::compose(o.X_WO.inverse(), X_WP);
+    if (queries) ++*queries;
+    const collision::CollideResult r = o.model->collide(part, X_OP);
+    if (r.colliding) return Hit{i, r.pairs.front()};
+  }
+  return std::nullopt;
+}
+
+/// Whether the one triangle pair of `hit` intersects with the part at X_WP:
+/// the leaf test of the first-hit query (the part's vertices mapped into the
+/// obstacle's frame by the same Transform::apply), so a pair that intersects
+/// here makes the query report the pose colliding.
+bool pair_collides(const collision::CollisionModel& part, const Transform& X_WP,
+                   const SlideObstacle& o, const collision::TrianglePair& pair) {
+  const Transform X_OP = engine::compose(o.X_WO.inverse(), X_WP);
+  const collision::Mesh& obstacle_mesh = o.model->mesh();
+  const collision::Mesh& part_mesh = part.mesh();
+  const collision::TriangleIndices& ta = obstacle_mesh.triangles[pair.a];
+  const collision::TriangleIndices& tb = part_mesh.triangles[pair.b];
+  return collision::triangles_intersect(
+      obstacle_mesh.vertices[ta[0]], obstacle_mesh.vertices[ta[1]], obstacle_mesh.vertices[ta[2]],
+      X_OP.apply(part_mesh.vertices[tb[0]]), X_OP.apply(part_mesh.vertices[tb[1]]),
+      X_OP.apply(part_mesh.vertices[tb[2]]));
+}
+
+/// A move of the part: from X_WP by v and the turn w about the world point c.
+struct Move {
+  Transform X_WP;
+  Vec3 c, v, w;
+  /// The pose after the fraction s of the move.
+  Transform at(Real s) const { return moved(X_WP, c, s * v, s * w); }
+  /// How far the fraction s moves any point of a part of size L at most.
+  Real reach(Real s, Real size) const { return s * (v.norm() + w.norm() * size); }
+};
+
+/// Fractions of a move: the part is collision-free after `free`, colliding after `hit`.
+struct Bracket {
+  Real free = 0;
+  Real hit = 1;
+  Hit pair_at_hit;  ///< a triangle pair that intersects after `hit`
+};
+
+/// The contact pose of a move whose end collides, by halving the bracket
+/// with a first-hit query of the whole part each time, until it moves a
+/// point less than the resolution or the query budget is spent.
+Bracket bracket_halving(const collision::CollisionModel& part,
+                        std::span<const SlideObstacle> obstacles, const Move& motion, Real size,
+                        Hit hit, const SlidingSettings& settings, int& queries) {
+  Bracket b{.pair_at_hit = hit};
+  for (int i = 0;
+       i < settings.bisection_steps && motion.reach(b.hit - b.free, size) > settings.resolution_m;
+       ++i) {
+    const Real mid = (b.free + b.hit) / 2;
+    if (const std::optional<Hit> h = first_hit(part, motion.at(mid), obstacles, &queries)) {
+      b.hit = mid;
+      b.pair_at_hit = *h;
+    } else {
+      b.free = mid;
+    }
+  }
+  return b;
+}
+
+/// The same bracket, guided by the triangle pair that collides: halve on
+/// that pair alone (one exact triangle test a step) to where it starts to
+/// touch, then ask the whole part there once. Collision-free: done, the pair
+/// proves the other end collides. Colliding: the query's pair touches
+/// earlier; go on with it. Each query thus moves the colliding end to an
+/// earlier pair's contact, and a move that meets one new facet costs two
+/// queries where halving with whole-part queries costs ten or more.
+Bracket bracket_guided(const collision::CollisionModel& part,
+                       std::span<const SlideObstacle> obstacles, const Move& motion, Real size,
+                       Hit hit, const SlidingSettings& settings, int& queries) {
+  Bracket b{.pair_at_hit = hit};
+  for (int i = 0; i < settings.bisection_steps; ++i) {
+    // Halve on the pair: it touches after b.hit and (the whole part being free there) not
+    // after b.free.
+    Real lo = b.free;
+    while (motion.reach(b.hit - lo, size) > settings.resolution_m) {
+      const Real mid = (lo + b.hit) / 2;
+      if (mid <= lo || mid >= b.hit) break;  // no double left between them
+      (pair_collides(part, motion.at(mid), obstacles[hit.obstacle], hit.pair) ? b.hit : lo) = mid;
+    }
+    if (lo == b.free) break;  // the pair touches within the resolution of the free end
+    const std::optional<Hit> earlier = first_hit(part, motion.at(lo), obstacles, &queries);
+    if (!earlier) {
+      b.free = lo;
+      break;
+    }
+    b.hit = lo;
+    hit = *earlier;
+  }
+  b.pair_at_hit = hit;
+  return b;
+}
+
+bool same_bits(const Transform& a, const Transform& b) { return a.R == b.R && a.t == b.t; }
+
+/// Whether `proof` shows the request's starting pose collision-free: the same part model at
+/// the same pose, and every obstacle's model at the same pose among those it was proved against.
+bool proves_free(const SlideProof* proof, const SlideRequest& request) {
+  if (!proof || !proof->part || proof->part != request.part ||
+      !same_bits(proof->X_WP, request.X_WP)) {
+    return false;
+  }
+  return std::all_of(request.obstacles.begin(), request.obstacles.end(),
+                     [&](const SlideObstacle& o) {
+                       return std::any_of(proof->obstacles.begin(), proof->obstacles.end(),
+                                          [&](const SlideObstacle& p) {
+                                            return p.model == o.model && same_bits(p.X_WO, o.X_WO);
+                                          });
+                     });
 }
 
 }  // namespace
@@ -126,12 +272,7 @@ Mat3 rotation_from_vector(const Vec3& w) {
 
 bool collides(const collision::CollisionModel& part, const Transform& X_WP,
               std::span<const SlideObstacle> obstacles, int* queries) {
-  for (const SlideObstacle& o : obstacles) {
-    const Transform X_OP = engine::compose(o.X_WO.inverse(), X_WP);
-    if (queries) ++*queries;
-    if (o.model->collide(part, X_OP).colliding) return true;
-  }
-  return false;
+  return first_hit(part, X_WP, obstacles, queries).has_value();
 }
 
 SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) {
@@ -149,7 +290,8 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
     result.status = SlideStatus::kOverstretched;
     return result;
   }
-  if (collides(part, result.X_WP, request.obstacles, &result.collision_queries)) {
+  if (!proves_free(request.start_proof, request) &&
+      collides(part, result.X_WP, request.obstacles, &result.collision_queries)) {
     result.status = SlideStatus::kBlocked;
     return result;
   }
@@ -207,36 +349,49 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
     }
     const Vec3 v = allowed.head<3>(), w = allowed.tail<3>();
     // 1. Try the move; where it collides, bisect toward the exact contact pose.
-    const Transform candidate = moved(result.X_WP, c, v, w);
-    if (!collides(part, candidate, request.obstacles, &result.collision_queries)) {
-      result.X_WP = candidate;
+    const Move motion{result.X_WP, c, v, w};
+    const std::optional<Hit> end_hit =
+        first_hit(part, motion.at(1), request.obstacles, &result.collision_queries);
+    if (!end_hit) {
+      result.X_WP = motion.at(1);
       follow_contacts(c, v, w);
       result.status = result.contacts.empty() ? SlideStatus::kReached : SlideStatus::kSliding;
       stalled = 0;
       continue;
     }
     result.status = SlideStatus::kSliding;
-    // Halve until the bracket is under the resolution (a small move needs few steps).
-    const Real move = v.norm() + w.norm() * request.size;
-    Real free = 0, hit = 1;
-    for (int i = 0; i < settings.bisection_steps && (hit - free) * move > settings.resolution_m;
-         ++i) {
-      const Real mid = (free + hit) / 2;
-      if (collides(part, moved(result.X_WP, c, mid * v, mid * w), request.obstacles,
-                   &result.collision_queries)) {
-        hit = mid;
-      } else {
-        free = mid;
-      }
-    }
-    const Transform at_hit = moved(result.X_WP, c, hit * v, hit * w);
-    result.X_WP = moved(result.X_WP, c, free * v, free * w);
+    const Bracket bracket = settings.pair_guided
+                                ? bracket_guided(part, request.obstacles, motion, request.size,
+                                                 *end_hit, settings, result.collision_queries)
+                                : bracket_halving(part, request.obstacles, motion, request.size,
+                                                  *end_hit, settings, result.collision_queries);
+    const Real free = bracket.free;
+    result.X_WP = motion.at(free);
     follow_contacts(c, free * v, free * w);
-    // 2, 3. The contacts of the colliding pose, their kinds and normals.
-    std::vector<SlideContact> met;
-    contacts_at(request, result.X_WP, at_hit, met, result.collision_queries);
+    // 2, 3. The contacts of the colliding pose, their kinds and normals. A hit on a surface
+    // the part already touches (the colliding pair's normal is a known contact's, the part
+    // pivoting into it about that contact) adds the pair's point with that normal; only a new
+    // direction asks for the contact patches.
     int added = 0;
-    for (const SlideContact& k : met) added += add_contact(k) ? 1 : 0;
+    const std::optional<SlideContact> touch =
+        settings.pair_guided ? pair_contact(request, bracket.pair_at_hit, result.X_WP)
+                             : std::nullopt;
+    const auto known = touch ? std::find_if(result.contacts.begin(), result.contacts.end(),
+                                            [&](const SlideContact& k) {
+                                              return k.obstacle == touch->obstacle &&
+                                                     k.n_W.dot(touch->n_W) > 0.9998;
+                                            })
+                             : result.contacts.end();
+    if (known != result.contacts.end()) {
+      SlideContact k = *touch;
+      k.kind = known->kind;
+      added = add_contact(k) ? 1 : 0;
+    }
+    if (added == 0) {
+      std::vector<SlideContact> met;
+      contacts_at(request, result.X_WP, motion.at(bracket.hit), met, result.collision_queries);
+      for (const SlideContact& k : met) added += add_contact(k) ? 1 : 0;
+    }
     result.new_contacts += added;
     // Two moves in a row that got nowhere (under a thousandth of the way): at rest.
     stalled = free < 1e-3 ? stalled + 1 : 0;
@@ -249,6 +404,10 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
     result.status = SlideStatus::kSliding;
   }
   measure_stretch();
+  // Every pose the step accepted was found free against all the obstacles.
+  result.proof.part = request.part;
+  result.proof.X_WP = result.X_WP;
+  result.proof.obstacles.assign(request.obstacles.begin(), request.obstacles.end());
   return result;
 }
 

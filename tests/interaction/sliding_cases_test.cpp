@@ -1,11 +1,14 @@
 // Where sliding is hard: a sharp edge, and two held parts sliding against
-// each other at once.
+// each other at once. And the step itself: both contact searches stop at the
+// contact pose, and a proof of a free pose covers only what it was made for.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "dovetail/collision/contacts.h"
+#include "dovetail/collision/distance.h"
 #include "dovetail/collision/primitives.h"
 #include "dovetail/interaction/glove_source.h"
 #include "dovetail/interaction/grasping.h"
@@ -34,6 +37,8 @@ Real depth_between(const engine::Simulation& sim, const std::string& a, const st
   }
   return depth;
 }
+
+bool same_pose(const Transform& a, const Transform& b) { return a.R == b.R && a.t == b.t; }
 
 /// A hand far above that holds `part` and moves by `moves` (reach steps of `duration`).
 GlovePlan moves_by(const Vec3& start, std::initializer_list<Vec3> moves, Real duration) {
@@ -125,6 +130,70 @@ TEST(SlidingCases, TwoHeldPartsSlideAgainstEachOtherAtOnce) {
   const Vec3 l = sim.scene().world_pose("left_cube").t, r = sim.scene().world_pose("right_cube").t;
   EXPECT_NEAR(r.x() - l.x(), 0.02, 1e-4) << "face to face";
   EXPECT_GT(l.y() - r.y(), 0.006) << "slid along each other as the hands parted vertically";
+}
+
+/// A 10 mm cube 10 mm above the top face (y = 0.02) of a block, the hand wanting it
+/// 5 mm into the block: one step on its own.
+struct CubeOverBlock {
+  std::shared_ptr<const collision::Mesh> cube_mesh = box(Vec3::Constant(0.005));
+  std::shared_ptr<const collision::Mesh> block_mesh = box(Vec3(0.03, 0.02, 0.03));
+  std::vector<SlideObstacle> obstacles{{collision::build_model(collision::Method::kObb, block_mesh),
+                                        collision::build_distance_model(block_mesh),
+                                        Transform::identity(), 0}};
+
+  SlideRequest request() const {
+    SlideRequest r;
+    r.part = collision::build_model(collision::Method::kObb, cube_mesh);
+    r.part_distance = collision::build_distance_model(cube_mesh);
+    r.size = 0.0087;
+    r.X_WP.t = Vec3(0, 0.035, 0);
+    r.X_WP_target.t = Vec3(0, 0.02, 0);
+    r.obstacles = obstacles;
+    return r;
+  }
+};
+
+TEST(SlidingCases, BothContactSearchesStopOnTheFaceToTheResolution) {
+  const CubeOverBlock scene;
+  const SlideRequest request = scene.request();
+  for (const bool pair_guided : {false, true}) {
+    SCOPED_TRACE(pair_guided ? "pair-guided" : "plain");
+    SlidingSettings settings;
+    settings.pair_guided = pair_guided;
+    const SlideResult r = slide(request, settings);
+    EXPECT_NE(r.status, SlideStatus::kReached);
+    EXPECT_FALSE(collides(*request.part, r.X_WP, request.obstacles)) << "accepted pose";
+    const Real bottom = r.X_WP.t.y() - 0.005;
+    EXPECT_GT(bottom, 0.02);
+    EXPECT_LT(bottom, 0.02 + settings.resolution_m) << "on the face";
+    EXPECT_NEAR(r.X_WP.t.x(), 0, 1e-12);
+    ASSERT_FALSE(r.contacts.empty());
+    EXPECT_GT(r.contacts.front().n_W.dot(Vec3::UnitY()), 0.9998) << "the face's normal";
+  }
+}
+
+TEST(SlidingCases, AProofOfAFreePoseCoversOnlyTheObstaclesAtTheirPoses) {
+  const CubeOverBlock scene;
+  SlideRequest request = scene.request();
+  const SlideResult first = slide(request);
+  ASSERT_TRUE(first.proof.part);
+  // Resting where the last step left it, among the same obstacles: no query to start with.
+  request.X_WP = first.X_WP;
+  const SlideResult without = slide(request);
+  request.start_proof = &first.proof;
+  const SlideResult with = slide(request);
+  EXPECT_EQ(with.collision_queries, without.collision_queries - 1);
+  EXPECT_TRUE(same_pose(with.X_WP, without.X_WP));
+  // The block moved up into the cube: the old proof no longer holds.
+  std::vector<SlideObstacle> moved = scene.obstacles;
+  moved[0].X_WO.t.y() += 0.001;
+  request.obstacles = moved;
+  EXPECT_EQ(slide(request).status, SlideStatus::kBlocked);
+  // A pose a hair's breadth off the proved one is not covered either.
+  request.obstacles = scene.obstacles;
+  request.X_WP.t.y() = std::nextafter(first.X_WP.t.y(), Real{0});
+  const SlideResult off = slide(request);
+  EXPECT_EQ(off.collision_queries, without.collision_queries);
 }
 
 }  // namespace

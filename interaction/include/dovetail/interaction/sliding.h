@@ -13,9 +13,11 @@
 /// The state machine of one step, after ALGORITHMS.md ("Rubber-band sliding"):
 ///   1. try the wanted motion; where it collides, approximate the exact
 ///      contact pose by bisection between the last free pose and the
-///      colliding one;
+///      colliding one, halving on the colliding triangle pair alone and
+///      confirming with one whole-part query (SlidingSettings::pair_guided);
 ///   2. classify the contact from the contact patches of the colliding pose
-///      (face, curve: edge on face or edge on edge, point);
+///      (face, curve: edge on face or edge on edge, point); a hit whose
+///      triangle pair has the normal of a known contact only adds its point;
 ///   3. take the contact normal from the closest points of the last free
 ///      pose, a hair's breadth from the contact: the direction from the other
 ///      part's closest point to the sliding part's, which is the face normal
@@ -46,9 +48,19 @@ namespace dovetail::interaction {
 
 /// How a sliding part behaves.
 struct SlidingSettings {
-  int substeps = 4;          ///< projected moves per frame at most
-  int bisection_steps = 14;  ///< halvings toward the exact contact pose at most (10 mm -> 0.6 um)
+  int substeps = 4;  ///< projected moves per frame at most
+  /// Whole-part collision queries toward the exact contact pose at most (14
+  /// halvings take a 10 mm move to 0.6 um).
+  int bisection_steps = 14;
   Real resolution_m = 1e-6;  ///< ... stopping once the bracket moves a point less than this
+  /// Let the colliding triangle pair guide the search: find the contact pose
+  /// by halving on that pair alone, then one whole-part query to confirm,
+  /// instead of a whole-part query per halving; and when the pair's normal is
+  /// already a contact's (the part pivoting into a surface it touches), add
+  /// the pair's point instead of analysing the contact patches. Both ways stop
+  /// at the same resolution and accept only poses the whole-part query finds
+  /// collision-free; false is the plain way, kept for comparison.
+  bool pair_guided = true;
   int solver_sweeps = 64;    ///< passes over the contacts projecting the motion
   Real band_limit_m = 0.05;  ///< stretch (centre to centre) past which the band breaks
   Real band_limit_deg = 20;  ///< ... or angle between held and wanted orientation
@@ -84,6 +96,15 @@ struct SlideContact {
 /// A contact the part has moved this far away from is forgotten (metres).
 inline constexpr Real kContactExpiry = 1e-4;
 
+/// A pose of the part that a step proved collision-free, and against what:
+/// a step starting from that very pose among the same obstacle models at the
+/// very same poses (bit for bit) need not prove it again.
+struct SlideProof {
+  std::shared_ptr<const collision::CollisionModel> part;  ///< null: nothing proved
+  Transform X_WP{};
+  std::vector<SlideObstacle> obstacles;  ///< their models and poses (ids do not matter)
+};
+
 /// What one step wants.
 struct SlideRequest {
   std::shared_ptr<const collision::CollisionModel> part;          ///< the sliding part (kObb)
@@ -97,6 +118,10 @@ struct SlideRequest {
   /// still against them, so they constrain the first move of this step and
   /// a part resting in a corner costs no search (contact coherence).
   std::span<const SlideContact> previous_contacts;
+  /// The last step's proof (SlideResult::proof). When it covers X_WP and
+  /// every obstacle, the step skips its first query (is the starting pose
+  /// free?): a part resting in contact then costs no query at all.
+  const SlideProof* start_proof = nullptr;
 };
 
 /// How the step ended.
@@ -121,6 +146,9 @@ struct SlideResult {
   int collision_queries = 0;
   Real stretch_m = 0;    ///< band stretch at the end: target centre to part centre
   Real stretch_deg = 0;  ///< and angle
+  /// The final pose, proved collision-free against the request's obstacles
+  /// (empty when kOverstretched or kBlocked): the next step's start_proof.
+  SlideProof proof;
 };
 
 /// Most contacts a step keeps.
