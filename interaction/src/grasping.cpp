@@ -324,6 +324,7 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   std::vector<GraspContact> found_contacts;
   for (const PartHandle part :
        candidates(scene, hand_->X_WH(), 1.2 * hand_->model().hand_length())) {
+    if (!scene.movable(part)) continue;  // fixed parts stop the fingers but are not grasped
     std::vector<GraspContact> touching = touches(scene, part);
     if (touching.empty()) continue;
     if (const std::optional<GraspType> type = classify_grasp(touching, settings_.grasp.friction)) {
@@ -344,6 +345,7 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
     candidate_ = found_part;
     candidate_type_ = *found;
     candidate_frames_ = 1;
+    candidate_start_flexion_ = last_flexion_;
   } else {
     candidate_.clear();
     candidate_frames_ = 0;
@@ -351,7 +353,11 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   last_flexion_ = total_flexion;
   // The grasp holds for onset_frames; its type is taken once the hand stops closing
   // (or after four times as long), so that the last fingers to arrive count.
+  // And the hand must have closed while the grasp built up: an open or still hand
+  // moved against a part (drawn back along a rod it just let go of) grasps nothing.
+  constexpr Real kMinClosing = 1;  // degrees of total flexion
   if (candidate_frames_ >= settings_.grasp.onset_frames &&
+      total_flexion >= candidate_start_flexion_ + kMinClosing &&
       (!still_closing || candidate_frames_ >= 4 * settings_.grasp.onset_frames)) {
     hold(candidate_, candidate_type_);
     // The digits that grasp are those touching the part now (a grasp fires only in a

@@ -96,7 +96,7 @@ file(WRITE ${out}/missing_plan.lua "return scenario {\n  name = \"x\", duration 
 dovetail_cli_test(run_missing_plan EXIT 1 ARGS run ${out}/missing_plan.lua --quiet
                   STDERR "missing_plan.lua:4: glove: .*no_such.plan")
 
-# The open hand drawn back along a part that has just snapped grasps it again:
-# this once crashed (a blocked slide with no contact); now it runs to the end.
-dovetail_cli_test(regrasp_after_snap EXIT 3 ARGS run ${scenario_data}/regrasp/regrasp_after_snap.lua --quiet
-                  STDERR "the hand took hold of the piston again")
+# The open hand drawn back along a part that has just snapped: it once grasped
+# the part again (and then crashed on a blocked slide with no contact). An open,
+# still hand grasps nothing now; the scenario's rule warns if it does.
+dovetail_cli_test(regrasp_after_snap EXIT 0 ARGS run ${scenario_data}/regrasp/regrasp_after_snap.lua --quiet)

@@ -87,6 +87,39 @@ TEST(SlidingCases, ACubePressedOntoABlockSlidesAlongItsTopAndOverItsSharpEdge) {
   EXPECT_TRUE(grasping.held());
 }
 
+TEST(SlidingCases, APartHeldWhileOverlappingAnotherStaysWhereItIsAndIsNeverLost) {
+  // The cube starts 1 mm inside the block (as a part just snapped into a seat may be
+  // at the skin's scale) and the hand pulls it further in: every step is blocked at
+  // its start with no contact to name. Expected: no slide event names a part, the
+  // cube does not move, and it stays held until the band breaks.
+  engine::Scene scene;
+  scene.add_part({.name = "block", .movable = false, .render_mesh = box(Vec3(0.03, 0.02, 0.03))});
+  scene.add_part({.name = "cube",
+                  .X_PC = {Mat3::Identity(), Vec3(0, 0.024, 0)},
+                  .render_mesh = box(Vec3::Constant(0.005))});
+  engine::Simulation sim(std::move(scene));
+  Hand hand(sim,
+            std::make_shared<SimulatedGlove>(moves_by(Vec3(0, 0.2, 0), {Vec3(0, -0.03, 0)}, 1.0)));
+  Grasping grasping(sim, hand);
+  grasping.hold("cube", GraspType::kPower);
+  const Transform start = sim.scene().world_pose("cube");
+  std::vector<Event> events;
+  for (int frame = 0; frame < 120; ++frame) {
+    const engine::FrameResult& r = sim.step();
+    events.insert(events.end(), r.events.begin(), r.events.end());
+  }
+  EXPECT_TRUE(same_pose(sim.scene().world_pose("cube"), start));
+  for (const Event& e : events) {
+    if (e.kind == EventKind::kSlideBegin) {
+      EXPECT_FALSE(e.b.empty());
+    }
+  }
+  const bool overstretched = std::any_of(events.begin(), events.end(), [](const Event& e) {
+    return e.kind == EventKind::kRelease && e.a == "cube" && e.b == "overstretched";
+  });
+  EXPECT_TRUE(grasping.held() || overstretched);
+}
+
 TEST(SlidingCases, TwoHeldPartsSlideAgainstEachOtherAtOnce) {
   // Two hands carry a cube each toward the other until their targets overlap by 10 mm.
   // Expected: both stop at contact (no penetration), both report sliding on the other,

@@ -165,6 +165,7 @@ class Grasping {
   std::string candidate_;   ///< part whose grasp is building up
   GraspType candidate_type_ = GraspType::kPrecision;
   int candidate_frames_ = 0;
+  Real candidate_start_flexion_ = 0;  ///< total glove flexion the frame before the candidate
   Real last_flexion_ = 0;
   std::optional<std::size_t> guiding_;  ///< the mate drawing the held part onto its axis
   bool sliding_ = false;

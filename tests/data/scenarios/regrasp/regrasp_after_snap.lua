@@ -1,6 +1,6 @@
 -- The engine-piston scenario with the hand drawn back along the rod after the
--- piston has snapped: the open hand grasps the seated piston again, which once
--- crashed (a blocked slide with no contact). It must run to its end.
+-- piston has snapped: the open hand once grasped the seated piston again, and
+-- then crashed (a blocked slide with no contact). It must run to its end and pass.
 -- Engine piston: a piston and its connecting rod are pulled out of a cylinder
 -- and put back, beside the two-cylinder engine of assimp's test models
 -- (2CylinderEngine.glb from Debian's assimp-testmodels, in millimetres).
