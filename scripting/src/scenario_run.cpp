@@ -354,6 +354,8 @@ void Runner::build() {
       source = std::make_shared<interaction::NoisyGlove>(source, *glove.noise);
     interaction::HandSettings hand_settings;
     hand_settings.model.hand_length = glove.hand_length;
+    // Every sample is kept only when the run is recorded (a simulated hour is 80 MB of them).
+    hand_settings.record = options_.record.has_value();
     hand_ = std::make_unique<interaction::Hand>(*sim_, source, hand_settings);
     grasping_ = std::make_unique<interaction::Grasping>(*sim_, *hand_);
     for (const MateSpec& m : scenario_.mates) grasping_->add_mate(m.mate);
