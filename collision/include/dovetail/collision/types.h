@@ -7,6 +7,8 @@
 #include <array>
 #include <cstdint>
 
+#include "dovetail/collision/fp_guard.h"
+
 namespace dovetail::collision {
 
 /// The one scalar type of the project (see docs/CONVENTIONS.md).
