@@ -1,0 +1,3 @@
+-- And modules.
+local m = require "socket"
+return scenario { name = "hostile", parts = { a = part { shape = box { size = { 1, 1, 1 } } } }, duration = 0.1 }

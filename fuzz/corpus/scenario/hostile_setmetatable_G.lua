@@ -1,0 +1,3 @@
+-- The environment's metatable is protected.
+setmetatable(_G, nil)
+return scenario { name = "hostile", parts = { a = part { shape = box { size = { 1, 1, 1 } } } }, duration = 0.1 }

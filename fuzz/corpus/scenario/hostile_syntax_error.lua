@@ -1,0 +1,2 @@
+-- A syntax error.
+return scenario { name = "broken" parts = {} }
