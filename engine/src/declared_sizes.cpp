@@ -348,7 +348,13 @@ std::optional<std::string> check_declared_sizes(const std::filesystem::path& pat
   const std::string head = read_head(path, kHeadBytes);
   const std::string extension = lower(path.extension().string());
 
-  if (head.size() >= 4 && head.compare(0, 3, "ply") == 0 && (head[3] == '\n' || head[3] == '\r')) {
+  // The PLY reader takes any file that starts with "ply", whatever follows on
+  // that line (a first line "ply?" made it hang), and any .ply file whatever
+  // its first line, so all of them are checked.
+  if (head.compare(0, 3, "ply") == 0 || extension == ".ply") {
+    if (head.size() < 4 || (head[3] != '\n' && head[3] != '\r')) {
+      return std::string("PLY header line 1: expected 'ply' alone on the line");
+    }
     return check_ply(head, file_size, limits);
   }
   if (extension == ".stl") return check_binary_stl(head, file_size, limits);

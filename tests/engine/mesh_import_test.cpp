@@ -333,6 +333,20 @@ TEST(MeshImport, PlyDeclaringHundredMillionVerticesFailsFast) {
   EXPECT_NE(fast_error(dir / "overflow.ply").find("overflow.ply"), std::string::npos);
 }
 
+// Found by fuzz/ (fuzz_mesh_ply): a first line "ply?" bypassed the header
+// check and the PLY reader spun on the malformed header that followed.
+TEST(MeshImport, PlyMagicWithSuffixIsRefusedFast) {
+  const std::string message = fast_error(kData / "ply_magic_with_suffix.ply");
+  EXPECT_NE(message.find("line 1: expected 'ply' alone on the line"), std::string::npos) << message;
+}
+
+// From fuzz/ (fuzz_mesh_ply): a .ply file without the "ply" line reached the
+// PLY reader; it is refused before, as malformed headers are.
+TEST(MeshImport, PlyWithoutMagicIsRefusedFast) {
+  const std::string message = fast_error(kData / "ply_without_magic.ply");
+  EXPECT_NE(message.find("line 1: expected 'ply' alone on the line"), std::string::npos) << message;
+}
+
 // Malformed PLY headers once made the importer hang or crash; they are refused
 // before it runs, naming the header line.
 TEST(MeshImport, MalformedPlyHeadersAreRefused) {
@@ -371,6 +385,9 @@ TEST(MeshImport, MalformedPlyHeadersAreRefused) {
        "line 2: invalid format line"},
       {"no_format.ply", "ply\n" + vertex + "property float z\n" + face + "end_header\n" + body,
        "no format line"},
+      {"magic_suffix.ply",
+       "ply?\nformat ascii 1.0\n" + vertex + "property float z\n" + face + "end_header\n" + body,
+       "line 1: expected 'ply' alone on the line"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
