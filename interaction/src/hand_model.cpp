@@ -285,11 +285,13 @@ HandPose HandModel::forward_kinematics(const JointAngles& q) const {
 
   pose.X_HS[index_of(Segment::kPalm)] = Transform::identity();
 
-  // Thumb: opposition roll about the palm's long axis, abduction about its normal.
+  // Thumb: opposition roll about the palm's long axis, abduction about its normal, the
+  // metacarpal's fixed pronation about its own axis.
   Transform X_HT;
   X_HT.t = Vec3(P::kThumbBase[0], P::kThumbBase[1], P::kThumbBase[2]) * hl;
   X_HT.R = rotation_z_deg(at(q, Joint::kThumbRoll)) *
-           rotation_y_deg(P::kThumbRestDeg + at(q, Joint::kThumbAbd));
+           rotation_y_deg(P::kThumbRestDeg + at(q, Joint::kThumbAbd)) *
+           rotation_z_deg(P::kThumbPronationDeg);
   const std::array<Real, 3> thumb = {0, at(q, Joint::kThumbMcp), at(q, Joint::kThumbIp)};
   chain(X_HT, Segment::kThumbMetacarpal, thumb, 0);
 

@@ -113,11 +113,14 @@ GloveSample sample_from_openxr(const XrHandFrame& frame) {
   s.q_WH = engine::quaternion_from_rotation(X_WH.R);
   JointAngles& q = s.joints;
 
-  // Thumb: its metacarpal in H is Rz(roll) Ry(rest + abduction).
+  // Thumb: its metacarpal in H is Rz(roll) Ry(rest + abduction) Rz(pronation), so its
+  // Z axis, which the twist about the bone leaves alone, is
+  // (cos roll sin a, sin roll sin a, cos a) with a = rest + abduction in (0, 180).
   const Mat3 M_thumb = relative(X_WH, X[xr(XrJoint::kThumbMetacarpal)]);
-  at(q, Joint::kThumbRoll) = std::atan2(-M_thumb(0, 1), M_thumb(1, 1)) * kDegreesPerRadian;
-  at(q, Joint::kThumbAbd) = std::atan2(-M_thumb(2, 0), M_thumb(2, 2)) * kDegreesPerRadian -
-                            HandProportions::kThumbRestDeg;
+  at(q, Joint::kThumbRoll) = std::atan2(M_thumb(1, 2), M_thumb(0, 2)) * kDegreesPerRadian;
+  at(q, Joint::kThumbAbd) =
+      std::atan2(std::hypot(M_thumb(0, 2), M_thumb(1, 2)), M_thumb(2, 2)) * kDegreesPerRadian -
+      HandProportions::kThumbRestDeg;
   at(q, Joint::kThumbMcp) =
       -angle_about_x(relative(X[xr(XrJoint::kThumbMetacarpal)], X[xr(XrJoint::kThumbProximal)]));
   at(q, Joint::kThumbIp) =

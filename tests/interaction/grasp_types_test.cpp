@@ -1,11 +1,14 @@
-// Natural grasping: a designed glove plan grasps a bar with a power grasp,
-// holds it while the hand moves and releases it when the hand opens; an open
-// hand brushing past a part grasps nothing.
+// Natural grasping: designed glove plans grasp a bar with a power grasp, a pin
+// between the thumb's and index's tips with a precision grasp and a washer-sized
+// disc between the thumb and two fingertips with a 3-point pinch; each is held
+// while the hand moves and released when the hand opens. An open hand brushing
+// past a part grasps nothing.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "dovetail/collision/primitives.h"
 #include "dovetail/interaction/glove_source.h"
@@ -36,6 +39,8 @@ struct GraspRun {
   std::vector<Event> events;
   Vec3 moved = Vec3::Zero();  ///< how far the part moved
   std::optional<GraspType> type_while_moving;
+  Real off_X_HO = 0;  ///< largest distance of the held part from its grasp pose in the hand
+  int frames_held = 0;
   std::vector<GloveSample> recorded;
   std::uint64_t state_hash = 0;
 };
@@ -64,6 +69,14 @@ GraspRun run_grasp(engine::PartDesc part, const JointAngles& posture,
     const engine::FrameResult& r = sim.step();
     run.events.insert(run.events.end(), r.events.begin(), r.events.end());
     if (frame == 100) run.type_while_moving = grasping.grasp_type();
+    if (grasping.held() == name) {
+      // The part's pose in the hand against the X_HO frozen at the grasp (points of a
+      // 50 mm part move by the translation plus 25 mm times the turn).
+      const Transform X_HO = engine::compose(hand.X_WH().inverse(), sim.scene().world_pose(name));
+      const Real turn = Eigen::AngleAxis<Real>(X_HO.R * grasping.X_HO().R.transpose()).angle();
+      run.off_X_HO = std::max(run.off_X_HO, (X_HO.t - grasping.X_HO().t).norm() + 0.025 * turn);
+      ++run.frames_held;
+    }
   }
   run.moved = sim.scene().world_pose(name).t - start;
   run.recorded = hand.recorded();
@@ -90,6 +103,32 @@ void expect_carried(const GraspRun& run, const std::string& part, const std::str
   EXPECT_EQ(std::string(grasp_type_name(*run.type_while_moving)), type);
   EXPECT_TRUE(released(run, part));
   EXPECT_NEAR(run.moved.y(), 0.05, 2e-3) << "the part went up with the hand";
+  EXPECT_GT(run.frames_held, 45) << "held through the lift";
+  EXPECT_LT(run.off_X_HO, 1e-6) << "the part kept its pose in the hand";
+}
+
+/// A posture with every angle scaled by s: the open hand at 0, the posture at 1,
+/// and between them the path of the simulated glove's close step.
+JointAngles part_way(const JointAngles& posture, Real s) {
+  JointAngles q = posture;
+  for (Real& angle : q) angle *= s;
+  return q;
+}
+
+/// The first s at which `gap` (decreasing while the hand closes) comes down to `target`
+/// on the way from the open hand to `posture`, by bisection.
+Real closed_to(const HandModel& hand, const JointAngles& posture, Real target,
+               const std::function<Real(const HandPose&)>& gap) {
+  Real open = 0, closed = 1;
+  for (int i = 0; i < 60; ++i) {
+    const Real mid = (open + closed) / 2;
+    (gap(hand.forward_kinematics(part_way(posture, mid))) > target ? open : closed) = mid;
+  }
+  return open;
+}
+
+const Transform& pose_of(const HandPose& pose, Segment segment) {
+  return pose.X_HS[static_cast<std::size_t>(segment)];
 }
 
 TEST(GraspTypes, ABarAcrossThePalmIsAPowerGrasp) {
@@ -97,6 +136,58 @@ TEST(GraspTypes, ABarAcrossThePalmIsAPowerGrasp) {
       cylinder_part("bar", 0.022, 0.08, Vec3(0.02, -0.0105 - 0.022 - 0.0001, -0.06), Vec3::UnitX()),
       *named_posture("power"));
   expect_carried(run, "bar", "power");
+}
+
+TEST(GraspTypes, APinBetweenTheThumbAndIndexTipsIsAPrecisionGrasp) {
+  // On the way to the pinch posture the thumb's and index's tips come 6 mm apart (the
+  // ends of their bones are the bones' closest points there); a pin 6 mm across and 40 mm
+  // long lies between them, across the index's fingertip. The glove closes to the pinch,
+  // and each digit stops on the pin.
+  const HandModel hand;
+  const JointAngles pinch = *named_posture("pinch");
+  const Real r_thumb = hand.radius(Segment::kThumbDistal);
+  const Real r_index = hand.radius(Segment::kIndexDistal);
+  const Real s = closed_to(hand, pinch, 0.006, [&](const HandPose& pose) {
+    return (pose.p_HTip[1] - pose.p_HTip[0]).norm() - r_thumb - r_index;
+  });
+  const HandPose pose = hand.forward_kinematics(part_way(pinch, s));
+  const Vec3 u = (pose.p_HTip[1] - pose.p_HTip[0]).normalized();
+  const Vec3 across = pose_of(pose, Segment::kIndexDistal).R.col(0);
+  const GraspRun run =
+      run_grasp(cylinder_part("pin", 0.003, 0.04, pose.p_HTip[0] + u * (r_thumb + 0.003),
+                              across - u * u.dot(across)),
+                pinch);
+  expect_carried(run, "pin", "precision");
+}
+
+TEST(GraspTypes, AWasherSizedDiscBetweenTheThumbAndTwoFingertipsIsATripod) {
+  // A disc the size of an M12 washer, 24 mm across and 3 mm thick; solid, because the
+  // thumb's pad meets it below the middle of the index and middle pads (about 16 mm apart),
+  // where a washer has its 13 mm hole. On the way to the tripod posture the thumb's tip
+  // comes 3 mm from the plane that touches the index and middle tips; the disc lies
+  // between, centred on the thumb's tip, its faces parallel to the line between the index
+  // and middle tips.
+  const HandModel hand;
+  const JointAngles tripod = *named_posture("tripod");
+  const Real r_thumb = hand.radius(Segment::kThumbDistal);
+  const Real r_finger = hand.radius(Segment::kIndexDistal);
+  ASSERT_EQ(hand.radius(Segment::kMiddleDistal), r_finger);
+  // The disc's normal: from the thumb's tip toward the middle of the two fingertips,
+  // square to the line between them.
+  auto normal = [](const HandPose& pose) {
+    const Vec3 across = (pose.p_HTip[2] - pose.p_HTip[1]).normalized();
+    const Vec3 to_pair = (pose.p_HTip[1] + pose.p_HTip[2]) / 2 - pose.p_HTip[0];
+    return Vec3((to_pair - across * across.dot(to_pair)).normalized());
+  };
+  const Real s = closed_to(hand, tripod, 0.003, [&](const HandPose& pose) {
+    return ((pose.p_HTip[1] + pose.p_HTip[2]) / 2 - pose.p_HTip[0]).dot(normal(pose)) - r_thumb -
+           r_finger;
+  });
+  const HandPose pose = hand.forward_kinematics(part_way(tripod, s));
+  const Vec3 n = normal(pose);
+  const GraspRun run = run_grasp(
+      cylinder_part("disc", 0.012, 0.003, pose.p_HTip[0] + n * (r_thumb + 0.0015), n), tripod);
+  expect_carried(run, "disc", "tripod");
 }
 
 TEST(GraspTypes, AGraspRecordedAndReplayedFromItsTraceIsTheSameRun) {

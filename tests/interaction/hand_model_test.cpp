@@ -41,11 +41,13 @@ Vec3 finger_tip(std::size_t f, Real hl, Real mcp, Real pip, Real dip, Real sprea
   return rz(-arch_deg, knuckle + ry(spread, chain));
 }
 
+/// The thumb in its own plane, turned by the metacarpal's pronation about its axis, then by
+/// abduction and roll.
 Vec3 thumb_tip(Real hl, Real roll, Real abd, Real mcp, Real ip) {
   const Vec3 base(P::kThumbBase[0] * hl, P::kThumbBase[1] * hl, P::kThumbBase[2] * hl);
   const Vec3 chain = P::kThumb[0] * hl * bone(0) + P::kThumb[1] * hl * bone(mcp) +
                      P::kThumb[2] * hl * bone(mcp + ip);
-  return base + rz(roll, ry(P::kThumbRestDeg + abd, chain));
+  return base + rz(roll, ry(P::kThumbRestDeg + abd, rz(P::kThumbPronationDeg, chain)));
 }
 
 void expect_near(const Vec3& actual, const Vec3& expected, const char* what) {
@@ -93,18 +95,67 @@ TEST_P(HandKinematics, FistFingertips) {
   expect_near(pose.p_HTip[0], thumb_tip(hl, 40, 10, 50, 40), "thumb");
 }
 
+/// The angle between two vectors in degrees.
+Real angle_deg(const Vec3& a, const Vec3& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b)) / kRad;
+}
+
 TEST_P(HandKinematics, PinchFingertips) {
   const HandModel hand({.size = GetParam()});
   const Real hl = hand.hand_length();
   const HandPose pose = hand.forward_kinematics(*named_posture("pinch"));
-  expect_near(pose.p_HTip[1], finger_tip(0, hl, 50, 60, 20, 0, 0), "index");
+  expect_near(pose.p_HTip[1], finger_tip(0, hl, 60, 30, 5, 0, 0), "index");
   expect_near(pose.p_HTip[2], finger_tip(1, hl, 10, 10, 5, 0, 0), "middle");
-  expect_near(pose.p_HTip[0], thumb_tip(hl, 60, 0, 10, 5), "thumb");
-  // The tips' capsule ends come within a few millimetres of each other.
+  expect_near(pose.p_HTip[0], thumb_tip(hl, 75, 15, 10, 10), "thumb");
+  // The tips' capsules meet: their ends are the closest points of the two bones here, and
+  // they are less than half a millimetre apart.
   const Real pads = hand.radius(Segment::kThumbDistal) + hand.radius(Segment::kIndexDistal);
-  const Real gap = (pose.p_HTip[0] - pose.p_HTip[1]).norm();
-  EXPECT_GT(gap, pads);
-  EXPECT_LT(gap, pads + 0.003);
+  const Vec3 thumb_to_index = pose.p_HTip[1] - pose.p_HTip[0];
+  EXPECT_GT(thumb_to_index.norm(), pads);
+  EXPECT_LT(thumb_to_index.norm(), pads + 0.0005);
+  // Pad to pad: each pad (-Y of the distal segment) faces the other tip within 50 degrees;
+  // the thumb's metacarpal is pronated, so its pad faces the index across the palm.
+  const Vec3 thumb_pad = -pose.X_HS[static_cast<std::size_t>(Segment::kThumbDistal)].R.col(1);
+  const Vec3 index_pad = -pose.X_HS[static_cast<std::size_t>(Segment::kIndexDistal)].R.col(1);
+  EXPECT_LT(angle_deg(thumb_pad, thumb_to_index), 50);
+  EXPECT_LT(angle_deg(index_pad, -thumb_to_index), 50);
+}
+
+TEST_P(HandKinematics, TripodFingertips) {
+  const HandModel hand({.size = GetParam()});
+  const Real hl = hand.hand_length();
+  const JointAngles tripod = *named_posture("tripod");
+  const HandPose pose = hand.forward_kinematics(tripod);
+  // The index is drawn 10 degrees toward the middle finger.
+  expect_near(pose.p_HTip[1], finger_tip(0, hl, 40, 60, 30, -10, 0), "index");
+  expect_near(pose.p_HTip[2], finger_tip(1, hl, 40, 70, 0, 0, 0), "middle");
+  expect_near(pose.p_HTip[0], thumb_tip(hl, 85, 15, 10, 15), "thumb");
+  // The thumb's tip lies below the middle of the index and middle tips (2 mm off it along
+  // the line between them, the tips 17 to 20 mm apart), and its pad faces them.
+  const Vec3 across = pose.p_HTip[2] - pose.p_HTip[1];
+  const Vec3 to_pair = (pose.p_HTip[1] + pose.p_HTip[2]) / 2 - pose.p_HTip[0];
+  EXPECT_LT(std::abs(to_pair.dot(across.normalized())), across.norm() / 6);
+  const Vec3 thumb_pad = -pose.X_HS[static_cast<std::size_t>(Segment::kThumbDistal)].R.col(1);
+  EXPECT_LT(angle_deg(thumb_pad, to_pair), 50);
+}
+
+TEST(HandModel, TheThumbIsPronatedAboutItsMetacarpal) {
+  // Flat hand: the metacarpal points 35 degrees away from the index in the palm's plane and
+  // is turned 25 degrees about its own axis, so the thumb flexes toward the fingers as well
+  // as toward the palm.
+  const HandModel hand;
+  const HandPose pose = hand.forward_kinematics(JointAngles{});
+  const Transform& X_HM = pose.X_HS[static_cast<std::size_t>(Segment::kThumbMetacarpal)];
+  const Real rest = P::kThumbRestDeg * kRad;
+  const Vec3 axis = -X_HM.R.col(2);
+  EXPECT_NEAR((axis - Vec3(-std::sin(rest), 0, -std::cos(rest))).norm(), 0, 1e-14);
+  const Vec3 flexion_side = -X_HM.R.col(1);
+  const Real pronation = P::kThumbPronationDeg * kRad;
+  EXPECT_NEAR((flexion_side - Vec3(std::cos(rest) * std::sin(pronation), -std::cos(pronation),
+                                   -std::sin(rest) * std::sin(pronation)))
+                  .norm(),
+              0, 1e-14);
+  EXPECT_GT(flexion_side.x(), 0) << "toward the fingers";
 }
 
 TEST_P(HandKinematics, SpreadAndArch) {

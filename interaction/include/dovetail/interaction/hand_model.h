@@ -16,7 +16,9 @@
 /// segment's proximal joint with its bone along -Z and +Y on the back of the
 /// finger. Flexion turns a segment toward the palm (-Y), abduction spreads a
 /// finger away from the middle finger, palm arch cups the ring and little
-/// metacarpals toward the palm. Segment lengths are Buchholz, Armstrong and
+/// metacarpals toward the palm. The thumb's metacarpal is pronated about its
+/// own axis, so the thumb flexes, and its pad faces, toward the fingers as
+/// well as toward the palm. Segment lengths are Buchholz, Armstrong and
 /// Goldstein's coefficients times the hand length (wrist crease to the tip
 /// of the middle finger). The tracker is on the hand, so the wrist angles
 /// are carried and limited but move no segment (the forearm is not modelled).
@@ -108,10 +110,15 @@ struct HandProportions {
   /// Spacing of the fingers across the palm: index..pinky at x = (-1.5,
   /// -0.5, 0.5, 1.5) * kSpacing.
   static constexpr Real kSpacing = 0.11;
-  /// Thumb carpometacarpal joint in H.
-  static constexpr std::array<Real, 3> kThumbBase = {-0.12, -0.03, -0.05};
+  /// Thumb carpometacarpal joint in H: on the palm's radial side (the index
+  /// ray is at x = -0.165), at its palmar face (y = -0.055), a little distal
+  /// of the fingers' carpometacarpal joints (z = -0.072).
+  static constexpr std::array<Real, 3> kThumbBase = {-0.18, -0.05, -0.10};
   /// Thumb metacarpal's rest angle away from the index (degrees, about +Y).
   static constexpr Real kThumbRestDeg = 35;
+  /// Pronation of the thumb metacarpal about its own long axis (degrees):
+  /// it turns the thumb's flexion plane, and its pad, toward the fingers.
+  static constexpr Real kThumbPronationDeg = 25;
   /// Share of palm_arch at the ring and little metacarpals.
   static constexpr Real kArchRing = 0.5;
   static constexpr Real kArchPinky = 1.0;
