@@ -518,7 +518,15 @@ class ExactHull {
   Real plane_height(std::uint32_t f, const Vec3& q) const {
     const TriangleIndices& t = faces_[f].v;
     const Vec3 n = (p_[t[1]] - p_[t[0]]).cross(p_[t[2]] - p_[t[0]]);
-    return n.dot(q - p_[t[0]]) / n.norm();
+    const Real above = n.dot(q - p_[t[0]]);
+    const Real length = n.norm();
+    if (length == 0) {
+      // A sliver whose rounded normal vanishes: the IEEE quotient, spelt out
+      // (the walk only uses it to choose a direction; sees() decides).
+      constexpr Real kInf = std::numeric_limits<Real>::infinity();
+      return above > 0 ? kInf : above < 0 ? -kInf : std::numeric_limits<Real>::quiet_NaN();
+    }
+    return above / length;
   }
   bool sees(std::uint32_t f, const Vec3& q) const {
     const TriangleIndices& t = faces_[f].v;
