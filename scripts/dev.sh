@@ -7,6 +7,8 @@
 #   scripts/dev.sh bench   build, then run the polygon-level benchmark on built-in meshes
 #   scripts/dev.sh tsan    build the collision, interaction and scripting tests with ThreadSanitizer
 #                          (build-tsan/) and run the parallel ones
+#   scripts/dev.sh asan    build everything with AddressSanitizer and UndefinedBehaviorSanitizer
+#                          (build-asan/) and run every test
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores),
 # DOVETAIL_WERROR=ON to treat warnings as errors (CI does).
 set -eu
@@ -33,6 +35,21 @@ if [ "$command" = tsan ]; then
   exit 0
 fi
 
+if [ "$command" = asan ]; then
+  # Any undefined behaviour stops the test (no recovery); a float division by
+  # zero counts as undefined here too.
+  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDOVETAIL_SANITIZE=address,undefined \
+    -DCMAKE_CXX_FLAGS="-fno-sanitize-recover=all -fsanitize=float-divide-by-zero" \
+    -DDOVETAIL_BUILD_BENCH=OFF -DDOVETAIL_WERROR="${DOVETAIL_WERROR:-OFF}" >/dev/null
+  cmake --build build-asan -j "$jobs"
+  # Leaks inside Mesa's software renderer are not Dovetail's (scripts/lsan.supp).
+  ASAN_OPTIONS="detect_leaks=1:abort_on_error=1 ${ASAN_OPTIONS:-}" \
+    LSAN_OPTIONS="suppressions=$here/scripts/lsan.supp:print_suppressions=0 ${LSAN_OPTIONS:-}" \
+    UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1 ${UBSAN_OPTIONS:-}" \
+    ctest --test-dir build-asan --output-on-failure -j "$jobs"
+  exit 0
+fi
+
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DDOVETAIL_WERROR="${DOVETAIL_WERROR:-OFF}" >/dev/null
 cmake --build "$build_dir" -j "$jobs"
 
@@ -41,5 +58,5 @@ case "$command" in
   run) "$build_dir/apps/dovetail" run --report "$build_dir/run/report.json" --render "$build_dir/run" ;;
   test) ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" ;;
   bench) "$build_dir/bench/polygon_bench" ;;
-  *) echo "dev.sh: unknown command '$command' (run, test, build, bench, tsan)" >&2; exit 2 ;;
+  *) echo "dev.sh: unknown command '$command' (run, test, build, bench, tsan, asan)" >&2; exit 2 ;;
 esac
