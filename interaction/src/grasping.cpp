@@ -498,20 +498,40 @@ void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
     const PartHandle p = scene.find(mate.part), o = scene.find(mate.other);
     if (!p.valid() || !o.valid()) continue;
     const Transform X_WP = scene.world_pose(p), X_WO = scene.world_pose(o);
-    const Vec3 p_W = X_WP.apply(mate.p_PF), q_W = X_WO.apply(mate.p_OF);
-    const Vec3 a_W = (X_WP.R * mate.axis_P).normalized(), b_W = (X_WO.R * mate.axis_O).normalized();
-    const Real angle = std::atan2(a_W.cross(b_W).norm(), a_W.dot(b_W)) / kDegree;
-    if ((p_W - q_W).norm() > mate.position_tolerance || angle > mate.angle_tolerance_deg) continue;
-    // The least turn of a onto b, then the point onto the point.
-    const Mat3 R = rotation_from_vector(a_W.cross(b_W).normalized() * (angle * kDegree));
-    Transform X_new;
-    X_new.R = angle > 0 ? Mat3(R * X_WP.R) : X_WP.R;
-    X_new.t = q_W - X_new.R * mate.p_PF;
-    scene.set_world_pose(p, X_new);
+    if (!within_tolerance(mate, X_WP, X_WO)) continue;
+    scene.set_world_pose(p, mate_pose(mate, X_WP, X_WO));
     pending_.push_back(
         {EventKind::kMate, simulation.frame(), simulation.time(), mate.part, mate.other});
     return;
   }
+}
+
+MateOffset mate_offset(const Mate& mate, const Transform& X_WP, const Transform& X_WO) {
+  const Vec3 a_W = (X_WP.R * mate.axis_P).normalized(), b_W = (X_WO.R * mate.axis_O).normalized();
+  return {(X_WP.apply(mate.p_PF) - X_WO.apply(mate.p_OF)).norm(),
+          std::atan2(a_W.cross(b_W).norm(), a_W.dot(b_W)) / kDegree};
+}
+
+bool within_tolerance(const Mate& mate, const Transform& X_WP, const Transform& X_WO) {
+  const MateOffset offset = mate_offset(mate, X_WP, X_WO);
+  return offset.distance_m <= mate.position_tolerance &&
+         offset.angle_deg <= mate.angle_tolerance_deg;
+}
+
+Transform mate_pose(const Mate& mate, const Transform& X_WP, const Transform& X_WO) {
+  const Vec3 a_W = (X_WP.R * mate.axis_P).normalized(), b_W = (X_WO.R * mate.axis_O).normalized();
+  const Real angle = std::atan2(a_W.cross(b_W).norm(), a_W.dot(b_W)) / kDegree;
+  Transform X_new;
+  X_new.R = X_WP.R;
+  if (angle > 0) {
+    // The least turn of a onto b; opposite axes turn half a turn about a normal of a.
+    const Vec3 cross = a_W.cross(b_W);
+    const Vec3 turn_axis = cross.norm() > 0 ? Vec3(cross.normalized()) : Vec3(a_W.unitOrthogonal());
+    X_new.R = rotation_from_vector(turn_axis * (angle * kDegree)) * X_WP.R;
+  }
+  // Then the point onto the point.
+  X_new.t = X_WO.apply(mate.p_OF) - X_new.R * mate.p_PF;
+  return X_new;
 }
 
 }  // namespace dovetail::interaction

@@ -411,17 +411,8 @@ void Runner::apply(const Clause& action, double now) {
     scene.set_parent(scene.get(a), PartHandle{}, true);
   } else if (w == "snap") {
     const interaction::Mate& m = mate(a)->mate;
-    const Transform X_WP = scene.world_pose(m.part), X_WO = scene.world_pose(m.other);
-    const Vec3 a_W = (X_WP.R * m.axis_P).normalized(), b_W = (X_WO.R * m.axis_O).normalized();
-    const Vec3 axis = a_W.cross(b_W);
-    const double angle = std::atan2(axis.norm(), a_W.dot(b_W));
-    Transform X = X_WP;
-    if (axis.norm() > 0)
-      X.R = Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix() * X_WP.R;
-    else if (angle > 1)
-      X.R = Eigen::AngleAxisd(std::numbers::pi, a_W.unitOrthogonal()).toRotationMatrix() * X_WP.R;
-    X.t = X_WO.apply(m.p_OF) - X.R * m.p_PF;
-    scene.set_world_pose(scene.get(m.part), X);
+    scene.set_world_pose(scene.get(m.part), interaction::mate_pose(m, scene.world_pose(m.part),
+                                                                   scene.world_pose(m.other)));
     injected_.push_back({EventKind::kMate, sim_->frame(), now, m.part, m.other});
   } else if (w == "complete") {
     for (std::size_t i = 0; i < scenario_.steps.size(); ++i) {
@@ -437,11 +428,7 @@ void Runner::apply(const Clause& action, double now) {
 
 bool Runner::near(const interaction::Mate& m) const {
   const engine::Scene& scene = sim_->scene();
-  const Transform X_WP = scene.world_pose(m.part), X_WO = scene.world_pose(m.other);
-  const Vec3 a_W = (X_WP.R * m.axis_P).normalized(), b_W = (X_WO.R * m.axis_O).normalized();
-  const double angle = std::atan2(a_W.cross(b_W).norm(), a_W.dot(b_W)) * 180 / std::numbers::pi;
-  return (X_WP.apply(m.p_PF) - X_WO.apply(m.p_OF)).norm() <= m.position_tolerance &&
-         angle <= m.angle_tolerance_deg;
+  return interaction::within_tolerance(m, scene.world_pose(m.part), scene.world_pose(m.other));
 }
 
 bool Runner::holds(const Clause& state) const {

@@ -89,6 +89,21 @@ struct Mate {
   Real angle_tolerance_deg = 5;
 };
 
+/// How far a mate's part is from its place: the distance between the two
+/// feature points (metres) and the angle between the two axes (degrees).
+struct MateOffset {
+  Real distance_m = 0;
+  Real angle_deg = 0;
+};
+/// The offset with the part at X_WP and the other at X_WO.
+MateOffset mate_offset(const Mate& mate, const Transform& X_WP, const Transform& X_WO);
+/// Whether the part at X_WP is within the mate's tolerances: released now, it would snap.
+bool within_tolerance(const Mate& mate, const Transform& X_WP, const Transform& X_WO);
+/// The part's pose in place: X_WP turned by the least rotation that brings its
+/// axis onto the other's (half a turn about an axis normal to both when they
+/// are opposite), then moved so the two feature points meet.
+Transform mate_pose(const Mate& mate, const Transform& X_WP, const Transform& X_WO);
+
 /// What the interaction of one hand does, and its settings.
 struct InteractionSettings {
   GraspSettings grasp{};
