@@ -503,6 +503,21 @@ class Loader {
     return collision::make_mesh(std::move(vertices), std::move(triangles), path.string());
   }
 
+  /// The sorted names of a table of named declarations, such as
+  /// `parts = { peg = part { ... } }`; `noun` is "part", `example` its example.
+  std::vector<std::string> declaration_names(int map, const SourceLocation& where,
+                                             const std::string& field, const std::string& noun,
+                                             const std::string& example) {
+    if (lua_type(L_, map) != LUA_TTABLE || !word_of(map).empty()) {
+      fail(where, "scenario: " + field + " must be a table of named " + noun + "s: " + example);
+    }
+    std::vector<std::string> names;
+    std::vector<lua_Integer> positions;
+    keys_of(map, names, positions, where, field);
+    if (!positions.empty()) fail(where, field + ": every " + noun + " needs a name: " + example);
+    return names;
+  }
+
   void read_scenario_fields(int table, const SourceLocation& where);
   void read_parts(int map, const SourceLocation& where);
   std::shared_ptr<const collision::Mesh> read_shape(int index, const SourceLocation& where,
@@ -513,8 +528,12 @@ class Loader {
   void read_steps(int list, const SourceLocation& where);
   void read_rules(int list, const SourceLocation& where);
   void read_expectations(int list, const SourceLocation& where);
+  /// Every name a clause may refer to, by kind.
+  struct Names {
+    std::vector<std::string> parts, mates, steps, regions;
+  };
   void resolve();
-  void resolve_clause(const Clause& clause);
+  void resolve_clause(const Clause& clause, const Names& names);
 
   LuaHost& host_;
   lua_State* L_;
@@ -622,14 +641,8 @@ void Loader::read_scenario_fields(int table, const SourceLocation& where) {
 }
 
 void Loader::read_parts(int map, const SourceLocation& where) {
-  if (lua_type(L_, map) != LUA_TTABLE || !word_of(map).empty()) {
-    fail(where, "scenario: parts must be a table of named parts: parts = { peg = part { ... } }");
-  }
-  std::vector<std::string> names;
-  std::vector<lua_Integer> positions;
-  keys_of(map, names, positions, where, "parts");
-  if (!positions.empty())
-    fail(where, "parts: every part needs a name: parts = { peg = part { ... } }");
+  const std::vector<std::string> names =
+      declaration_names(map, where, "parts", "part", "parts = { peg = part { ... } }");
   if (names.empty()) fail(where, "scenario: parts is empty");
   const Word& word = *find_word("part");
   for (const std::string& name : names) {
@@ -744,14 +757,8 @@ std::shared_ptr<const collision::Mesh> Loader::read_shape(int index, const Sourc
 }
 
 void Loader::read_mates(int map, const SourceLocation& where) {
-  std::vector<std::string> names;
-  std::vector<lua_Integer> positions;
-  if (lua_type(L_, map) != LUA_TTABLE || !word_of(map).empty()) {
-    fail(where, "scenario: mates must be a table of named mates: mates = { fit = mate { ... } }");
-  }
-  keys_of(map, names, positions, where, "mates");
-  if (!positions.empty())
-    fail(where, "mates: every mate needs a name: mates = { fit = mate { ... } }");
+  const std::vector<std::string> names =
+      declaration_names(map, where, "mates", "mate", "mates = { fit = mate { ... } }");
   const Word& word = *find_word("mate");
   for (const std::string& name : names) {
     raw_getfield(map, name.c_str());
@@ -779,14 +786,8 @@ void Loader::read_mates(int map, const SourceLocation& where) {
 }
 
 void Loader::read_regions(int map, const SourceLocation& where) {
-  std::vector<std::string> names;
-  std::vector<lua_Integer> positions;
-  if (lua_type(L_, map) != LUA_TTABLE || !word_of(map).empty()) {
-    fail(where, "scenario: regions must be a table of named regions");
-  }
-  keys_of(map, names, positions, where, "regions");
-  if (!positions.empty())
-    fail(where, "regions: every region needs a name: regions = { tray = region { ... } }");
+  const std::vector<std::string> names =
+      declaration_names(map, where, "regions", "region", "regions = { tray = region { ... } }");
   const Word& word = *find_word("region");
   for (const std::string& name : names) {
     raw_getfield(map, name.c_str());
@@ -972,12 +973,8 @@ void Loader::read_expectations(int list, const SourceLocation& where) {
   }
 }
 
-void Loader::resolve_clause(const Clause& clause) {
-  std::vector<std::string> parts, mates, steps, regions;
-  for (const PartSpec& p : scenario_.parts) parts.push_back(p.name);
-  for (const MateSpec& m : scenario_.mates) mates.push_back(m.mate.name);
-  for (const StepSpec& s : scenario_.steps) steps.push_back(s.name);
-  for (const RegionSpec& r : scenario_.regions) regions.push_back(r.region.name);
+void Loader::resolve_clause(const Clause& clause, const Names& names) {
+  const auto& [parts, mates, steps, regions] = names;
   auto check = [&](const std::string& name, const std::vector<std::string>& known,
                    const char* kind) {
     if (std::find(known.begin(), known.end(), name) == known.end()) {
@@ -1021,8 +1018,12 @@ void Loader::resolve_clause(const Clause& clause) {
 }
 
 void Loader::resolve() {
-  std::vector<std::string> parts;
-  for (const PartSpec& p : scenario_.parts) parts.push_back(p.name);
+  Names names;
+  for (const PartSpec& p : scenario_.parts) names.parts.push_back(p.name);
+  for (const MateSpec& m : scenario_.mates) names.mates.push_back(m.mate.name);
+  for (const StepSpec& s : scenario_.steps) names.steps.push_back(s.name);
+  for (const RegionSpec& r : scenario_.regions) names.regions.push_back(r.region.name);
+  const std::vector<std::string>& parts = names.parts;
   auto fixed = [&](const std::string& name) {
     for (const PartSpec& p : scenario_.parts) {
       if (p.name == name) return p.fixed;
@@ -1075,22 +1076,22 @@ void Loader::resolve() {
   };
   for (const StepSpec& s : scenario_.steps) {
     if (s.done) {
-      resolve_clause(*s.done);
+      resolve_clause(*s.done, names);
       can_never(*s.done, "step '" + s.name + "': ");
     }
   }
   for (const RuleSpec& r : scenario_.rules) {
-    resolve_clause(r.when);
+    resolve_clause(r.when, names);
     can_never(r.when, "rule: ");
-    if (r.unless) resolve_clause(*r.unless);
+    if (r.unless) resolve_clause(*r.unless, names);
     if (r.only_if) {
-      resolve_clause(*r.only_if);
+      resolve_clause(*r.only_if, names);
       can_never(*r.only_if, "rule: ");
     }
-    for (const Clause& c : r.act) resolve_clause(c);
+    for (const Clause& c : r.act) resolve_clause(c, names);
   }
   for (const Clause& c : scenario_.expectations) {
-    resolve_clause(c);
+    resolve_clause(c, names);
     can_never(c, "expectation: ");
   }
 }
