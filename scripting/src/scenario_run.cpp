@@ -62,8 +62,6 @@ std::pair<std::string, std::string> ordered(const std::string& a, const std::str
   return a < b ? std::pair(a, b) : std::pair(b, a);
 }
 
-bool is_hand_part(const std::string& name) { return name.rfind("hand.", 0) == 0; }
-
 constexpr const char* kRunnerKey = "dovetail.runner";
 constexpr std::array<float, 3> kHighlight = {1.0F, 0.55F, 0.0F};
 
@@ -86,7 +84,7 @@ class Runner {
   void build();
   void start_frame(std::uint64_t frame, double t);
   void end_frame(const engine::FrameResult& result, double previous_time);
-  std::vector<Occurrence> occurrences(const engine::FrameResult& result, double previous_time);
+  std::vector<Occurrence> occurrences(const engine::FrameResult& result);
   bool matches(const Clause& when, const Occurrence& o) const;
   bool timer_fires(const Clause& when, double now, double previous) const;
   bool holds(const Clause& state) const;
@@ -126,7 +124,6 @@ class Runner {
     double t0, t1;
   };
   std::vector<Motion> motions_;
-  std::vector<std::pair<std::string, double>> grasps_;  ///< part + type, time
   std::map<const collision::Mesh*, std::shared_ptr<const collision::CollisionModel>> models_;
   std::optional<engine::Camera> camera_;
   /// Poses at which each touching pair's depth was last measured.
@@ -455,7 +452,7 @@ bool Runner::holds(const Clause& state) const {
   return false;
 }
 
-std::vector<Occurrence> Runner::occurrences(const engine::FrameResult& result, double) {
+std::vector<Occurrence> Runner::occurrences(const engine::FrameResult& result) {
   std::vector<Occurrence> out;
   for (const Event& e : result.events) {
     switch (e.kind) {
@@ -478,7 +475,6 @@ std::vector<Occurrence> Runner::occurrences(const engine::FrameResult& result, d
         if (--hand_touching_[e.b] == 0) out.push_back({Happening::kSeparate, "hand", e.b});
         break;
       case EventKind::kGrasp:
-        grasps_.push_back({e.a + "\n" + e.b, e.time});
         out.push_back({Happening::kGrasp, e.a, e.b});
         break;
       case EventKind::kRelease:
@@ -576,7 +572,6 @@ void Runner::complete_step(std::size_t i, double now, std::vector<Occurrence>& o
 void Runner::measure_penetration(double now) {
   const engine::Scene& scene = sim_->scene();
   for (const auto& [a, b] : touching_) {
-    if (is_hand_part(a) || is_hand_part(b)) continue;  // the hand passes through parts
     const PartHandle pa = scene.find(a), pb = scene.find(b);
     if (!pa.valid() || !pb.valid()) continue;
     const auto& ma = scene.collision_mesh(pa);
@@ -611,7 +606,7 @@ void Runner::measure_penetration(double now) {
 
 void Runner::end_frame(const engine::FrameResult& result, double previous_time) {
   const double now = result.time;
-  std::vector<Occurrence> happened = occurrences(result, previous_time);
+  std::vector<Occurrence> happened = occurrences(result);
   measure_penetration(now);
   // Steps first: their completions are events the rules of this frame see.
   for (const std::size_t i : forced_steps_) complete_step(i, now, happened);
@@ -760,22 +755,25 @@ void Runner::evaluate_expectations() {
         e.detail = "snapped at t=" + format_time(at) + " s";
       }
     } else if (w == "grasped_as") {
-      const std::string key = args[0].text + "\n" + args[1].text;
-      const auto it = std::find_if(grasps_.begin(), grasps_.end(),
-                                   [&](const auto& g) { return g.first == key; });
-      if (it == grasps_.end()) {
-        e.passed = false;
-        std::string seen;
-        for (const auto& g : grasps_) {
-          if (g.first.rfind(args[0].text + "\n", 0) == 0) {
-            seen = "; it was grasped as " + g.first.substr(args[0].text.size() + 1) +
-                   " at t=" + format_time(g.second) + " s";
-            break;
-          }
+      // The timeline's grasp events: a = the part, b = the grasp type.
+      const Event* as_asked = nullptr;
+      const Event* other = nullptr;
+      for (const Event& ev : sim_->report().events) {
+        if (ev.kind != EventKind::kGrasp || ev.a != args[0].text) continue;
+        if (ev.b == args[1].text) {
+          as_asked = &ev;
+          break;
         }
-        e.detail = "'" + args[0].text + "' was never grasped as " + args[1].text + seen;
+        if (!other) other = &ev;
+      }
+      if (as_asked) {
+        e.detail = "at t=" + format_time(as_asked->time) + " s";
       } else {
-        e.detail = "at t=" + format_time(it->second) + " s";
+        e.passed = false;
+        e.detail =
+            "'" + args[0].text + "' was never grasped as " + args[1].text +
+            (other ? "; it was grasped as " + other->b + " at t=" + format_time(other->time) + " s"
+                   : std::string());
       }
     }
     out_.expectations.push_back(std::move(e));

@@ -294,6 +294,32 @@ TEST(ScenarioLoad, NodesOfAMeshFileBecomeTheirOwnParts) {
   }
 }
 
+TEST(ScenarioRun, AGraspIsCheckedByItsType) {
+  // The bar of the power-grasp test (44 mm across, under the palm of the hand at
+  // the origin), closed on, lifted and let go by the simulated glove.
+  const test::TempDir dir("dovetail_scenario");
+  std::ofstream(dir / "grasp.plan")
+      << "close 0.5 power\nwait 0.2\nreach 0.5 0 0.05 0 1 0 0 0\nopen 0.4\nwait 0.2\n";
+  const auto file = write(dir, "grasp.lua", R"(return scenario {
+  name = "bar", units = "mm",
+  parts = { bar = part { shape = cylinder { diameter = 44, length = 80 }, at = { -20, -32.6, -60 }, turn = { y = 90 } } },
+  hand = glove { plan = "grasp.plan" },
+  rules = { rule { when = grasped("bar", "power"), act = { log "power" } } },
+  expect = { grasped_as("bar", "power"), grasped_as("bar", "precision") },
+})");
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed) << o.failure_summary() << o.error;
+  ASSERT_EQ(o.expectations.size(), 2u);
+  EXPECT_TRUE(o.expectations[0].passed) << o.expectations[0].detail;
+  EXPECT_FALSE(o.expectations[1].passed);
+  EXPECT_NE(o.expectations[1].detail.find(
+                "'bar' was never grasped as precision; it was grasped as power at t="),
+            std::string::npos)
+      << o.expectations[1].detail;
+  ASSERT_EQ(o.messages.size(), 1u);
+  EXPECT_EQ(o.messages[0].text, "power");
+}
+
 TEST(ShippedScenarios, PegInHolePassesAndGivesTheSameReportAtAnyThreadCountAndOnReplay) {
   const test::TempDir dir("dovetail_scenario");
   RunOptions options;
