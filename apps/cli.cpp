@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -219,6 +220,25 @@ BuiltModel build_timed(collision::Method method, std::shared_ptr<const collision
   built.model = collision::build_model(method, std::move(mesh));
   built.build_ms = ms_since(start);
   return built;
+}
+
+std::vector<std::filesystem::path> scenario_files(const std::filesystem::path& folder) {
+  std::vector<std::filesystem::path> files;
+  std::error_code ec;
+  for (auto it = std::filesystem::directory_iterator(folder, ec);
+       !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
+    if (it->is_regular_file(ec) && it->path().extension() == ".lua") files.push_back(it->path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+void make_folder(const std::filesystem::path& folder) {
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  if (!std::filesystem::is_directory(folder, ec)) {
+    throw InputError(folder.string() + ": cannot create the folder");
+  }
 }
 
 bool stderr_is_terminal() { return isatty(STDERR_FILENO) != 0; }

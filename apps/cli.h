@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
@@ -105,6 +106,14 @@ struct BuiltModel {
   double build_ms = 0;
 };
 BuiltModel build_timed(collision::Method method, std::shared_ptr<const collision::Mesh> mesh);
+
+/// The `*.lua` files directly in `folder` (not its subfolders), in file-name
+/// order; none when it is not a readable folder.
+std::vector<std::filesystem::path> scenario_files(const std::filesystem::path& folder);
+
+/// Creates `folder` and its parents when missing; InputError naming it when
+/// it cannot be made.
+void make_folder(const std::filesystem::path& folder);
 
 /// True when stderr is a terminal (progress is shown only then).
 bool stderr_is_terminal();

@@ -129,8 +129,7 @@ std::string first_reason(const Job& job) {
 
 void start(Job& job, const std::filesystem::path& out, int threads) {
   const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe");
-  const std::filesystem::path folder = out / job.stem;
-  std::filesystem::create_directories(folder);
+  const std::filesystem::path folder = out / job.stem;  // `run --render` makes it
   std::vector<std::string> args = {self.string(),
                                    "run",
                                    job.file.string(),
@@ -262,7 +261,8 @@ details{margin:.5em 0}
       h += "<table><tr><th>step</th><th>done at (s)</th></tr>\n";
       for (const auto& s : r["steps"]) {
         h += "<tr><td>" + html_text(s.value("name", "")) + "</td><td>" +
-             (s["done_at"].is_number() ? format_seconds(s["done_at"].get<double>()) : std::string("not done")) +
+             (s["done_at"].is_number() ? format_seconds(s["done_at"].get<double>())
+                                       : std::string("not done")) +
              (s.value("out_of_order", false) ? " (out of order)" : "") + "</td></tr>\n";
       }
       h += "</table>\n";
@@ -273,9 +273,10 @@ details{margin:.5em 0}
           "<details><summary>event timeline (" + std::to_string(events.size()) +
           " events)</summary><table><tr><th>time (s)</th><th>event</th><th>a</th><th>b</th></tr>\n";
       for (const auto& e : events) {
-        h += "<tr><td>" + (e["time"].is_number() ? format_seconds(e["time"].get<double>()) : std::string()) +
-             "</td><td>" + html_text(e.value("kind", "")) +
-             "</td><td>" + html_text(e.value("a", "")) + "</td><td>" + html_text(e.value("b", "")) +
+        h += "<tr><td>" +
+             (e["time"].is_number() ? format_seconds(e["time"].get<double>()) : std::string()) +
+             "</td><td>" + html_text(e.value("kind", "")) + "</td><td>" +
+             html_text(e.value("a", "")) + "</td><td>" + html_text(e.value("b", "")) +
              "</td></tr>\n";
       }
       h += "</table></details>\n";
@@ -315,17 +316,8 @@ int regress_command(std::span<const std::string> argv) {
     shard_k = k;
     shard_n = n;
   }
-  std::error_code ec;
-  std::filesystem::create_directories(out, ec);
-  if (!std::filesystem::is_directory(out))
-    throw InputError(out.string() + ": cannot create the folder");
-
-  std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-    if (entry.is_regular_file() && entry.path().extension() == ".lua")
-      files.push_back(entry.path());
-  }
-  std::sort(files.begin(), files.end());
+  make_folder(out);
+  const std::vector<std::filesystem::path> files = scenario_files(folder);
   std::vector<Job> jobs;
   for (std::size_t i = 0; i < files.size(); ++i) {
     if (i % shard_n != shard_k - 1) continue;

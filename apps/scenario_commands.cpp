@@ -64,13 +64,7 @@ std::filesystem::path default_scenario() {
   folders.emplace_back(DOVETAIL_SCENARIO_DIR);
 #endif
   for (const auto& folder : folders) {
-    std::error_code ec;
-    if (!std::filesystem::is_directory(folder, ec)) continue;
-    std::vector<std::filesystem::path> files;
-    for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
-      if (entry.path().extension() == ".lua") files.push_back(entry.path());
-    }
-    std::sort(files.begin(), files.end());
+    const std::vector<std::filesystem::path> files = scenario_files(folder);
     if (!files.empty()) return files.front();
   }
   throw UsageError(
@@ -84,9 +78,7 @@ int run_scenario_command(const Args& args, const std::filesystem::path& scenario
   if (auto v = args.value("record")) options.record = *v;
   if (auto v = args.value("render")) {
     options.render_dir = *v;
-    std::error_code ec;
-    std::filesystem::create_directories(*v, ec);
-    if (!std::filesystem::is_directory(*v)) throw InputError(*v + ": cannot create the folder");
+    make_folder(*v);
   }
   options.render_every = args.unsigned_integer("every").value_or(0);
   if (options.render_every > 0 && !options.render_dir)
