@@ -1,6 +1,8 @@
 // Hand benchmark: what the glove-driven hand costs per frame.
 //
-//   hand_bench [--runs R] [--detail pairs|triangles|both] [--pictures DIR]
+//   hand_bench [--runs R] [--detail pairs|triangles|both] [--pictures DIR] [--slow MS]
+// --slow MS lists the sliding frames slower than MS milliseconds, with their
+// sub-steps, collision queries and contacts.
 //
 // One collision thread. Each scene is a 10,000-triangle part and the hand,
 // driven by the simulated glove through a plan that approaches, closes
@@ -32,6 +34,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <numbers>
@@ -248,7 +251,7 @@ void grasp_picture(const std::string& pictures) {
                   : "no grasp");
 }
 
-void sliding(int runs, const std::string& pictures, bool pair_guided) {
+void sliding(int runs, const std::string& pictures, bool pair_guided, double slow_ms) {
   constexpr Real kTop = 0.03, kDepth = 0.04, kLength = 0.06;
   const auto block = std::make_shared<const collision::Mesh>(
       collision::make_block_with_hole(Vec3(0.04, kTop, 0.04), 0.01025, kDepth, 64));
@@ -288,6 +291,13 @@ void sliding(int runs, const std::string& pictures, bool pair_guided) {
       const engine::FrameResult& r = sim.step();
       if (grasping.held() && grasping.last_slide().status != interaction::SlideStatus::kReached) {
         in_contact.push_back(grasping.stats().frame_ms);
+        if (slow_ms > 0 && grasping.stats().frame_ms > slow_ms) {
+          const interaction::SlideResult& s = grasping.last_slide();
+          std::printf(
+              "  slow frame %d: %.3f ms, %d sub-steps, %d queries, %d new contacts of %zu\n", frame,
+              grasping.stats().frame_ms, s.substeps, s.collision_queries, s.new_contacts,
+              s.contacts.size());
+        }
       }
       for (const engine::Event& e : r.events) mated += e.kind == engine::EventKind::kMate;
       if (run == 0 && !pictures.empty() && (frame == 30 || frame == 100)) {
@@ -319,6 +329,7 @@ void sliding(int runs, const std::string& pictures, bool pair_guided) {
 int main(int argc, char** argv) {
   int runs = 5;
   std::string detail = "both";
+  double slow_ms = 0;    // list sliding frames slower than this (0: none)
   std::string pictures;  // folder for PNGs of the sliding peg
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -326,12 +337,14 @@ int main(int argc, char** argv) {
       runs = std::max(1, std::atoi(argv[++i]));
     } else if (arg == "--pictures" && i + 1 < argc) {
       pictures = argv[++i];
+    } else if (arg == "--slow" && i + 1 < argc) {
+      slow_ms = std::atof(argv[++i]);
     } else if (arg == "--detail" && i + 1 < argc) {
       detail = argv[++i];
     } else {
-      std::fprintf(
-          stderr,
-          "usage: hand_bench [--runs R] [--detail pairs|triangles|both] [--pictures DIR]\n");
+      std::fprintf(stderr,
+                   "usage: hand_bench [--runs R] [--detail pairs|triangles|both] [--pictures DIR] "
+                   "[--slow MS]\n");
       return 2;
     }
   }
@@ -370,8 +383,8 @@ int main(int argc, char** argv) {
     }
   }
   fk_only();
-  sliding(runs, "", false);
-  sliding(runs, pictures, true);
+  sliding(runs, "", false, slow_ms);
+  sliding(runs, pictures, true, slow_ms);
   if (!pictures.empty()) grasp_picture(pictures);
   return 0;
 }

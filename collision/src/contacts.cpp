@@ -77,54 +77,148 @@ Real depth_behind(const detail::TriangleVertices& face, const Vec3& n,
   return depth;
 }
 
-/// Quick test before the piece: every vertex of each triangle within `tolerance` of the other's
-/// plane.
-bool nearly_coplanar(const detail::TriangleVertices& t_a, const detail::TriangleVertices& t_b,
-                     Real tolerance) {
-  const Vec3 n_a = (t_a[1] - t_a[0]).cross(t_a[2] - t_a[0]).normalized();
-  const Vec3 n_b = (t_b[1] - t_b[0]).cross(t_b[2] - t_b[0]).normalized();
-  for (int i = 0; i < 3; ++i) {
-    if (std::abs((t_b[i] - t_a[0]).dot(n_a)) > tolerance) return false;
-    if (std::abs((t_a[i] - t_b[0]).dot(n_b)) > tolerance) return false;
+/// The geometry the coplanar search asks for again and again, computed once
+/// per triangle and vertex it meets: B's vertices mapped into A's frame by the
+/// same Transform::apply as the collision query, and each triangle's unit
+/// normal in A's frame.
+class CoplanarGeometry {
+ public:
+  CoplanarGeometry(const Mesh& a, const Mesh& b, const Transform& X_AB)
+      : a_(a),
+        b_(b),
+        X_AB_(X_AB),
+        b_vertices_(b.vertices.size()),
+        b_mapped_(b.vertices.size(), 0),
+        normals_a_(a.triangles.size()),
+        normals_b_(b.triangles.size()),
+        has_normal_a_(a.triangles.size(), 0),
+        has_normal_b_(b.triangles.size(), 0) {}
+
+  detail::TriangleVertices triangle_a(std::uint32_t t) const {
+    const TriangleIndices& f = a_.triangles[t];
+    return {a_.vertices[f[0]], a_.vertices[f[1]], a_.vertices[f[2]]};
   }
-  return true;
-}
+  detail::TriangleVertices triangle_b(std::uint32_t t) {
+    const TriangleIndices& f = b_.triangles[t];
+    return {vertex_b(f[0]), vertex_b(f[1]), vertex_b(f[2])};
+  }
+
+  /// Every vertex of each triangle within `tolerance` of the other's plane.
+  bool nearly_coplanar(std::uint32_t ta, std::uint32_t tb, Real tolerance) {
+    const Vec3& n_a = normal(ta, has_normal_a_, normals_a_, triangle_a(ta));
+    const Vec3& n_b = normal(tb, has_normal_b_, normals_b_, triangle_b(tb));
+    const TriangleIndices& fa = a_.triangles[ta];
+    const TriangleIndices& fb = b_.triangles[tb];
+    const Vec3& a0 = a_.vertices[fa[0]];
+    const Vec3& b0 = vertex_b(fb[0]);
+    for (int i = 0; i < 3; ++i) {
+      if (std::abs((vertex_b(fb[i]) - a0).dot(n_a)) > tolerance) return false;
+      if (std::abs((a_.vertices[fa[i]] - b0).dot(n_b)) > tolerance) return false;
+    }
+    return true;
+  }
+
+ private:
+  const Vec3& vertex_b(std::uint32_t v) {
+    if (!b_mapped_[v]) {
+      b_vertices_[v] = X_AB_.apply(b_.vertices[v]);
+      b_mapped_[v] = 1;
+    }
+    return b_vertices_[v];
+  }
+
+  static const Vec3& normal(std::uint32_t t, std::vector<char>& known, std::vector<Vec3>& normals,
+                            const detail::TriangleVertices& v) {
+    if (!known[t]) {
+      normals[t] = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+      known[t] = 1;
+    }
+    return normals[t];
+  }
+
+  const Mesh& a_;
+  const Mesh& b_;
+  const Transform& X_AB_;
+  std::vector<Vec3> b_vertices_;
+  std::vector<char> b_mapped_;
+  std::vector<Vec3> normals_a_, normals_b_;
+  std::vector<char> has_normal_a_, has_normal_b_;
+};
 
 /// Adds the pairs of faces that lie on each other within the coplanar
 /// tolerance but that the exact test separates by a rounding-size gap
 /// (faces of a rotated part resting on another): starting next to the
 /// reported pairs, pairs one triangle step apart are tried, and every pair
-/// found with an overlap of positive area spreads the search further.
+/// found with an overlap of positive area spreads the search further. The
+/// pairs found are appended in (a, b) order.
+///
+/// A vertex shared by many triangles (the centre of a fanned cap) puts each
+/// of them next to every pair of the fan, so the same candidate comes up
+/// from many pairs; a candidate just tried with the same partner is skipped
+/// (one partner remembered per triangle), and the plane test, on cached
+/// vertices and normals, comes before the set of pairs already tried.
 void add_nearly_coplanar_pairs(const Mesh& a, const Mesh& b, const Transform& X_AB, Real tolerance,
                                const VertexTriangles& around_a, const VertexTriangles& around_b,
                                std::vector<TrianglePair>& pairs, std::vector<PairPiece>& pieces) {
   const auto key = [](std::uint32_t ta, std::uint32_t tb) {
     return (static_cast<std::uint64_t>(ta) << 32) | tb;
   };
-  std::unordered_set<std::uint64_t> seen;
-  for (const TrianglePair& p : pairs) seen.insert(key(p.a, p.b));
-  std::vector<TrianglePair> queue;
-  const auto spread = [&](const TrianglePair& p) {
-    around_a.around(a.triangles[p.a], [&](std::uint32_t t) { queue.push_back({t, p.b}); });
-    around_b.around(b.triangles[p.b], [&](std::uint32_t t) { queue.push_back({p.a, t}); });
-  };
-  for (std::size_t i = 0; i < pairs.size(); ++i) spread(pairs[i]);
-  while (!queue.empty()) {
-    const TrianglePair p = queue.back();
-    queue.pop_back();
-    if (!seen.insert(key(p.a, p.b)).second) continue;
+  std::unordered_set<std::uint64_t> tried;
+  for (const TrianglePair& p : pairs) tried.insert(key(p.a, p.b));
+  CoplanarGeometry geometry(a, b, X_AB);
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> last_b_of_a(a.triangles.size(), kNone);
+  std::vector<std::uint32_t> last_a_of_b(b.triangles.size(), kNone);
+  const std::size_t first_found = pairs.size();
+  const auto consider = [&](std::uint32_t ta, std::uint32_t tb) {
+    if (!geometry.nearly_coplanar(ta, tb, tolerance)) return;
+    if (!tried.insert(key(ta, tb)).second) return;
     PairPiece candidate;
-    for (int k = 0; k < 3; ++k) {
-      candidate.t_a[k] = a.vertices[a.triangles[p.a][k]];
-      candidate.t_b[k] = X_AB.apply(b.vertices[b.triangles[p.b][k]]);
-    }
-    if (!nearly_coplanar(candidate.t_a, candidate.t_b, tolerance)) continue;
+    candidate.t_a = geometry.triangle_a(ta);
+    candidate.t_b = geometry.triangle_b(tb);
     candidate.piece = detail::intersect_triangles(candidate.t_a, candidate.t_b, tolerance);
-    if (candidate.piece.area <= 0) continue;
-    pairs.push_back(p);
+    if (candidate.piece.area <= 0) return;
+    pairs.push_back({ta, tb});
     pieces.push_back(std::move(candidate));
-    spread(p);
+  };
+  // The pairs found join the end of the list and spread in their turn. A
+  // vertex whose triangles were all tried with the same partner is skipped whole.
+  std::vector<std::uint32_t> row_done_a(a.vertices.size(), kNone);
+  std::vector<std::uint32_t> row_done_b(b.vertices.size(), kNone);
+  const auto spread = [&](const VertexTriangles& around, const TriangleIndices& f,
+                          std::uint32_t partner, std::vector<std::uint32_t>& row_done,
+                          std::vector<std::uint32_t>& last_partner, auto&& try_pair) {
+    for (const std::uint32_t v : f) {
+      if (row_done[v] == partner) continue;
+      row_done[v] = partner;
+      for (std::uint32_t k = around.offsets[v]; k < around.offsets[v + 1]; ++k) {
+        const std::uint32_t t = around.triangles[k];
+        if (last_partner[t] == partner) continue;
+        last_partner[t] = partner;
+        try_pair(t);
+      }
+    }
+  };
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const TrianglePair p = pairs[i];
+    spread(around_a, a.triangles[p.a], p.b, row_done_a, last_b_of_a,
+           [&](std::uint32_t t) { consider(t, p.b); });
+    spread(around_b, b.triangles[p.b], p.a, row_done_b, last_a_of_b,
+           [&](std::uint32_t t) { consider(p.a, t); });
   }
+  // The order of the search is not the result's: the pairs found in pair order.
+  std::vector<std::size_t> order(pairs.size() - first_found);
+  std::iota(order.begin(), order.end(), first_found);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t i, std::size_t j) { return pairs[i] < pairs[j]; });
+  std::vector<TrianglePair> found_pairs;
+  std::vector<PairPiece> found_pieces;
+  for (const std::size_t i : order) {
+    found_pairs.push_back(pairs[i]);
+    found_pieces.push_back(std::move(pieces[i]));
+  }
+  std::copy(found_pairs.begin(), found_pairs.end(), pairs.begin() + first_found);
+  std::move(found_pieces.begin(), found_pieces.end(), pieces.begin() + first_found);
 }
 
 /// Closed segment [v, w] against closed triangle t: do they share a point?
@@ -525,9 +619,13 @@ std::vector<ContactPatch> compute_contacts(const Mesh& a, const Mesh& b, const T
   const Real merge = std::max(request.merge_distance, 1e-9 * scale);
   for (PairPiece& p : pieces)
     p.piece = detail::intersect_triangles(p.t_a, p.t_b, coplanar_tolerance);
-  const VertexTriangles around_a(a);
-  const VertexTriangles around_b(b);
-  add_nearly_coplanar_pairs(a, b, X_AB, coplanar_tolerance, around_a, around_b, pairs, pieces);
+  // The surfaces' neighbourhoods, for the coplanar search and the depth.
+  const bool walks = request.nearly_coplanar_pairs || request.estimate_depth;
+  const VertexTriangles around_a = walks ? VertexTriangles(a) : VertexTriangles();
+  const VertexTriangles around_b = walks ? VertexTriangles(b) : VertexTriangles();
+  if (request.nearly_coplanar_pairs) {
+    add_nearly_coplanar_pairs(a, b, X_AB, coplanar_tolerance, around_a, around_b, pairs, pieces);
+  }
   for (PairPiece& p : pieces) {
     p.lo = p.hi = p.piece.points.front();
     for (const Vec3& x : p.piece.points) {

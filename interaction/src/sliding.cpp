@@ -51,8 +51,8 @@ void contacts_at(const SlideRequest& request, const Transform& X_WP_free, const 
   for (const SlideObstacle& o : request.obstacles) {
     const Transform X_OP = engine::compose(o.X_WO.inverse(), X_WP_hit);
     ++queries;
-    const std::vector<collision::ContactPatch> patches =
-        collision::compute_contacts(*o.model, *request.part, X_OP, {.estimate_depth = false});
+    const std::vector<collision::ContactPatch> patches = collision::compute_contacts(
+        *o.model, *request.part, X_OP, {.estimate_depth = false, .nearly_coplanar_pairs = false});
     const collision::Mesh& obstacle_mesh = o.model->mesh();
     for (const collision::ContactPatch& patch : patches) {
       const std::size_t first = out.size();

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -473,6 +474,53 @@ TEST(Contacts, NearlyCoplanarFacesInARotatedFrame) {
   EXPECT_EQ(sunk[0].kind, ContactKind::kCurve);
   EXPECT_NEAR(sunk[0].depth, 1e-6, 1e-12);
   EXPECT_TRUE(sunk[0].penetrating);
+}
+
+TEST(Contacts, FannedCapRestingInARotatedFrameIsOneFacePatchOnlyWithTheCoplanarSearch) {
+  // A cylinder whose caps are fans of 64 slivers stands on a box, both turned
+  // by one general rotation: the cap lies on the top up to rounding. The
+  // search for nearly coplanar pairs finds the whole cap (the exact test sees
+  // only some of its slivers touching); without it, the patch is made of the
+  // intersecting pairs alone, a subset.
+  const Mat3 Q = Eigen::AngleAxis<Real>(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  const Mesh box_a = make_box(Vec3(2, 2, 1));
+  std::vector<Vec3> va;
+  for (const Vec3& p : box_a.vertices) va.push_back(Q * p);
+  const auto a = model(make_mesh(va, box_a.triangles, "rotated box"));
+  constexpr int kSides = 64;
+  constexpr Real kRadius = 0.4;
+  const Mesh cylinder = make_cylinder(kRadius, 0.5, kSides);
+  Real bottom = std::numeric_limits<Real>::infinity();
+  for (const Vec3& p : cylinder.vertices) bottom = std::min(bottom, p.z());
+  const auto b = model(cylinder);
+  Transform X;
+  X.R = Q;
+  X.t = Q * Vec3(0.3, -0.2, 1 - bottom);
+  const std::vector<ContactPatch> searched = compute_contacts(*a, *b, X);
+  const std::vector<ContactPatch> exact_only =
+      compute_contacts(*a, *b, X, {.nearly_coplanar_pairs = false});
+  ASSERT_EQ(searched.size(), 1u);
+  EXPECT_EQ(searched[0].kind, ContactKind::kFace);
+  const Real cap_area = 0.5 * kSides * kRadius * kRadius * std::sin(2 * std::numbers::pi / kSides);
+  EXPECT_NEAR(searched[0].area, cap_area, 1e-9);
+  expect_near(searched[0].normal, Q * Vec3(0, 0, 1), 1e-9);
+  std::vector<TrianglePair> exact_pairs;
+  for (const ContactPatch& patch : exact_only) {
+    exact_pairs.insert(exact_pairs.end(), patch.pairs.begin(), patch.pairs.end());
+  }
+  std::sort(exact_pairs.begin(), exact_pairs.end());
+  EXPECT_LT(exact_pairs.size(), searched[0].pairs.size());
+  EXPECT_TRUE(std::includes(searched[0].pairs.begin(), searched[0].pairs.end(), exact_pairs.begin(),
+                            exact_pairs.end()));
+  // The search's result does not depend on where it starts: from the
+  // intersecting pairs given in reverse order, the same patch to the bit.
+  const CollideResult hits = a->collide(*b, X, {.all_pairs = true});
+  std::vector<TrianglePair> reversed(hits.pairs.rbegin(), hits.pairs.rend());
+  const std::vector<ContactPatch> again = compute_contacts(a->mesh(), b->mesh(), X, reversed);
+  ASSERT_EQ(again.size(), 1u);
+  EXPECT_EQ(again[0].pairs, searched[0].pairs);
+  EXPECT_EQ(again[0].area, searched[0].area);
+  EXPECT_EQ(again[0].point, searched[0].point);
 }
 
 }  // namespace

@@ -36,6 +36,12 @@ struct ContactRequest {
   /// depth 0 and `penetrating` false for every patch, and the patch's pairs
   /// are the intersecting pairs and nearly coplanar neighbours as usual.
   bool estimate_depth = true;
+  /// Also look next to the intersecting pairs for faces that lie on each other
+  /// within `coplanar_tolerance` but that the exact test separates by a
+  /// rounding-size gap (a rotated part resting on another), so that a resting
+  /// face gives one face patch. False: the patches are made of the
+  /// intersecting pairs alone (cheaper when many pairs cross one plane).
+  bool nearly_coplanar_pairs = true;
 };
 
 /// How the surfaces meet in a patch.
