@@ -212,67 +212,6 @@ std::optional<std::string> check_ply(std::string_view head, std::uintmax_t file_
   return std::nullopt;
 }
 
-/// Words of an OFF header with `#` comments removed, up to `max_words`,
-/// with the offset just past the last word taken.
-std::vector<std::string_view> off_words(std::string_view head, std::size_t max_words,
-                                        std::size_t& end_offset) {
-  std::vector<std::string_view> words;
-  std::size_t i = 0;
-  while (i < head.size() && words.size() < max_words) {
-    const char c = head[i];
-    if (c == '#') {
-      while (i < head.size() && head[i] != '\n') ++i;
-      continue;
-    }
-    if (std::isspace(static_cast<unsigned char>(c))) {
-      ++i;
-      continue;
-    }
-    const std::size_t start = i;
-    while (i < head.size() && head[i] != '#' && !std::isspace(static_cast<unsigned char>(head[i])))
-      ++i;
-    words.push_back(head.substr(start, i - start));
-  }
-  end_offset = i;
-  return words;
-}
-
-std::optional<std::string> check_off(std::string_view head, std::uintmax_t file_size,
-                                     const collision::MeshLimits& limits) {
-  std::size_t end_offset = 0;
-  std::vector<std::string_view> w = off_words(head, 5, end_offset);
-  if (w.empty()) return std::nullopt;
-  const std::string keyword = lower(w[0]);
-  if (keyword.size() < 3 || keyword.size() > 6 || keyword.substr(keyword.size() - 3) != "off") {
-    return std::nullopt;
-  }
-  std::size_t first_count = 1;
-  if (keyword.front() == 'n') ++first_count;  // nOFF: the dimension comes first
-  if (w.size() < first_count + 2) return std::nullopt;
-  if (lower(w[1]) == "binary") return std::nullopt;
-  const Count vertices = parse_count(w[first_count]);
-  const Count faces = parse_count(w[first_count + 1]);
-  if (!vertices.valid || !faces.valid) return std::nullopt;  // the importer reports it
-  if (vertices.overflow || vertices.value > limits.max_vertices) {
-    return vertices.overflow ? std::string("OFF header declares a vertex count beyond 64 bits")
-                             : too_many(vertices.value, "vertices", limits.max_vertices);
-  }
-  if (faces.overflow || faces.value > limits.max_triangles) {
-    return faces.overflow ? std::string("OFF header declares a face count beyond 64 bits")
-                          : too_many(faces.value, "faces", limits.max_triangles);
-  }
-  // Find where the counts end to know how many bytes follow.
-  std::size_t counts_end = 0;
-  off_words(head, first_count + 2, counts_end);
-  const std::uintmax_t available = file_size > counts_end ? file_size - counts_end : 0;
-  // "0 0 0\n" per vertex, "0\n" per face at least.
-  long double needed = static_cast<long double>(vertices.value) * 6.0L +
-                       static_cast<long double>(faces.value) * 2.0L;
-  if (needed > 0) needed -= 1;
-  if (needed > static_cast<long double>(available)) return beyond_file("OFF", needed, available);
-  return std::nullopt;
-}
-
 std::optional<std::string> check_binary_stl(std::string_view head, std::uintmax_t file_size,
                                             const collision::MeshLimits& limits) {
   std::size_t i = 0;
@@ -359,7 +298,6 @@ std::optional<std::string> check_declared_sizes(const std::filesystem::path& pat
   }
   if (extension == ".stl") return check_binary_stl(head, file_size, limits);
   if (extension == ".obj") return check_obj(path, file_size, limits);
-  if (std::optional<std::string> off = check_off(head, file_size, limits)) return off;
   return std::nullopt;
 }
 

@@ -3,7 +3,7 @@
 /// Cheap checks of the sizes a mesh file declares, before any importer
 /// allocates for them.
 ///
-/// Why: PLY and OFF headers and binary STL state element counts up front, and
+/// Why: PLY headers and binary STL state element counts up front, and
 /// importers reserve memory for them. A 300-byte file claiming 10^11 vertices
 /// must be refused in microseconds, not after a failed multi-gigabyte
 /// allocation. Every element needs at least a few bytes, so the declared counts
@@ -19,7 +19,7 @@
 namespace dovetail::engine::detail {
 
 /// Reads the start of `path` (its size is `file_size` bytes) and, for formats
-/// that declare counts (PLY, OFF, binary STL) or may hold more vertices than
+/// that declare counts (PLY, binary STL) or may hold more vertices than
 /// the limits (OBJ over a size threshold), returns what is wrong with the
 /// declared sizes; nullopt when nothing is wrong or the format is not one of
 /// these (the importer decides then).

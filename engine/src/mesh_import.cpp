@@ -463,8 +463,24 @@ ImportReport import_scene(const fs::path& path, const aiScene& scene, const Impo
 
 }  // namespace
 
+/// The formats Dovetail reads: each reader assimp has is attack surface, so only
+/// those of parts and assemblies are let through, chosen by the file's
+/// extension (assimp would otherwise guess a reader from the content).
+void check_format(const fs::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* known : {".obj", ".stl", ".ply", ".gltf", ".glb"}) {
+    if (extension == known) return;
+  }
+  fail(path, (extension.empty() ? std::string("has no extension")
+                                : "is a format Dovetail does not read ('" + extension + "')") +
+                 "; meshes are read from .obj, .stl, .ply, .gltf and .glb files");
+}
+
 ImportReport import_file(const fs::path& path, const ImportOptions& options) {
   const std::uintmax_t size = check_file(path);
+  check_format(path);
   if (std::optional<std::string> wrong = detail::check_declared_sizes(path, size, options.limits)) {
     fail(path, *wrong);
   }
