@@ -42,6 +42,7 @@ commands:
   broadphase  overlapping pairs of moving boxes, frame by frame
   render    draw a mesh or assembly file to PNG (with the hand of a glove trace)
   glove     convert glove recordings, sample glove plans, check traces
+  capture   replay failure-capture files written by 'run --capture'
   version   print the version
 
 'dovetail <command> --help' describes a command.
@@ -78,6 +79,7 @@ constexpr Command kCommands[] = {
     {"broadphase", dovetail::cli::broadphase_command},
     {"render", dovetail::cli::render_command},
     {"glove", dovetail::cli::glove_command},
+    {"capture", dovetail::cli::capture_command},
     {"version", version_command},
 };
 

@@ -20,6 +20,7 @@ namespace {
 constexpr const char* kRunHelp =
     R"(usage: dovetail run [SCENARIO] [--trace T] [--record T] [--report R.json]
                     [--render DIR [--every N]] [--threads N] [--quiet]
+                    [--capture DIR [--cross-check METHOD]]
 
 Runs a Lua assembly scenario headless: the scene, the hand driven by the
 scenario's glove (or --trace), the rules and steps frame by frame, then checks
@@ -34,11 +35,19 @@ or its script fails. Without SCENARIO, runs the first shipped scenario
   --render DIR    write DIR/final.png, and with --every N every N-th frame
   --threads N     collision worker threads (default 1; the report is the same)
   --quiet         no progress meter and no summary on stdout
+  --capture DIR   failure capture: write every suspect collision query (a search
+                  stopped at its iteration cap, a pose that is not finite, a
+                  cross-check disagreement) with its inputs to DIR, to be
+                  replayed with 'dovetail capture FILE'
+  --cross-check METHOD
+                  with --capture: decide every exact pair a second time with
+                  METHOD (boxtree, dop6, dop14, dop18, dop26, aabb, obb, brute)
 )";
 
 constexpr const char* kReplayHelp =
     R"(usage: dovetail replay SCENARIO TRACE [--record T] [--report R.json]
                        [--render DIR [--every N]] [--threads N] [--quiet]
+                       [--capture DIR [--cross-check METHOD]]
 
 `dovetail run SCENARIO --trace TRACE`: replays a recorded glove trace in the
 scenario. A trace recorded by `run --record` gives the identical report.
@@ -86,6 +95,18 @@ int run_scenario_command(const Args& args, const std::filesystem::path& scenario
   options.threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
   const bool quiet = args.flag("quiet");
   options.progress = !quiet && stderr_is_terminal();
+  if (auto v = args.value("capture")) {
+    options.capture_dir = *v;
+    make_folder(*v);
+  }
+  if (auto v = args.value("cross-check")) {
+    if (!options.capture_dir) throw UsageError("run: --cross-check needs --capture DIR");
+    options.cross_check = collision::parse_method(*v);
+    if (!options.cross_check) {
+      throw UsageError("run: unknown --cross-check method '" + *v +
+                       "' (boxtree, dop6, dop14, dop18, dop26, aabb, obb, brute)");
+    }
+  }
   if (!std::filesystem::exists(scenario)) throw InputError(scenario.string() + ": no such file");
   if (options.trace && !std::filesystem::exists(*options.trace)) {
     throw InputError(options.trace->string() + ": no such file");
@@ -99,6 +120,11 @@ int run_scenario_command(const Args& args, const std::filesystem::path& scenario
     if (!out) throw InputError(*path + ": cannot be written");
   }
   for (const std::string& w : outcome.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  if (options.capture_dir && outcome.suspect_queries > 0) {
+    std::fprintf(stderr, "warning: %zu suspect collision queries, %zu capture files in %s\n",
+                 outcome.suspect_queries, outcome.captures.size(),
+                 options.capture_dir->string().c_str());
+  }
   const std::string failures = outcome.failure_summary();
   if (!failures.empty()) std::fputs(failures.c_str(), stderr);
   if (!quiet) {
@@ -135,8 +161,10 @@ int run_scenario_command(const Args& args, const std::filesystem::path& scenario
 }  // namespace
 
 int run_command(std::span<const std::string> argv) {
-  const Args args("run", argv, {"trace", "record", "report", "render", "every", "threads"},
-                  {"quiet"});
+  const Args args(
+      "run", argv,
+      {"trace", "record", "report", "render", "every", "threads", "capture", "cross-check"},
+      {"quiet"});
   if (args.help()) {
     std::fputs(kRunHelp, stdout);
     return kExitOk;
@@ -151,7 +179,9 @@ int run_command(std::span<const std::string> argv) {
 }
 
 int replay_command(std::span<const std::string> argv) {
-  const Args args("replay", argv, {"record", "report", "render", "every", "threads"}, {"quiet"});
+  const Args args("replay", argv,
+                  {"record", "report", "render", "every", "threads", "capture", "cross-check"},
+                  {"quiet"});
   if (args.help()) {
     std::fputs(kReplayHelp, stdout);
     return kExitOk;

@@ -22,6 +22,8 @@ namespace {
 struct Shape {
   std::shared_ptr<const Mesh> mesh;
   std::shared_ptr<const CollisionModel> model;  ///< polygon level, built for the first exact pair
+  /// The cross-check's polygon level (WorldSettings::cross_check), on first need.
+  std::shared_ptr<const CollisionModel> check_model;
   /// Distance hierarchy, built for the first exact distance query.
   std::shared_ptr<const DistanceModel> distance_model;
   std::shared_ptr<const ConvexHull> hull;  ///< convex level and tight world boxes
@@ -84,6 +86,7 @@ struct PairWork {
   bool convex_separated = false;
   bool cached_plane = false;
   bool polygon = false;
+  bool search_capped = false;  ///< the separating plane or GJK stopped at its iteration cap
   CollideResult result;
 };
 
@@ -102,6 +105,7 @@ struct CollisionWorld::Impl {
   std::vector<ProxyPair> candidates;
   std::vector<PairWork> work;
   StepResult result;
+  std::uint64_t steps = 0;  ///< step() calls so far, for the captures' context
 
   Part& part(PartId id) {
     if (id.index >= parts.size() || !parts[id.index].alive || parts[id.index].id != id) {
@@ -200,12 +204,16 @@ struct CollisionWorld::Impl {
           separating_plane_test(*a.shape->hull, *b.shape->hull, X_AB, w.state->plane);
       w.convex_tested = true;
       w.cached_plane = plane.cache_hit;
+      w.search_capped = plane.gave_up && !plane.overlap &&
+                        plane.iterations >= SeparatingPlaneSettings{}.max_iterations;
       if (plane.separated) {
         w.convex_separated = true;
         return false;
       }
       if (w.level == LevelOfDetail::kHull) {
-        w.colliding = gjk(*a.shape->hull, *b.shape->hull, X_AB, &w.state->gjk).intersecting;
+        const GjkResult g = gjk(*a.shape->hull, *b.shape->hull, X_AB, &w.state->gjk);
+        w.colliding = g.intersecting;
+        w.search_capped = w.search_capped || g.hit_iteration_cap;
         return false;
       }
     } else if (w.level == LevelOfDetail::kHull) {
@@ -435,6 +443,52 @@ struct CollisionWorld::Impl {
     build(todo, [&](Shape& shape) { ensure_model(shape); });
   }
 
+  /// Failure capture after the pairs are decided, serially and in pair
+  /// order (so the files do not depend on the threads): capped searches,
+  /// poses that are not finite, and the cross-check's disagreements.
+  void capture_suspects() {
+    for (const PairWork& w : work) {
+      const Part& a = parts[w.a];
+      const Part& b = parts[w.b];
+      const auto record = [&](CaptureKind kind, std::string what) {
+        settings.capture->record(
+            {.kind = kind,
+             .what = std::move(what),
+             .context = "step " + std::to_string(steps) + ": '" + a.name + "' and '" + b.name + "'",
+             .a = a.shape->mesh,
+             .b = b.shape->mesh,
+             .X_AB = relative(a.X_WP, b.X_WP)});
+      };
+      const bool finite = a.X_WP.R.allFinite() && a.X_WP.t.allFinite() && b.X_WP.R.allFinite() &&
+                          b.X_WP.t.allFinite();
+      if (!finite) {
+        record(CaptureKind::kNonFinite, "a part's pose is not finite");
+        continue;
+      }
+      if (w.search_capped) {
+        record(CaptureKind::kIterationCap,
+               w.level == LevelOfDetail::kHull
+                   ? "GJK or the separating-plane search stopped at its cap"
+                   : "the separating-plane search stopped at its cap");
+      }
+      if (!settings.cross_check || w.level != LevelOfDetail::kExact) continue;
+      if (!w.polygon && !w.convex_separated) continue;
+      for (Shape* shape : {a.shape.get(), b.shape.get()}) {
+        if (!shape->check_model)
+          shape->check_model = build_model(*settings.cross_check, shape->mesh);
+      }
+      const bool check =
+          a.shape->check_model->collide(*b.shape->check_model, relative(a.X_WP, b.X_WP)).colliding;
+      if (check == w.colliding) continue;
+      const std::string verdict = w.colliding ? "intersecting" : "separate";
+      const std::string other = check ? "intersecting" : "separate";
+      record(CaptureKind::kMethodsDisagree,
+             (w.polygon ? std::string(method_name(settings.method)) + " says " + verdict
+                        : std::string("the convex level separated the hulls")) +
+                 ", " + std::string(method_name(*settings.cross_check)) + " says " + other);
+    }
+  }
+
   const StepResult& step() {
     StepResult next;
     // 1. World boxes of new and moved parts; broad phase.
@@ -498,6 +552,9 @@ struct CollisionWorld::Impl {
       if (deferred[i]) heavy_pairs.push_back(i);
     }
     if (!heavy_pairs.empty()) evaluate_split(heavy_pairs);
+
+    if (settings.capture) capture_suspects();
+    ++steps;
 
     // 4. Gather in pair order: contacts sorted by (a, b, triangle_a, triangle_b).
     for (const PairWork& w : work) {

@@ -54,7 +54,9 @@ Simulation::Simulation(Scene scene, const SimulationSettings& settings)
                                .broadphase = settings_.broadphase,
                                .convex_level = settings_.convex_level,
                                .threads = settings_.collision_threads,
-                               .contacts = settings_.contacts});
+                               .contacts = settings_.contacts,
+                               .capture = settings_.capture,
+                               .cross_check = settings_.cross_check});
   std::vector<Event> ignored;
   commit(ignored, 0);
   state_hash_ = engine::state_hash(scene_);

@@ -101,6 +101,7 @@ class Runner {
   RunOutcome& out_;
   LuaHost host_;
   Scenario scenario_;
+  std::unique_ptr<collision::CaptureSink> capture_;  ///< outlives the simulation's world
   std::unique_ptr<engine::Simulation> sim_;
   std::unique_ptr<interaction::Hand> hand_;
   std::unique_ptr<interaction::Grasping> grasping_;
@@ -324,6 +325,11 @@ void Runner::build() {
   engine::SimulationSettings settings;
   settings.time_step = scenario_.time_step;
   settings.collision_threads = options_.threads;
+  if (options_.capture_dir) {
+    capture_ = std::make_unique<collision::CaptureSink>(*options_.capture_dir);
+    settings.capture = capture_.get();
+    settings.cross_check = options_.cross_check;
+  }
   sim_ = std::make_unique<engine::Simulation>(std::move(scene), settings);
   for (const RegionSpec& r : scenario_.regions) sim_->add_region(r.region);
   // Actions of the last frame, then moves in progress: before the hand and grasping.
@@ -847,6 +853,10 @@ void Runner::run() {
     const std::filesystem::path final_frame = *options_.render_dir / "final.png";
     render(final_frame);
     out_.final_frame = final_frame;
+  }
+  if (capture_) {
+    out_.captures = capture_->files();
+    out_.suspect_queries = capture_->recorded();
   }
   out_.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -100,3 +100,23 @@ dovetail_cli_test(run_missing_plan EXIT 1 ARGS run ${out}/missing_plan.lua --qui
 # the part again (and then crashed on a blocked slide with no contact). An open,
 # still hand grasps nothing now; the scenario's rule warns if it does.
 dovetail_cli_test(regrasp_after_snap EXIT 0 ARGS run ${scenario_data}/regrasp/regrasp_after_snap.lua --quiet)
+
+# ---- failure capture
+# A shipped scenario cross-checked with another method: nothing suspect, so no
+# warning and no capture file (the folder stays empty).
+dovetail_cli_test(run_capture_cross_check EXIT 0
+                  ARGS run ${scenarios}/01_peg_in_hole.lua --quiet --capture ${out}/captures
+                       --cross-check dop18
+                  STDERR "^$")
+dovetail_cli_test(run_cross_check_needs_capture EXIT 2
+                  ARGS run ${scenarios}/01_peg_in_hole.lua --cross-check dop18
+                  STDERR "--cross-check needs --capture DIR")
+dovetail_cli_test(run_cross_check_unknown EXIT 2
+                  ARGS run ${scenarios}/01_peg_in_hole.lua --capture ${out}/captures --cross-check fcl
+                  STDERR "unknown --cross-check method 'fcl'")
+dovetail_cli_test(capture_replay_checked_in EXIT 0
+                  ARGS capture ${data}/captures/resting-boxes-turned.capture
+                       ${data}/captures/touching-hulls.capture
+                  STDOUT "methods-disagree not reproduced: every method says intersecting&&iteration-cap not reproduced")
+dovetail_cli_test(capture_bad_file EXIT 1 ARGS capture ${data}/cube.obj
+                  STDERR "cube.obj:1: not a capture file")

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "dovetail/collision/broadphase.h"
+#include "dovetail/collision/capture.h"
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/distance.h"
@@ -74,6 +75,17 @@ struct WorldSettings {
   bool convex_level = true;  ///< separating-plane test before the polygon level
   int threads = 1;           ///< 1 = fully serial; 0 = one per hardware thread
   ContactDetail contacts = ContactDetail::kTriangles;
+  /// Failure capture (capture.h): every suspect query of step() is written
+  /// here with its inputs: a pair whose separating-plane search or GJK
+  /// stopped at its iteration cap, a pair with a pose that is not finite, and,
+  /// with `cross_check`, a pair the two methods disagree on. nullptr: off.
+  /// Not owned; must outlive the world.
+  CaptureSink* capture = nullptr;
+  /// Decide every pair that step() takes to the exact level a second time
+  /// with this polygon-level method, and every pair the convex level
+  /// separated with `method` too; a disagreement is captured (needs
+  /// `capture`). Off by default: it costs a second polygon-level query per pair.
+  std::optional<Method> cross_check{};
 };
 
 /// Marks a contact found at the box or hull level, which has no triangles.

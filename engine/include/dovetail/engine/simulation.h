@@ -38,6 +38,10 @@ struct SimulationSettings {
   /// Whether part_moved events go into the report's timeline (they are
   /// always delivered to subscribers). Off by default: a moving part gives one per frame.
   bool timeline_part_moved = false;
+  /// Failure capture of the collision pipeline (collision::WorldSettings::capture,
+  /// ::cross_check): not owned, nullptr = off.
+  collision::CaptureSink* capture = nullptr;
+  std::optional<collision::Method> cross_check{};
 };
 
 /// "Set part X's local pose at frame k": applied at the start of frame k, in

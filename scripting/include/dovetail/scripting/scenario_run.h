@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "dovetail/collision/model.h"
 #include "dovetail/engine/report.h"
 #include "dovetail/scripting/lua_host.h"
 #include "dovetail/scripting/scenario.h"
@@ -36,6 +37,11 @@ struct RunOptions {
   int render_width = 960;
   int render_height = 720;
   bool progress = false;  ///< a progress meter on stderr
+  /// Failure capture (collision/capture.h): suspect collision queries are
+  /// written into this folder; `cross_check` decides every exact pair a second
+  /// time with that method. The report does not depend on either.
+  std::optional<std::filesystem::path> capture_dir{};
+  std::optional<collision::Method> cross_check{};
   SandboxLimits limits{};
 };
 
@@ -86,6 +92,11 @@ struct RunOutcome {
   /// The frame loop alone (simulation, rules, steps, penetration), for benchmarks.
   double loop_seconds = 0;
   std::optional<std::filesystem::path> final_frame{};  ///< the PNG written, if any
+  /// With RunOptions::capture_dir: the capture files written, and how many
+  /// suspect queries there were (repeats of one capture write one file).
+  /// Not in the JSON report.
+  std::vector<std::filesystem::path> captures{};
+  std::size_t suspect_queries = 0;
 
   /// The report as JSON: deterministic, no wall-clock times (docs/authoring.md, "Reports").
   std::string to_json() const;

@@ -1,0 +1,56 @@
+/// \file capture_command.cpp
+/// `dovetail capture FILE...`: replays failure-capture files written by
+/// `run --capture DIR` (collision/capture.h) and says whether each suspect
+/// outcome happens again.
+
+#include <cstdio>
+#include <string>
+
+#include "cli.h"
+#include "commands.h"
+#include "dovetail/collision/capture.h"
+
+namespace dovetail::cli {
+
+namespace {
+
+constexpr const char* kCaptureHelp =
+    R"(usage: dovetail capture FILE...
+
+Replays failure-capture files written by 'dovetail run --capture DIR': reads
+each query's inputs (two meshes and their relative pose, hexadecimal floats)
+and runs it again: every polygon-level method and the convex level against
+brute force for a disagreement, GJK and the separating-plane search for an
+iteration cap, every method for a value that is not finite. Prints one line
+per file: "reproduced" or "not reproduced" and what the replay saw.
+Exits 0 when none reproduces, 3 when one does, 1 on a file that cannot be read.
+)";
+
+}  // namespace
+
+int capture_command(std::span<const std::string> argv) {
+  const Args args("capture", argv, {}, {});
+  if (args.help()) {
+    std::fputs(kCaptureHelp, stdout);
+    return kExitOk;
+  }
+  if (args.positional().empty()) throw UsageError("capture: give one or more capture files");
+  int exit_code = kExitOk;
+  for (const std::string& file : args.positional()) {
+    collision::Capture capture;
+    try {
+      capture = collision::read_capture(file);
+    } catch (const collision::CaptureError& e) {
+      throw InputError(e.what());
+    }
+    const collision::CaptureReplay replay = collision::replay_capture(capture);
+    std::printf("%s: %s %s: %s (%s)\n", file.c_str(),
+                std::string(collision::capture_kind_name(capture.kind)).c_str(),
+                replay.reproduced ? "reproduced" : "not reproduced", replay.what.c_str(),
+                capture.context.c_str());
+    if (replay.reproduced) exit_code = kExitCheckFailed;
+  }
+  return exit_code;
+}
+
+}  // namespace dovetail::cli
