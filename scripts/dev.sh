@@ -38,8 +38,8 @@ fi
 if [ "$command" = asan ]; then
   # Any undefined behaviour stops the test (no recovery); a float division by
   # zero counts as undefined here too.
-  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDOVETAIL_SANITIZE=address,undefined \
-    -DCMAKE_CXX_FLAGS="-fno-sanitize-recover=all -fsanitize=float-divide-by-zero" \
+  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DDOVETAIL_SANITIZE=address,undefined \
+    -DCMAKE_CXX_FLAGS="-O1 -fno-sanitize-recover=all -fsanitize=float-divide-by-zero" \
     -DDOVETAIL_BUILD_BENCH=OFF -DDOVETAIL_WERROR="${DOVETAIL_WERROR:-OFF}" >/dev/null
   cmake --build build-asan -j "$jobs"
   # Leaks inside Mesa's software renderer are not Dovetail's (scripts/lsan.supp).
