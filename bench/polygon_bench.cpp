@@ -22,10 +22,7 @@
 #include "dovetail/collision/pose_sampling.h"
 #include "dovetail/collision/primitives.h"
 #include "dovetail/engine/mesh_import.h"
-
-#ifdef DOVETAIL_HAVE_FCL
-#include <fcl/fcl.h>
-#endif
+#include "fcl_peer.h"
 
 namespace {
 
@@ -65,27 +62,12 @@ struct Contender {
 };
 
 #ifdef DOVETAIL_HAVE_FCL
+using bench::fcl_model;
+using bench::fcl_transform;
+
 struct FclPair {
   std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> a, b;
 };
-
-std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> fcl_model(const collision::Mesh& mesh) {
-  auto model = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
-  std::vector<fcl::Vector3d> v(mesh.vertices.begin(), mesh.vertices.end());
-  std::vector<fcl::Triangle> t;
-  for (const auto& tri : mesh.triangles) t.emplace_back(tri[0], tri[1], tri[2]);
-  model->beginModel(static_cast<int>(t.size()), static_cast<int>(v.size()));
-  model->addSubModel(v, t);
-  model->endModel();
-  return model;
-}
-
-fcl::Transform3d fcl_transform(const collision::Transform& X) {
-  fcl::Transform3d T = fcl::Transform3d::Identity();
-  T.linear() = X.R;
-  T.translation() = X.t;
-  return T;
-}
 #endif
 
 int run(const Options& options) {

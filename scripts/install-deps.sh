@@ -11,6 +11,8 @@ packages="$packages libcgal-dev assimp-testmodels"
 packages="$packages chromium"
 # Bench-only peers (optional for the library, used by bench/).
 packages="$packages libfcl-dev libbullet-dev libccd-dev"
+# Bench-only: the charts of docs/benchmarks.md (scripts/charts.sh).
+packages="$packages gnuplot-nox"
 # Fuzzing only: clang and its libFuzzer runtime (scripts/fuzz.sh, docs/reliability.md).
 packages="$packages clang libfuzzer-14-dev"
 

@@ -118,6 +118,12 @@ class LeafTester {
 
   void count_volume_test() { ++result_.stats.volume_tests; }
 
+  /// A time-critical query's cut: volumes that still overlap count as a hit.
+  void volumes_hit() {
+    result_.colliding = true;
+    done_ = true;
+  }
+
   /// Sorts all-pairs output by (a, b).
   void finish() {
     if (all_pairs_) std::sort(result_.pairs.begin(), result_.pairs.end());

@@ -37,8 +37,12 @@ class PairTraversal {
 
   void run() {
     const Entry root = root_entry();
-    if (overlapping(root)) visit(root.a, root.enc_a, root.b, root.enc_b);
+    if (overlapping(root)) visit(root.a, root.enc_a, root.b, root.enc_b, 0);
   }
+
+  /// Time-critical detection (CollideRequest::max_depth): a pair of
+  /// overlapping volumes this many levels below the roots is a hit.
+  void cut_at_depth(int max_depth) { max_depth_ = max_depth; }
 
   /// Overlapping node pairs breadth-first from the roots, until there are at
   /// least `target` or only leaf pairs remain.
@@ -60,7 +64,7 @@ class PairTraversal {
     return {queue.begin(), queue.end()};
   }
 
-  void run_from(const Entry& e) { visit(e.a, e.enc_a, e.b, e.enc_b); }
+  void run_from(const Entry& e) { visit(e.a, e.enc_a, e.b, e.enc_b, 0); }
 
   /// Records, for a first-hit query, the node pair `levels` above the leaf
   /// pair where the hit is found (or the highest pair visited, if fewer).
@@ -112,9 +116,13 @@ class PairTraversal {
     }
   }
 
-  void visit(std::uint32_t a, const EncA& enc_a, std::uint32_t b, const EncB& enc_b) {
+  void visit(std::uint32_t a, const EncA& enc_a, std::uint32_t b, const EncB& enc_b, int depth) {
     const NodeLink la = p_.link_a(a);
     const NodeLink lb = p_.link_b(b);
+    if (depth == max_depth_ && !(la.is_leaf() && lb.is_leaf())) {
+      tester_.volumes_hit();
+      return;
+    }
     if (la.is_leaf() && lb.is_leaf()) {
       tester_.test_leaves(p_.slots_a() + la.first_slot(), la.count(),
                           p_.slots_b() + lb.first_slot(), lb.count());
@@ -128,14 +136,14 @@ class PairTraversal {
       for (std::uint32_t c = la.first_child(); c < la.first_child() + 2; ++c) {
         const EncA enc_c = p_.enclose_a(c);
         tester_.count_volume_test();
-        if (p_.overlap(c, enc_c, b, enc_b)) visit(c, enc_c, b, enc_b);
+        if (p_.overlap(c, enc_c, b, enc_b)) visit(c, enc_c, b, enc_b, depth + 1);
         if (tester_.done()) return unwind(a, b);
       }
     } else {
       for (std::uint32_t c = lb.first_child(); c < lb.first_child() + 2; ++c) {
         const EncB enc_c = p_.enclose_b(c);
         tester_.count_volume_test();
-        if (p_.overlap(a, enc_a, c, enc_c)) visit(a, enc_a, c, enc_c);
+        if (p_.overlap(a, enc_a, c, enc_c)) visit(a, enc_a, c, enc_c, depth + 1);
         if (tester_.done()) return unwind(a, b);
       }
     }
@@ -155,6 +163,7 @@ class PairTraversal {
   TraversalHint* hint_ = nullptr;
   int hint_levels_ = 0;
   int hint_countdown_ = 0;
+  int max_depth_ = -1;  ///< negative: exact
 };
 
 /// Levels above the intersecting leaf pair a TraversalHint records.
@@ -182,7 +191,10 @@ CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh
   LeafTester tester(mesh_a, mesh_b, X_AB, request.all_pairs, result);
   const Policy policy(a, b, X_AB);
   PairTraversal<Policy> traversal(policy, tester);
-  if (request.hint && !request.all_pairs) {
+  if (request.max_depth >= 0 && !request.all_pairs) {
+    traversal.cut_at_depth(request.max_depth);
+    traversal.run();
+  } else if (request.hint && !request.all_pairs) {
     traversal.record_hint(request.hint, kHintLevels);
     traversal.run_hinted(*request.hint, a.node_count(), b.node_count());
   } else {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -346,6 +347,46 @@ TEST(Hierarchies, ParallelQueriesEqualSerialAtAnyThreadCount) {
       }
       EXPECT_GT(colliding, 5) << name;
       EXPECT_LT(colliding, 38) << name;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace dovetail::collision
+
+namespace dovetail::collision {
+namespace {
+
+TEST(Hierarchies, TimeCriticalQueriesAreConservativeAndExactWhenDeepEnough) {
+  // Cut at depth d, the AABB, OBB and DOP trees report overlapping volumes as
+  // a hit: never a miss; more false hits the shallower the cut; exact again
+  // once the cut lies below every leaf pair.
+  const auto a = share(make_sphere(0.6, 3));
+  const auto b = share(make_torus(0.7, 0.25, 24, 12));
+  const std::vector<Transform> poses = random_poses(300, 1.4, 7);
+  const auto brute_a = build_model(Method::kBrute, a), brute_b = build_model(Method::kBrute, b);
+  std::vector<bool> truth;
+  for (const Transform& X : poses) truth.push_back(brute_a->collide(*brute_b, X).colliding);
+  for (const Method m : {Method::kAabb, Method::kObb, Method::kDop18}) {
+    const auto ma = build_model(m, a), mb = build_model(m, b);
+    int previous_false = std::numeric_limits<int>::max();
+    for (const int depth : {0, 2, 4, 8, 16, 64}) {
+      int false_hits = 0;
+      for (std::size_t p = 0; p < poses.size(); ++p) {
+        const CollideResult r = ma->collide(*mb, poses[p], {.max_depth = depth});
+        if (truth[p]) {
+          EXPECT_TRUE(r.colliding) << method_name(m) << " depth " << depth << " pose " << p;
+        }
+        false_hits += r.colliding && !truth[p];
+      }
+      EXPECT_LE(false_hits, previous_false) << method_name(m) << " depth " << depth;
+      previous_false = false_hits;
+      if (depth == 0) {
+        EXPECT_GT(false_hits, 0) << method_name(m);
+      }
+      if (depth == 64) {
+        EXPECT_EQ(false_hits, 0) << method_name(m);
+      }
     }
   }
 }

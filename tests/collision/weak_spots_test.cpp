@@ -150,8 +150,7 @@ TEST(WeakSpots, CoplanarAndNearlyCoplanarContactIsExact) {
 TEST(WeakSpots, ThinAndSliverPartsAreExact) {
   const auto box = share(make_box(Vec3(0.5, 0.5, 0.5)));
   const auto foil = share(transformed(make_box(Vec3(1, 1, 1)), Vec3(0.3, 0.3, 5e-7).asDiagonal()));
-  const auto needle =
-      share(transformed(make_cylinder(1, 1, 6), Vec3(1e-6, 1e-6, 2).asDiagonal()));
+  const auto needle = share(transformed(make_cylinder(1, 1, 6), Vec3(1e-6, 1e-6, 2).asDiagonal()));
   for (const Real offset : {0.0, 0.4999999, 0.5 - 1e-12, 0.5, 0.5 + 1e-12, 0.5000001, 0.85, 1.2}) {
     char label[64];
     std::snprintf(label, sizeof label, "foil at x %.13g", offset);

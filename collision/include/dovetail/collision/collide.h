@@ -40,6 +40,13 @@ struct CollideRequest {
   /// there is none). Must come from queries of the same two models. Ignored
   /// by all-pairs queries and by the other methods.
   TraversalHint* hint = nullptr;
+  /// Time-critical detection: a first-hit query on the AABB, OBB and DOP
+  /// trees that reaches this many levels below the root pair (one level: one
+  /// tree descends once) with the volumes still overlapping stops there and
+  /// reports colliding, with no triangle pair. Conservative: never misses a
+  /// collision, may report one that is not. Negative (the default): exact.
+  /// Ignored by all-pairs queries and by the other methods.
+  int max_depth = -1;
 };
 
 /// Work a query did; the cost model is volume_tests * C_bv + triangle_tests * C_p.
