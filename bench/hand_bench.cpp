@@ -1,8 +1,13 @@
 // Hand benchmark: what the glove-driven hand costs per frame.
 //
 //   hand_bench [--runs R] [--detail pairs|triangles|both] [--pictures DIR] [--slow MS]
+//              [--sweep TABLE]
 // --slow MS lists the sliding frames slower than MS milliseconds, with their
-// sub-steps, collision queries and contacts.
+// sub-steps, collision queries and contacts. --sweep TABLE runs only the
+// sliding scene, with the contact search's resolution and sub-step budget
+// varied, measuring the deepest overlap of peg and block every frame and their
+// distance in the frames in contact, and writes the table behind the sliding
+// chart (scripts/charts.sh).
 //
 // One collision thread. Each scene is a 10,000-triangle part and the hand,
 // driven by the simulated glove through a plan that approaches, closes
@@ -41,6 +46,9 @@
 #include <string>
 #include <vector>
 
+#include "dovetail/collision/contacts.h"
+#include "dovetail/collision/distance.h"
+#include "dovetail/collision/model.h"
 #include "dovetail/collision/primitives.h"
 #include "dovetail/engine/render.h"
 #include "dovetail/engine/scene.h"
@@ -251,13 +259,35 @@ void grasp_picture(const std::string& pictures) {
                   : "no grasp");
 }
 
-void sliding(int runs, const std::string& pictures, bool pair_guided, double slow_ms) {
+/// What the sliding scene gave over all runs.
+struct SlidingRuns {
+  std::vector<double> contact_ms;   ///< interaction step per frame in contact, all runs
+  std::vector<double> run_medians;  ///< median of each run
+  std::uint64_t frames_in_contact = 0;  ///< of the first run
+  std::uint64_t mated = 0;
+  std::size_t triangles = 0;
+  /// Deepest overlap of peg and block over every frame of every run (the
+  /// collision layer's contact depth), when measured.
+  Real max_penetration = 0;
+  /// The gap between peg and block over the frames in contact, when measured:
+  /// how close to the surfaces the contact search brings the part.
+  std::vector<double> contact_gap_m;
+};
+
+/// The peg carried into the hole `runs` times with these sliding settings.
+SlidingRuns sliding_runs(int runs, const std::string& pictures,
+                         const interaction::SlidingSettings& sliding_settings, double slow_ms,
+                         bool measure_penetration) {
   constexpr Real kTop = 0.03, kDepth = 0.04, kLength = 0.06;
   const auto block = std::make_shared<const collision::Mesh>(
       collision::make_block_with_hole(Vec3(0.04, kTop, 0.04), 0.01025, kDepth, 64));
   const auto peg = std::make_shared<const collision::Mesh>(banded_cylinder(0.01, kLength, 256, 19));
-  std::vector<double> contact_ms, run_medians;
-  std::uint64_t frames_in_contact = 0, mated = 0;
+  SlidingRuns out;
+  out.triangles = peg->triangle_count();
+  const auto block_model = collision::build_model(collision::Method::kObb, block);
+  const auto peg_model = collision::build_model(collision::Method::kObb, peg);
+  const auto block_distance = collision::build_distance_model(block);
+  const auto peg_distance = collision::build_distance_model(peg);
   for (int run = 0; run < runs; ++run) {
     Transform X_WPeg;
     X_WPeg.R = interaction::rotation_z_deg(-2) * interaction::rotation_x_deg(90);
@@ -275,7 +305,7 @@ void sliding(int runs, const std::string& pictures, bool pair_guided, double slo
     p.steps = {down, close(0.3, "power"), close(0.3, "open")};
     interaction::Hand hand(sim, std::make_shared<interaction::SimulatedGlove>(p));
     interaction::InteractionSettings interaction_settings;
-    interaction_settings.sliding.pair_guided = pair_guided;
+    interaction_settings.sliding = sliding_settings;
     interaction::Grasping grasping(sim, hand, interaction_settings);
     grasping.add_mate({.name = "peg_in_hole",
                        .part = "peg",
@@ -299,22 +329,44 @@ void sliding(int runs, const std::string& pictures, bool pair_guided, double slo
               s.contacts.size());
         }
       }
-      for (const engine::Event& e : r.events) mated += e.kind == engine::EventKind::kMate;
+      for (const engine::Event& e : r.events) out.mated += e.kind == engine::EventKind::kMate;
+      if (measure_penetration) {
+        const Transform X_WB = sim.scene().world_pose("block");
+        const Transform X_WP = sim.scene().world_pose("peg");
+        const Transform X_BP{X_WB.R.transpose() * X_WP.R, X_WB.R.transpose() * (X_WP.t - X_WB.t)};
+        for (const collision::ContactPatch& patch :
+             collision::compute_contacts(*block_model, *peg_model, X_BP)) {
+          out.max_penetration = std::max(out.max_penetration, patch.depth);
+        }
+        if (grasping.held() && grasping.last_slide().status != interaction::SlideStatus::kReached) {
+          out.contact_gap_m.push_back(
+              collision::distance(*block_distance, *peg_distance, X_BP).distance);
+        }
+      }
       if (run == 0 && !pictures.empty() && (frame == 30 || frame == 100)) {
         engine::RenderSettings settings{.width = 480, .height = 360, .camera = "iso"};
         engine::write_png(engine::render(engine::render_scene(sim.scene()), settings),
                           pictures + "/peg-frame-" + std::to_string(frame) + ".png");
       }
     }
-    if (run == 0) frames_in_contact = in_contact.size();
-    contact_ms.insert(contact_ms.end(), in_contact.begin(), in_contact.end());
-    run_medians.push_back(percentile(in_contact, 0.5));
+    if (run == 0) out.frames_in_contact = in_contact.size();
+    out.contact_ms.insert(out.contact_ms.end(), in_contact.begin(), in_contact.end());
+    out.run_medians.push_back(percentile(in_contact, 0.5));
   }
+  return out;
+}
+
+void sliding(int runs, const std::string& pictures, bool pair_guided, double slow_ms) {
+  interaction::SlidingSettings settings;
+  settings.pair_guided = pair_guided;
+  const SlidingRuns r = sliding_runs(runs, pictures, settings, slow_ms, false);
+  const std::vector<double>& contact_ms = r.contact_ms;
+  const std::vector<double>& run_medians = r.run_medians;
   std::printf(
       "sliding (%s): %zu-triangle peg into a hole, %llu frames in contact per run, mated in "
       "%llu of %d runs\n",
-      pair_guided ? "pair-guided" : "plain", peg->triangle_count(),
-      static_cast<unsigned long long>(frames_in_contact), static_cast<unsigned long long>(mated),
+      pair_guided ? "pair-guided" : "plain", r.triangles,
+      static_cast<unsigned long long>(r.frames_in_contact), static_cast<unsigned long long>(r.mated),
       runs);
   std::printf(
       "  interaction step ms per frame in contact: median %.4f  p95 %.4f  worst %.4f  "
@@ -324,12 +376,67 @@ void sliding(int runs, const std::string& pictures, bool pair_guided, double slo
       *std::max_element(run_medians.begin(), run_medians.end()));
 }
 
+/// Sliding accuracy against its cost: the peg scene with the contact search's
+/// resolution and sub-step budget varied, the deepest overlap of peg and block
+/// measured every frame. One line per setting on stdout and in `table`.
+void sliding_sweep(int runs, const std::string& table_path) {
+  struct Variant {
+    std::string name;
+    interaction::SlidingSettings settings;
+  };
+  std::vector<Variant> variants;
+  for (const Real resolution : {1e-7, 1e-6, 1e-5, 1e-4, 1e-3}) {
+    interaction::SlidingSettings s;
+    s.resolution_m = resolution;
+    char name[64];
+    std::snprintf(name, sizeof name, "resolution_%gm", resolution);
+    variants.push_back({name, s});
+  }
+  for (const int substeps : {1, 2, 8}) {
+    interaction::SlidingSettings s;
+    s.substeps = substeps;
+    variants.push_back({"substeps_" + std::to_string(substeps), s});
+  }
+  {
+    interaction::SlidingSettings s;
+    s.pair_guided = false;
+    variants.push_back({"plain_search", s});
+  }
+  std::FILE* table = table_path.empty() ? nullptr : std::fopen(table_path.c_str(), "w");
+  if (table) {
+    std::fprintf(table,
+                 "# setting median_ms p95_ms worst_ms max_penetration_mm median_gap_um "
+                 "p95_gap_um mated_runs runs\n");
+  }
+  std::printf("sliding sweep: %d runs each; ms per frame in contact; deepest overlap over all frames\n",
+              runs);
+  std::printf("%-18s %9s %9s %9s %15s %14s %11s %6s\n", "setting", "median", "p95", "worst",
+              "penetration mm", "gap median um", "gap p95 um", "mated");
+  for (const Variant& v : variants) {
+    const SlidingRuns r = sliding_runs(runs, "", v.settings, 0, true);
+    const double median = percentile(r.contact_ms, 0.5), p95 = percentile(r.contact_ms, 0.95),
+                 worst = percentile(r.contact_ms, 1.0);
+    const double gap_median = 1e6 * percentile(r.contact_gap_m, 0.5);
+    const double gap_p95 = 1e6 * percentile(r.contact_gap_m, 0.95);
+    std::printf("%-18s %9.4f %9.4f %9.4f %15.6f %14.3f %11.3f %3llu/%d\n", v.name.c_str(), median,
+                p95, worst, 1000 * r.max_penetration, gap_median, gap_p95,
+                static_cast<unsigned long long>(r.mated), runs);
+    if (table) {
+      std::fprintf(table, "%s %.5f %.5f %.5f %.7f %.4f %.4f %llu %d\n", v.name.c_str(), median,
+                   p95, worst, 1000 * r.max_penetration, gap_median, gap_p95,
+                   static_cast<unsigned long long>(r.mated), runs);
+    }
+  }
+  if (table) std::fclose(table);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int runs = 5;
   std::string detail = "both";
   double slow_ms = 0;    // list sliding frames slower than this (0: none)
+  std::string sweep;     // sliding accuracy against cost: the table, then stop
   std::string pictures;  // folder for PNGs of the sliding peg
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -339,14 +446,20 @@ int main(int argc, char** argv) {
       pictures = argv[++i];
     } else if (arg == "--slow" && i + 1 < argc) {
       slow_ms = std::atof(argv[++i]);
+    } else if (arg == "--sweep" && i + 1 < argc) {
+      sweep = argv[++i];
     } else if (arg == "--detail" && i + 1 < argc) {
       detail = argv[++i];
     } else {
       std::fprintf(stderr,
                    "usage: hand_bench [--runs R] [--detail pairs|triangles|both] [--pictures DIR] "
-                   "[--slow MS]\n");
+                   "[--slow MS] [--sweep TABLE]\n");
       return 2;
     }
+  }
+  if (!sweep.empty()) {
+    sliding_sweep(runs, sweep);
+    return 0;
   }
   const auto torus =
       std::make_shared<const collision::Mesh>(collision::make_torus(0.06, 0.02, 100, 50));

@@ -5,7 +5,7 @@
 #   scripts/charts.sh [DATA]    DATA: the folder with stanford-bunny.obj, teapot.obj
 #                               and fandisk.obj (default ../shared/data)
 # Environment: BUILD_DIR (default build), DIRECTIONS (100), RUNS (5), STEPS (180).
-# Takes about 10 minutes on 2 cores.
+# Takes about 15 minutes on 2 cores, most of it the sliding sweep.
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -22,7 +22,7 @@ for f in stanford-bunny.obj teapot.obj fandisk.obj; do
   [ -f "$data/$f" ] || { echo "charts: $data/$f not found (give the data folder)" >&2; exit 1; }
 done
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" -j "$(nproc)" --target accuracy_bench tumble_bench >/dev/null
+cmake --build "$build" -j "$(nproc)" --target accuracy_bench tumble_bench hand_bench >/dev/null
 mkdir -p docs/results docs/images
 
 chart() {  # name title a b
@@ -62,6 +62,25 @@ plot for [i=1:words(methods)] file using (strcol(1) eq word(methods, i) ? \$2 : 
 GNUPLOT
   done
 }
+
+# Sliding: accuracy against cost, the peg carried into its hole.
+echo "charts: sliding ($runs runs per setting)" >&2
+"$build/bench/hand_bench" --runs "$runs" --sweep docs/results/sliding_sweep.dat >docs/results/sliding_sweep.txt
+for format in png svg; do
+  if [ "$format" = png ]; then term="pngcairo size 900,560 font 'sans,10'"; else term="svg size 900,560 font 'sans,10'"; fi
+  gnuplot <<GNUPLOT
+set terminal $term
+set output "docs/images/sliding_sweep.$format"
+set title "Sliding a 10,240-triangle peg into its hole: gap left at contact against cost"
+set xlabel "interaction step, 95th percentile over the frames in contact (ms)"
+set ylabel "gap between peg and block in contact, median (µm, log)"
+set logscale y
+set grid
+set key off
+file = "docs/results/sliding_sweep.dat"
+plot file using 3:6 with points pt 7 ps 1.5, file using 3:6:(strcol(1)) with labels offset 1,0.6 left font ",9"
+GNUPLOT
+done
 
 chart bunny "Stanford bunny against itself" "$data/stanford-bunny.obj" "$data/stanford-bunny.obj"
 chart teapot_fandisk "Teapot against fandisk" "$data/teapot.obj" "$data/fandisk.obj"
