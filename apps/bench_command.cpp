@@ -39,8 +39,6 @@ constexpr double kPegRadius = 0.03;
 constexpr double kPegLength = 0.12;
 constexpr int kPegSides = 64;
 
-double round_ms(double ms) { return std::round(ms * 1000.0) / 1000.0; }
-
 struct MethodOutcome {
   collision::Method method;
   double build_ms = 0;

@@ -17,6 +17,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "dovetail/collision/broadphase.h"
+#include "line_reader.h"
 
 namespace dovetail::cli {
 
@@ -45,98 +46,8 @@ before it are still written.
 /// Limits of the box file.
 constexpr std::uint64_t kMaxObjects = 0xffffffffu;
 
-/// `field` in single quotes, for messages.
-std::string quote(std::string_view field) {
-  std::string s;
-  s.reserve(field.size() + 2);
-  s += '\'';
-  s += field;
-  s += '\'';
-  return s;
-}
-
-/// "1 field", "5 fields".
-std::string fields_text(std::size_t n) {
-  return std::to_string(n) + (n == 1 ? " field" : " fields");
-}
-
-/// A bad line of the box file.
-struct BoxFileError {
-  std::string message;
-};
-
-/// Reads a box file line by line, skipping blank and `#` lines.
-class BoxFileReader {
- public:
-  explicit BoxFileReader(const std::string& path) : path_(path) {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    const fs::file_status status = fs::status(path, ec);
-    if (!fs::exists(status)) throw InputError(path + ": file not found");
-    if (fs::is_directory(status)) throw InputError(path + ": is a directory");
-    in_.open(path, std::ios::binary);
-    if (!in_) throw InputError(path + ": cannot be opened: " + std::strerror(errno));
-  }
-
-  std::size_t line() const { return line_; }
-
-  /// The next line that holds data, split into fields; nullopt at the end.
-  std::optional<std::vector<std::string_view>> next() {
-    while (std::getline(in_, text_)) {
-      ++line_;
-      if (!text_.empty() && text_.back() == '\r') text_.pop_back();
-      fields_.clear();
-      std::size_t i = 0;
-      while (i < text_.size()) {
-        while (i < text_.size() && (text_[i] == ' ' || text_[i] == '\t')) ++i;
-        const std::size_t start = i;
-        while (i < text_.size() && text_[i] != ' ' && text_[i] != '\t') ++i;
-        if (i > start) fields_.emplace_back(text_.data() + start, i - start);
-      }
-      if (fields_.empty() || fields_[0][0] == '#') continue;
-      return fields_;
-    }
-    if (in_.bad()) fail("read error");
-    ++line_;  // errors about missing data name the line after the last one
-    return std::nullopt;
-  }
-
-  [[noreturn]] void fail(const std::string& what) const {
-    throw BoxFileError{path_ + ":" + std::to_string(line_) + ": " + what};
-  }
-
-  std::uint64_t count(std::string_view field, const char* what) const {
-    std::uint64_t v = 0;
-    const auto [ptr, ec] = std::from_chars(field.data(), field.data() + field.size(), v);
-    if (ec != std::errc() || ptr != field.data() + field.size()) {
-      fail(std::string(what) + " must be a non-negative integer, not " + quote(field));
-    }
-    return v;
-  }
-
-  double number(std::string_view field) const {
-    std::string_view digits = field;
-    if (digits.size() > 1 && digits[0] == '+') digits.remove_prefix(1);
-    double v = 0;
-    const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
-    if (ec == std::errc::result_out_of_range) fail(quote(field) + " is out of range");
-    if (ec != std::errc() || ptr != digits.data() + digits.size()) {
-      fail(quote(field) + " is not a number");
-    }
-    if (!std::isfinite(v)) fail(quote(field) + " is not finite");
-    return v;
-  }
-
- private:
-  std::string path_;
-  std::ifstream in_;
-  std::string text_;
-  std::vector<std::string_view> fields_;
-  std::size_t line_ = 0;
-};
-
 /// Reads box `index` of frame `frame`.
-collision::Aabb read_box(BoxFileReader& reader, std::uint64_t frame, std::uint64_t index,
+collision::Aabb read_box(LineReader& reader, std::uint64_t frame, std::uint64_t index,
                          std::uint64_t objects) {
   const std::optional<std::vector<std::string_view>> fields = reader.next();
   if (!fields) {
@@ -159,15 +70,6 @@ collision::Aabb read_box(BoxFileReader& reader, std::uint64_t frame, std::uint64
   }
   return box;
 }
-
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double round_ms(double ms) { return std::round(ms * 1000.0) / 1000.0; }
 
 std::string broadphase_list() {
   std::string names;
@@ -217,7 +119,7 @@ int broadphase_command(std::span<const std::string> argv) {
     text.clear();
   };
 
-  BoxFileReader reader(boxes_path);
+  LineReader reader(boxes_path);
   std::unique_ptr<collision::Broadphase> broadphase = collision::make_broadphase(method);
   std::uint64_t objects = 0, frames = 0, frames_done = 0, pairs_total = 0;
   std::vector<double> frame_ms;
@@ -266,7 +168,7 @@ int broadphase_command(std::span<const std::string> argv) {
       reader.fail("more data than the first line declares (N F = " + std::to_string(objects) + " " +
                   std::to_string(frames) + ")");
     }
-  } catch (const BoxFileError& e) {
+  } catch (const LineError& e) {
     error = e.message;
   }
   flush();

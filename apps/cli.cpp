@@ -200,6 +200,15 @@ double ms_since(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
+double round_ms(double ms) { return std::round(ms * 1000.0) / 1000.0; }
+
+double median(std::vector<double> values) {
+  if (values.empty()) return std::nan("");
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
 LoadedMesh load_mesh(const std::string& path) {
   try {
     engine::ImportReport report = engine::import_file(path, {});

@@ -90,6 +90,10 @@ std::string method_list();
 
 /// Milliseconds since `start`.
 double ms_since(std::chrono::steady_clock::time_point start);
+/// Milliseconds rounded to the microsecond, for summaries.
+double round_ms(double ms);
+/// The median; NaN for none.
+double median(std::vector<double> values);
 
 /// A mesh imported merged, with the import's findings.
 struct LoadedMesh {

@@ -33,6 +33,8 @@ int reference_command(std::span<const std::string> args);
 int broadphase_command(std::span<const std::string> args);
 /// `dovetail render INPUT --out PNG ...`: draws a mesh or assembly file to PNG.
 int render_command(std::span<const std::string> args);
+/// `dovetail pipeline --scene FILE ...`: the whole collision pipeline on a scene from files.
+int pipeline_command(std::span<const std::string> args);
 /// `dovetail capture FILE...`: replays failure-capture files.
 int capture_command(std::span<const std::string> args);
 /// `dovetail glove convert|plan|check ...`: glove traces from recordings and plans.

@@ -25,8 +25,6 @@ bytes per triangle and build time.
   --parts      also list the parts (one per mesh instance of every node)
 )";
 
-double round_ms(double ms) { return std::round(ms * 1000.0) / 1000.0; }
-
 std::string json_vec(const collision::Vec3& v) {
   return json_array({json_number(v.x()), json_number(v.y()), json_number(v.z())});
 }

@@ -40,6 +40,7 @@ commands:
   poses     write a contact-distance pose list for two meshes
   bench     every collision method against brute force on a peg and a ring
   broadphase  overlapping pairs of moving boxes, frame by frame
+  pipeline  the whole collision pipeline on a scene of meshes, frame by frame
   render    draw a mesh or assembly file to PNG (with the hand of a glove trace)
   glove     convert glove recordings, sample glove plans, check traces
   capture   replay failure-capture files written by 'run --capture'
@@ -77,6 +78,7 @@ constexpr Command kCommands[] = {
     {"inspect", dovetail::cli::inspect_command},
     {"poses", dovetail::cli::poses_command},
     {"broadphase", dovetail::cli::broadphase_command},
+    {"pipeline", dovetail::cli::pipeline_command},
     {"render", dovetail::cli::render_command},
     {"glove", dovetail::cli::glove_command},
     {"capture", dovetail::cli::capture_command},

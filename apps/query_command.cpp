@@ -112,8 +112,6 @@ bool distance_method_is_brute(const Args& args, Mode mode) {
                    "; valid methods: rss, brute");
 }
 
-double round_ms(double ms) { return std::round(ms * 1000.0) / 1000.0; }
-
 void print_notes(const std::string& path, const LoadedMesh& loaded) {
   for (const std::string& note : loaded.report.notes) {
     std::fprintf(stderr, "dovetail: note: %s: %s\n", path.c_str(), note.c_str());

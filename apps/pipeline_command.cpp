@@ -1,0 +1,237 @@
+/// \file pipeline_command.cpp
+/// `dovetail pipeline --scene FILE ...`: the whole collision pipeline (object
+/// level, convex level, polygon level, on worker threads) on a scene from
+/// files, frame by frame: which parts' meshes intersect.
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cli.h"
+#include "commands.h"
+#include "dovetail/collision/broadphase.h"
+#include "dovetail/collision/collision_world.h"
+#include "dovetail/collision/model.h"
+#include "dovetail/engine/mesh_import.h"
+#include "line_reader.h"
+
+namespace dovetail::cli {
+
+namespace {
+
+constexpr const char* kHelp =
+    R"(usage: dovetail pipeline --scene FILE [--broadphase M] [--method M] [--threads N]
+                         [--out PAIRS]
+
+Runs the whole collision pipeline (object level, convex level, polygon level)
+on a scene from files and reports, frame by frame, which parts' meshes
+intersect (touching counts).
+
+  --scene FILE    text: a first line `N F` (parts, frames); then N lines, each a
+                  mesh path relative to FILE's folder; then F frames of N lines
+                  `tx ty tz qw qx qy qz`, the pose of part i in the world (the
+                  quaternion is normalized; blank lines and `#` lines skipped)
+  --broadphase M  sap (default), grid, octree, brute
+  --method M      polygon level: obb (default), boxtree, dop6, dop14, dop18,
+                  dop26, aabb, brute
+  --threads N     worker threads (default 1; 0 = one per core); the pairs do
+                  not depend on it
+  --out PAIRS     write the pairs there: per frame a line `frame K count C` (K
+                  from 0), then the C intersecting pairs `i j`, i < j, sorted
+                  (default: standard output, before the summary)
+
+Prints a one-line JSON summary on standard output: parts, frames, build_ms
+(the meshes' hulls and hierarchies), ms_per_frame_median (the frames after
+the first, without reading the file or building) and pairs_total. A bad line
+stops the run with an error naming file and line; the pairs of the frames
+before it are still written.
+)";
+
+/// Pose `index` of frame `frame`: `tx ty tz qw qx qy qz`.
+collision::Transform read_pose(LineReader& reader, std::uint64_t frame, std::uint64_t index,
+                               std::uint64_t parts) {
+  const std::optional<std::vector<std::string_view>> fields = reader.next();
+  if (!fields) {
+    reader.fail("file ends in frame " + std::to_string(frame) + " after " + std::to_string(index) +
+                " of " + std::to_string(parts) + " poses");
+  }
+  if (fields->size() != 7) {
+    reader.fail("expected 7 numbers `tx ty tz qw qx qy qz`, got " + fields_text(fields->size()));
+  }
+  double v[7];
+  for (std::size_t k = 0; k < 7; ++k) v[k] = reader.number((*fields)[k]);
+  const Eigen::Quaternion<double> q(v[3], v[4], v[5], v[6]);
+  const double norm = q.norm();
+  if (!(norm > 1e-12) || !std::isfinite(norm)) reader.fail("the quaternion has no length");
+  collision::Transform X;
+  X.R = q.normalized().toRotationMatrix();
+  X.t = collision::Vec3(v[0], v[1], v[2]);
+  return X;
+}
+
+template <typename Parse, typename Name, typename All>
+auto choose(const Args& args, const char* option, Parse parse, Name name, All all,
+            decltype(parse("")) fallback) {
+  const std::optional<std::string> text = args.value(option);
+  if (!text) return fallback;
+  if (const auto m = parse(*text)) return m;
+  std::string valid;
+  for (const auto m : all()) valid += (valid.empty() ? "" : ", ") + std::string(name(m));
+  throw UsageError("pipeline: unknown --" + std::string(option) + " '" + *text +
+                   "'; valid: " + valid);
+}
+
+}  // namespace
+
+int pipeline_command(std::span<const std::string> argv) {
+  const Args args("pipeline", argv, {"scene", "broadphase", "method", "threads", "out"}, {});
+  if (args.help()) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  args.expect_positional(0, "no positional arguments");
+  const std::string scene_path = args.required("scene");
+  const collision::BroadphaseMethod broadphase = *choose(
+      args, "broadphase", collision::parse_broadphase, collision::broadphase_name,
+      collision::all_broadphases, std::optional(collision::BroadphaseMethod::kSweepAndPrune));
+  const collision::Method method =
+      *choose(args, "method", collision::parse_method, collision::method_name,
+              collision::all_methods, std::optional(collision::Method::kObb));
+  const int threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
+  const std::optional<std::string> out_path = args.value("out");
+
+  std::ofstream out;
+  if (out_path) {
+    const std::string inputs[] = {scene_path};
+    refuse_overwriting_input("pipeline", *out_path, inputs);
+    out.open(*out_path, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(*out_path + ": cannot be written: " + std::strerror(errno));
+  }
+  std::string text;
+  const auto flush = [&] {
+    if (out_path) {
+      out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    } else {
+      std::fwrite(text.data(), 1, text.size(), stdout);
+    }
+    text.clear();
+  };
+
+  LineReader reader(scene_path);
+  const std::filesystem::path folder = std::filesystem::path(scene_path).parent_path();
+  collision::CollisionWorld world({.method = method,
+                                   .broadphase = broadphase,
+                                   .convex_level = true,
+                                   .threads = threads,
+                                   .contacts = collision::ContactDetail::kPairs,
+                                   .capture = nullptr,
+                                   .cross_check = std::nullopt});
+  std::uint64_t parts = 0, frames = 0, frames_done = 0, pairs_total = 0;
+  double build_ms = 0;
+  std::vector<double> frame_ms;
+  std::optional<std::string> error;
+  try {
+    const std::optional<std::vector<std::string_view>> header = reader.next();
+    if (!header) reader.fail("empty file, expected a first line `N F` (parts, frames)");
+    if (header->size() != 2) {
+      reader.fail("expected a first line `N F` (parts, frames), got " +
+                  fields_text(header->size()));
+    }
+    parts = reader.count((*header)[0], "the part count N");
+    frames = reader.count((*header)[1], "the frame count F");
+    if (parts > 1'000'000) reader.fail("more than 1,000,000 parts");
+
+    // The meshes, each file read once however many parts use it.
+    std::map<std::string, std::shared_ptr<const collision::Mesh>> meshes;
+    std::vector<collision::PartId> ids;
+    for (std::uint64_t i = 0; i < parts; ++i) {
+      if (!reader.next()) {
+        reader.fail("file ends after " + std::to_string(i) + " of " + std::to_string(parts) +
+                    " mesh paths");
+      }
+      std::string name = reader.text();
+      name.erase(0, name.find_first_not_of(" \t"));
+      name.erase(name.find_last_not_of(" \t") + 1);
+      std::shared_ptr<const collision::Mesh>& mesh = meshes[name];
+      if (!mesh) {
+        try {
+          mesh = std::make_shared<const collision::Mesh>(engine::import_mesh(folder / name));
+        } catch (const std::exception& e) {
+          reader.fail("mesh of part " + std::to_string(i) + ": " + e.what());
+        }
+      }
+      ids.push_back(world.add_part({.mesh = mesh,
+                                    .X_WP = collision::Transform{},
+                                    .movable = true,
+                                    .level = collision::LevelOfDetail::kExact,
+                                    .name = std::to_string(i)}));
+    }
+    const auto build_start = std::chrono::steady_clock::now();
+    world.prepare();
+    build_ms = ms_since(build_start);
+
+    std::vector<collision::Transform> poses;
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> pairs;
+    for (std::uint64_t f = 0; f < frames; ++f) {
+      poses.clear();
+      for (std::uint64_t i = 0; i < parts; ++i) poses.push_back(read_pose(reader, f, i, parts));
+      const auto start = std::chrono::steady_clock::now();
+      for (std::size_t i = 0; i < ids.size(); ++i) world.set_pose(ids[i], poses[i]);
+      const collision::StepResult& step = world.step();
+      frame_ms.push_back(ms_since(start));
+      pairs.clear();
+      for (const collision::PartPair& p : step.colliding) {
+        const std::uint64_t i = p.a.index, j = p.b.index;
+        pairs.emplace_back(std::min(i, j), std::max(i, j));
+      }
+      std::sort(pairs.begin(), pairs.end());
+      ++frames_done;
+      pairs_total += pairs.size();
+      text += "frame " + std::to_string(f) + " count " + std::to_string(pairs.size()) + "\n";
+      for (const auto& [i, j] : pairs) text += std::to_string(i) + ' ' + std::to_string(j) + '\n';
+      if (text.size() > (std::size_t{1} << 20)) flush();
+    }
+    if (reader.next()) {
+      reader.fail("more data than the first line declares (N F = " + std::to_string(parts) + " " +
+                  std::to_string(frames) + ")");
+    }
+  } catch (const LineError& e) {
+    error = e.message;
+  }
+  flush();
+  if (out_path) {
+    out.close();
+    if (!out) throw InputError(*out_path + ": write failed: " + std::strerror(errno));
+  }
+
+  const std::vector<double> after_first(frame_ms.begin() + (frame_ms.empty() ? 0 : 1),
+                                        frame_ms.end());
+  JsonLine json;
+  json.add("scene", scene_path)
+      .add("broadphase", collision::broadphase_name(broadphase))
+      .add("method", collision::method_name(method))
+      .add("threads", threads)
+      .add("parts", parts)
+      .add("frames", frames_done)
+      .add("build_ms", round_ms(build_ms))
+      .add("ms_per_frame_median", round_ms(median(after_first)))
+      .add("pairs_total", pairs_total);
+  if (error) json.add("error", *error);
+  std::fputs((json.str() + "\n").c_str(), stdout);
+
+  if (error) throw InputError(*error);
+  return kExitOk;
+}
+
+}  // namespace dovetail::cli
