@@ -262,14 +262,6 @@ std::string json_array(const std::vector<std::string>& items) {
   return out;
 }
 
-std::string json_number(double value) {
-  if (!std::isfinite(value)) return "null";
-  char buffer[32];
-  const auto [ptr, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
-  if (ec != std::errc()) return "null";
-  return std::string(buffer, ptr);
-}
-
 void JsonLine::key(std::string_view k) {
   if (!body_.empty()) body_ += ",";
   body_ += json_string(k) + ":";

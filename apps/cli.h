@@ -146,7 +146,6 @@ class JsonLine {
 using engine::json_string;
 /// `[item,item,...]` from items that are already JSON.
 std::string json_array(const std::vector<std::string>& items);
-/// A finite double as JSON (shortest round-trip form); null when not finite.
-std::string json_number(double value);
+using engine::json_number;
 
 }  // namespace dovetail::cli

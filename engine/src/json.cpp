@@ -1,7 +1,8 @@
 #include "dovetail/engine/json.h"
 
-#include <cstdio>
-#include <cstdlib>
+#include <charconv>
+#include <cmath>
+#include <system_error>
 
 namespace dovetail::engine {
 
@@ -38,12 +39,11 @@ std::string json_string(std::string_view text) {
 }
 
 std::string json_number(double value) {
+  if (!std::isfinite(value)) return "null";  // JSON has no NaN or infinity
   char buffer[32];
-  for (int digits = 15; digits <= 17; ++digits) {
-    std::snprintf(buffer, sizeof(buffer), "%.*g", digits, value);
-    if (std::strtod(buffer, nullptr) == value) break;
-  }
-  return buffer;
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  if (error != std::errc()) return "null";
+  return std::string(buffer, end);
 }
 
 }  // namespace dovetail::engine

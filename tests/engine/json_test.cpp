@@ -1,0 +1,33 @@
+#include "dovetail/engine/json.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <limits>
+#include <string>
+
+namespace dovetail::engine {
+namespace {
+
+TEST(Json, NumbersAreShortestAndReadBackToTheSameBits) {
+  EXPECT_EQ(json_number(0.1), "0.1");
+  EXPECT_EQ(json_number(3.0), "3");
+  EXPECT_EQ(json_number(-0.0), "-0");
+  EXPECT_EQ(json_number(1e300), "1e+300");
+  for (const double x : {1.0 / 90, 2.0 / 3, 1e-310, 123456789.123456789, -7.25e-5}) {
+    const std::string text = json_number(x);
+    EXPECT_EQ(std::strtod(text.c_str(), nullptr), x) << text;
+  }
+}
+
+TEST(Json, NonFiniteNumbersAreNull) {
+  // JSON has no NaN or infinity: reports and the command line write null.
+  EXPECT_EQ(json_number(std::numeric_limits<double>::quiet_NaN()), "null");
+  EXPECT_EQ(json_number(std::numeric_limits<double>::infinity()), "null");
+  EXPECT_EQ(json_number(-std::numeric_limits<double>::infinity()), "null");
+}
+
+TEST(Json, StringsAreEscaped) { EXPECT_EQ(json_string("a\"b\\c\n"), "\"a\\\"b\\\\c\\n\""); }
+
+}  // namespace
+}  // namespace dovetail::engine
