@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/model.h"
 #include "dovetail/collision/pose_sampling.h"
@@ -37,15 +38,11 @@
 
 namespace {
 
+using dovetail::bench::median;
+
 using namespace dovetail;
 using collision::Method;
 using Clock = std::chrono::steady_clock;
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 struct Options {
   std::string mesh_a, mesh_b;
@@ -72,15 +69,6 @@ struct Setting {
   std::exit(2);
 }
 
-long positive(const char* flag, const char* text) {
-  char* end = nullptr;
-  const long v = std::strtol(text, &end, 10);
-  if (end == text || *end != '\0' || v < 1) {
-    usage(std::string(flag) + " needs a positive whole number, not '" + text + "'");
-  }
-  return v;
-}
-
 Options parse(int argc, char** argv) {
   Options o;
   std::vector<std::string> meshes;
@@ -88,11 +76,14 @@ Options parse(int argc, char** argv) {
     const std::string arg = argv[i];
     const bool has_value = i + 1 < argc;
     if (arg == "--directions" && has_value) {
-      o.directions = static_cast<int>(positive("--directions", argv[++i]));
+      o.directions = static_cast<int>(
+          dovetail::bench::whole("accuracy_bench", "--directions", argv[++i], 1, 1000000));
     } else if (arg == "--runs" && has_value) {
-      o.runs = static_cast<int>(positive("--runs", argv[++i]));
+      o.runs =
+          static_cast<int>(dovetail::bench::whole("accuracy_bench", "--runs", argv[++i], 1, 1000));
     } else if (arg == "--seed" && has_value) {
-      o.seed = static_cast<std::uint64_t>(positive("--seed", argv[++i]));
+      o.seed = static_cast<std::uint64_t>(
+          dovetail::bench::whole("accuracy_bench", "--seed", argv[++i], 0, 1LL << 62));
     } else if (arg == "--table" && has_value) {
       o.table = argv[++i];
     } else if (arg.rfind("--", 0) == 0) {

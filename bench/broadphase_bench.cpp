@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "dovetail/collision/broadphase.h"
 
 #ifdef DOVETAIL_HAVE_BULLET
@@ -38,6 +39,8 @@
 
 namespace {
 
+using dovetail::bench::median;
+
 using namespace dovetail::collision;
 using Clock = std::chrono::steady_clock;
 using Frames = std::vector<std::vector<Aabb>>;
@@ -47,13 +50,6 @@ constexpr double kWorld = 100;
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 /// splitmix64: the same scene on every platform.
@@ -285,17 +281,21 @@ Options parse(int argc, char** argv) {
     if (i + 1 >= argc) usage(("missing value for " + arg).c_str());
     const char* value = argv[++i];
     if (arg == "--objects") {
-      o.objects = std::atoi(value);
+      o.objects = static_cast<int>(
+          dovetail::bench::whole("broadphase_bench", "--objects", value, 2, 10000000));
     } else if (arg == "--frames") {
-      o.frames = std::atoi(value);
+      o.frames = static_cast<int>(
+          dovetail::bench::whole("broadphase_bench", "--frames", value, 1, 1000000));
     } else if (arg == "--runs") {
-      o.runs = std::atoi(value);
+      o.runs =
+          static_cast<int>(dovetail::bench::whole("broadphase_bench", "--runs", value, 1, 1000));
     } else if (arg == "--seed") {
-      o.seed = std::strtoull(value, nullptr, 10);
+      o.seed = static_cast<std::uint64_t>(
+          dovetail::bench::whole("broadphase_bench", "--seed", value, 0, 1LL << 62));
     } else if (arg == "--size") {
-      o.size = std::atof(value);
+      o.size = dovetail::bench::real("broadphase_bench", "--size", value, 0);
     } else if (arg == "--speed") {
-      o.speed = std::atof(value);
+      o.speed = dovetail::bench::real("broadphase_bench", "--speed", value, 0);
     } else if (arg == "--write-scene") {
       o.write_scene = value;
     } else {

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/primitives.h"
 
@@ -36,16 +37,12 @@
 
 namespace {
 
+using dovetail::bench::median;
+
 using namespace dovetail::collision;
 using Clock = std::chrono::steady_clock;
 
 constexpr double kPi = 3.14159265358979323846;
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 struct Options {
   int pairs = 64;
@@ -295,17 +292,20 @@ int main(int argc, char** argv) {
       return argv[++i];
     };
     if (const char* v = value("--pairs")) {
-      o.pairs = std::atoi(v);
+      o.pairs = static_cast<int>(dovetail::bench::whole("convex_bench", "--pairs", v, 1, 10000000));
     } else if (const char* v2 = value("--frames")) {
-      o.frames = std::atoi(v2);
+      o.frames =
+          static_cast<int>(dovetail::bench::whole("convex_bench", "--frames", v2, 1, 1000000));
     } else if (const char* v3 = value("--vertices")) {
-      o.vertices = std::atoi(v3);
+      o.vertices =
+          static_cast<int>(dovetail::bench::whole("convex_bench", "--vertices", v3, 4, 10000000));
     } else if (const char* v6 = value("--speed")) {
-      o.speed = std::atof(v6);
+      o.speed = dovetail::bench::real("convex_bench", "--speed", v6, 0);
     } else if (const char* v4 = value("--runs")) {
-      o.runs = std::atoi(v4);
+      o.runs = static_cast<int>(dovetail::bench::whole("convex_bench", "--runs", v4, 1, 1000));
     } else if (const char* v5 = value("--seed")) {
-      o.seed = std::strtoull(v5, nullptr, 10);
+      o.seed = static_cast<std::uint64_t>(
+          dovetail::bench::whole("convex_bench", "--seed", v5, 0, 1LL << 62));
     } else {
       std::fprintf(stderr,
                    "usage: convex_bench [--pairs N] [--frames F] [--vertices V] [--speed K] "

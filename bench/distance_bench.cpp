@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "dovetail/collision/distance.h"
 #include "dovetail/collision/model.h"
 #include "dovetail/collision/pose_sampling.h"
@@ -30,17 +31,13 @@
 
 namespace {
 
+using dovetail::bench::median;
+
 using namespace dovetail;
 using Clock = std::chrono::steady_clock;
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 struct Options {
@@ -288,13 +285,17 @@ int main(int argc, char** argv) {
       return argv[++i];
     };
     if (arg == "--directions")
-      options.directions = std::stoi(value());
+      options.directions = static_cast<int>(
+          dovetail::bench::whole("distance_bench", "--directions", value().c_str(), 1, 1000000));
     else if (arg == "--runs")
-      options.runs = std::stoi(value());
+      options.runs = static_cast<int>(
+          dovetail::bench::whole("distance_bench", "--runs", value().c_str(), 1, 1000));
     else if (arg == "--seed")
-      options.seed = std::stoull(value());
+      options.seed = static_cast<std::uint64_t>(
+          dovetail::bench::whole("distance_bench", "--seed", value().c_str(), 0, 1LL << 62));
     else if (arg == "--leaf")
-      options.leaf = std::stoi(value());
+      options.leaf = static_cast<int>(
+          dovetail::bench::whole("distance_bench", "--leaf", value().c_str(), 1, 64));
     else if (arg == "--json")
       options.json = value();
     else if (arg == "--help") {

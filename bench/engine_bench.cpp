@@ -19,12 +19,15 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/pose_sampling.h"
 #include "dovetail/engine/scene.h"
 #include "dovetail/engine/simulation.h"
 
 namespace {
+
+using dovetail::bench::median;
 
 using namespace dovetail;
 using collision::Real;
@@ -34,12 +37,6 @@ using Clock = std::chrono::steady_clock;
 
 constexpr const char* kEngine =
     "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 struct RunResult {
   double polygon_pairs = 0, colliding_pairs = 0, volume_tests = 0;  ///< per frame
@@ -214,9 +211,10 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i];
     if (arg == "--seconds")
-      seconds = std::stod(argv[i + 1]);
+      seconds = dovetail::bench::real("engine_bench", "--seconds", argv[i + 1], 0);
     else if (arg == "--runs")
-      runs = std::stoi(argv[i + 1]);
+      runs =
+          static_cast<int>(dovetail::bench::whole("engine_bench", "--runs", argv[i + 1], 1, 1000));
     else if (arg == "--assembly")
       assembly = argv[i + 1];
     else if (arg == "--only")

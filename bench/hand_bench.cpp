@@ -46,6 +46,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "dovetail/collision/contacts.h"
 #include "dovetail/collision/distance.h"
 #include "dovetail/collision/model.h"
@@ -61,6 +62,8 @@
 
 namespace {
 
+using dovetail::bench::percentile;
+
 using namespace dovetail;
 using collision::Mat3;
 using collision::Real;
@@ -69,12 +72,6 @@ using collision::Vec3;
 using interaction::GlovePlan;
 using interaction::PlanStep;
 using Clock = std::chrono::steady_clock;
-
-double percentile(std::vector<double> v, double p) {
-  std::sort(v.begin(), v.end());
-  const auto i = static_cast<std::size_t>(std::llround(p * static_cast<double>(v.size() - 1)));
-  return v[i];
-}
 
 /// Two grids of n x n quads, 1 mm apart, plus four side walls.
 collision::Mesh plate(Real size, int n) {
@@ -261,8 +258,8 @@ void grasp_picture(const std::string& pictures) {
 
 /// What the sliding scene gave over all runs.
 struct SlidingRuns {
-  std::vector<double> contact_ms;   ///< interaction step per frame in contact, all runs
-  std::vector<double> run_medians;  ///< median of each run
+  std::vector<double> contact_ms;       ///< interaction step per frame in contact, all runs
+  std::vector<double> run_medians;      ///< median of each run
   std::uint64_t frames_in_contact = 0;  ///< of the first run
   std::uint64_t mated = 0;
   std::size_t triangles = 0;
@@ -366,8 +363,8 @@ void sliding(int runs, const std::string& pictures, bool pair_guided, double slo
       "sliding (%s): %zu-triangle peg into a hole, %llu frames in contact per run, mated in "
       "%llu of %d runs\n",
       pair_guided ? "pair-guided" : "plain", r.triangles,
-      static_cast<unsigned long long>(r.frames_in_contact), static_cast<unsigned long long>(r.mated),
-      runs);
+      static_cast<unsigned long long>(r.frames_in_contact),
+      static_cast<unsigned long long>(r.mated), runs);
   std::printf(
       "  interaction step ms per frame in contact: median %.4f  p95 %.4f  worst %.4f  "
       "run medians %.4f (%.4f..%.4f)\n",
@@ -408,8 +405,9 @@ void sliding_sweep(int runs, const std::string& table_path) {
                  "# setting median_ms p95_ms worst_ms max_penetration_mm median_gap_um "
                  "p95_gap_um mated_runs runs\n");
   }
-  std::printf("sliding sweep: %d runs each; ms per frame in contact; deepest overlap over all frames\n",
-              runs);
+  std::printf(
+      "sliding sweep: %d runs each; ms per frame in contact; deepest overlap over all frames\n",
+      runs);
   std::printf("%-18s %9s %9s %9s %15s %14s %11s %6s\n", "setting", "median", "p95", "worst",
               "penetration mm", "gap median um", "gap p95 um", "mated");
   for (const Variant& v : variants) {
@@ -422,8 +420,8 @@ void sliding_sweep(int runs, const std::string& table_path) {
                 p95, worst, 1000 * r.max_penetration, gap_median, gap_p95,
                 static_cast<unsigned long long>(r.mated), runs);
     if (table) {
-      std::fprintf(table, "%s %.5f %.5f %.5f %.7f %.4f %.4f %llu %d\n", v.name.c_str(), median,
-                   p95, worst, 1000 * r.max_penetration, gap_median, gap_p95,
+      std::fprintf(table, "%s %.5f %.5f %.5f %.7f %.4f %.4f %llu %d\n", v.name.c_str(), median, p95,
+                   worst, 1000 * r.max_penetration, gap_median, gap_p95,
                    static_cast<unsigned long long>(r.mated), runs);
     }
   }
@@ -441,11 +439,11 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--runs" && i + 1 < argc) {
-      runs = std::max(1, std::atoi(argv[++i]));
+      runs = static_cast<int>(dovetail::bench::whole("hand_bench", "--runs", argv[++i], 1, 1000));
     } else if (arg == "--pictures" && i + 1 < argc) {
       pictures = argv[++i];
     } else if (arg == "--slow" && i + 1 < argc) {
-      slow_ms = std::atof(argv[++i]);
+      slow_ms = dovetail::bench::real("hand_bench", "--slow", argv[++i], 0);
     } else if (arg == "--sweep" && i + 1 < argc) {
       sweep = argv[++i];
     } else if (arg == "--detail" && i + 1 < argc) {

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "dovetail/collision/collision_world.h"
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/pose_sampling.h"
@@ -30,17 +31,13 @@
 
 namespace {
 
+using dovetail::bench::median;
+
 using namespace dovetail::collision;
 using Clock = std::chrono::steady_clock;
 
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 /// A random convex polytope: the hull of `points` random points on a sphere
@@ -253,13 +250,16 @@ int main(int argc, char** argv) {
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string arg = argv[i];
     if (arg == "--n")
-      n = std::stoul(argv[i + 1]);
+      n = static_cast<std::size_t>(
+          dovetail::bench::whole("pipeline_bench", "--n", argv[i + 1], 2, 10000000));
     else if (arg == "--density")
-      density = std::stod(argv[i + 1]);
+      density = dovetail::bench::real("pipeline_bench", "--density", argv[i + 1], 0);
     else if (arg == "--frames")
-      frames = std::stoi(argv[i + 1]);
+      frames = static_cast<int>(
+          dovetail::bench::whole("pipeline_bench", "--frames", argv[i + 1], 1, 1000000));
     else if (arg == "--runs")
-      runs = std::stoi(argv[i + 1]);
+      runs = static_cast<int>(
+          dovetail::bench::whole("pipeline_bench", "--runs", argv[i + 1], 1, 1000));
     else {
       std::fprintf(stderr, "pipeline_bench: unknown option %s\n", arg.c_str());
       return 2;

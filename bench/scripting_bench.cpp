@@ -14,9 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "dovetail/scripting/scenario_run.h"
 
 namespace {
+
+using dovetail::bench::median;
 
 using dovetail::scripting::RunOutcome;
 
@@ -70,19 +73,20 @@ std::string scenario(int n, int rules) {
   return s;
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   int runs = 5, parts = 1000, rules = 100;
   for (int i = 1; i + 1 < argc; i += 2) {
-    if (std::strcmp(argv[i], "--runs") == 0) runs = std::atoi(argv[i + 1]);
-    if (std::strcmp(argv[i], "--parts") == 0) parts = std::atoi(argv[i + 1]);
-    if (std::strcmp(argv[i], "--rules") == 0) rules = std::atoi(argv[i + 1]);
+    if (std::strcmp(argv[i], "--runs") == 0)
+      runs = static_cast<int>(
+          dovetail::bench::whole("scripting_bench", "--runs", argv[i + 1], 1, 1000));
+    if (std::strcmp(argv[i], "--parts") == 0)
+      parts = static_cast<int>(
+          dovetail::bench::whole("scripting_bench", "--parts", argv[i + 1], 1, 1000000));
+    if (std::strcmp(argv[i], "--rules") == 0)
+      rules = static_cast<int>(
+          dovetail::bench::whole("scripting_bench", "--rules", argv[i + 1], 0, 1000000));
   }
   const auto dir = std::filesystem::temp_directory_path() / "dovetail_scripting_bench";
   std::filesystem::create_directories(dir);

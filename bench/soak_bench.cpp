@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "dovetail/scripting/scenario_run.h"
 
 namespace {
@@ -131,9 +132,12 @@ int main(int argc, char** argv) {
       minutes.clear();
       std::stringstream list(argv[i + 1]);
       std::string item;
-      while (std::getline(list, item, ',')) minutes.push_back(std::atof(item.c_str()));
+      while (std::getline(list, item, ',')) {
+        minutes.push_back(dovetail::bench::real("soak_bench", "--minutes", item.c_str(), 0));
+      }
     } else if (std::strcmp(argv[i], "--threads") == 0) {
-      threads = std::atoi(argv[i + 1]);
+      threads =
+          static_cast<int>(dovetail::bench::whole("soak_bench", "--threads", argv[i + 1], 0, 1024));
     }
   }
   if (!std::filesystem::exists(kEngine)) {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/model.h"
 #include "dovetail/collision/primitives.h"
@@ -58,10 +59,8 @@ Options parse(int argc, char** argv) {
     const std::string arg = argv[i];
     const bool has_value = i + 1 < argc;
     if (arg == "--steps" && has_value) {
-      char* end = nullptr;
-      const long v = std::strtol(argv[++i], &end, 10);
-      if (*end != '\0' || v < 1) usage("--steps needs a positive whole number");
-      o.steps = static_cast<int>(v);
+      o.steps =
+          static_cast<int>(dovetail::bench::whole("tumble_bench", "--steps", argv[++i], 1, 100000));
     } else if (arg == "--distances" && has_value) {
       if (std::sscanf(argv[++i], "%lf:%lf:%lf", &o.d0, &o.d1, &o.dstep) != 3 || !(o.dstep > 0) ||
           !(o.d1 >= o.d0)) {
