@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "disjoint_sets.h"
 #include "dovetail/collision/containment.h"
 #include "dovetail/collision/predicates.h"
 #include "tri_distance.h"
@@ -19,30 +20,8 @@ namespace dovetail::collision {
 
 namespace {
 
+using detail::DisjointSets;
 using detail::VertexTriangles;
-
-/// Union-find over piece indices, smaller root kept (so a patch's root is its first pair).
-class DisjointSets {
- public:
-  explicit DisjointSets(std::size_t n) : parent_(n) {
-    std::iota(parent_.begin(), parent_.end(), std::size_t{0});
-  }
-  std::size_t find(std::size_t i) {
-    while (parent_[i] != i) {
-      parent_[i] = parent_[parent_[i]];
-      i = parent_[i];
-    }
-    return i;
-  }
-  void join(std::size_t i, std::size_t j) {
-    i = find(i);
-    j = find(j);
-    if (i != j) parent_[std::max(i, j)] = std::min(i, j);
-  }
-
- private:
-  std::vector<std::size_t> parent_;
-};
 
 /// One pair with its triangles in A's frame and its piece of intersection.
 struct PairPiece {

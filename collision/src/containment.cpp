@@ -10,6 +10,7 @@
 #include <tuple>
 #include <vector>
 
+#include "disjoint_sets.h"
 #include "predicates_inline.h"
 
 namespace dovetail::collision {
@@ -56,12 +57,7 @@ std::vector<Edge> directed_edges(const Mesh& mesh) {
 /// Connected surface components (shells) of a mesh: triangles joined through
 /// shared edges. Returns the shell of each triangle and the shell count.
 std::pair<std::vector<std::uint32_t>, std::size_t> shells(const Mesh& mesh) {
-  std::vector<std::uint32_t> parent(mesh.triangles.size());
-  std::iota(parent.begin(), parent.end(), std::uint32_t{0});
-  const auto find = [&](std::uint32_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  detail::DisjointSets sets(mesh.triangles.size());
   std::vector<Edge> edges = directed_edges(mesh);
   for (Edge& e : edges) {
     if (e.from > e.to) std::swap(e.from, e.to);
@@ -69,16 +65,14 @@ std::pair<std::vector<std::uint32_t>, std::size_t> shells(const Mesh& mesh) {
   std::sort(edges.begin(), edges.end());
   for (std::size_t k = 1; k < edges.size(); ++k) {
     if (edges[k].from == edges[k - 1].from && edges[k].to == edges[k - 1].to) {
-      const std::uint32_t r1 = find(edges[k].triangle);
-      const std::uint32_t r2 = find(edges[k - 1].triangle);
-      parent[std::max(r1, r2)] = std::min(r1, r2);
+      sets.join(edges[k].triangle, edges[k - 1].triangle);
     }
   }
   std::vector<std::uint32_t> shell(mesh.triangles.size());
   std::vector<std::uint32_t> number(mesh.triangles.size(), UINT32_MAX);
   std::size_t count = 0;
   for (std::uint32_t t = 0; t < shell.size(); ++t) {
-    const std::uint32_t r = find(t);
+    const std::size_t r = sets.find(t);
     if (number[r] == UINT32_MAX) number[r] = static_cast<std::uint32_t>(count++);
     shell[t] = number[r];
   }

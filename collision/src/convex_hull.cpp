@@ -21,37 +21,12 @@
 #include "convex_internal.h"
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/predicates.h"
+#include "expansion.h"
 #include "predicates_inline.h"
 
 namespace dovetail::collision {
 
 namespace detail {
-
-namespace {
-
-inline void two_sum(Real a, Real b, Real& s, Real& e) {
-  s = a + b;
-  const Real bv = s - a;
-  const Real av = s - bv;
-  e = (a - av) + (b - bv);
-}
-
-/// h := h + b for a nonoverlapping expansion h of increasing magnitude, zero
-/// components eliminated (Shewchuk's grow-expansion).
-inline int grow_expansion(Real* h, int m, Real b) {
-  Real q = b;
-  int k = 0;
-  for (int i = 0; i < m; ++i) {
-    Real s, e;
-    two_sum(q, h[i], s, e);
-    q = s;
-    if (e != 0) h[k++] = e;
-  }
-  if (q != 0 || k == 0) h[k++] = q;
-  return k;
-}
-
-}  // namespace
 
 int dot_difference_sign(const Vec3& d, const Vec3& u, const Vec3& v) {
   Real h[13];

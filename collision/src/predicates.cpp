@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "expansion.h"
 #include "predicates_inline.h"
 
 // Exact evaluation by floating-point expansions (Shewchuk, "Adaptive Precision
@@ -31,6 +32,11 @@ namespace dovetail::collision {
 
 namespace {
 
+using detail::fast_two_sum;
+using detail::two_diff;
+using detail::two_product;
+using detail::two_sum;
+
 /// Capacities, in components, of the expansions formed below.
 constexpr int kDifference = 2;
 constexpr int kProduct2 = 8;  // difference x difference
@@ -38,34 +44,6 @@ constexpr int kMinor = 16;    // difference of two such products
 constexpr int kTerm = 64;     // difference x minor
 constexpr int kDet3 = 3 * kTerm;
 constexpr int kDet2 = 2 * kProduct2;
-
-/// s + e = a + b exactly.
-inline void two_sum(Real a, Real b, Real& s, Real& e) {
-  s = a + b;
-  const Real b_virtual = s - a;
-  const Real a_virtual = s - b_virtual;
-  e = (a - a_virtual) + (b - b_virtual);
-}
-
-/// s + e = a + b exactly, when |a| >= |b| or a == 0.
-inline void fast_two_sum(Real a, Real b, Real& s, Real& e) {
-  s = a + b;
-  e = b - (s - a);
-}
-
-/// d + e = a - b exactly.
-inline void two_diff(Real a, Real b, Real& d, Real& e) {
-  d = a - b;
-  const Real b_virtual = a - d;
-  const Real a_virtual = d + b_virtual;
-  e = (a - a_virtual) + (b_virtual - b);
-}
-
-/// p + e = a * b exactly (inside the documented range).
-inline void two_product(Real a, Real b, Real& p, Real& e) {
-  p = a * b;
-  e = std::fma(a, b, -p);
-}
 
 /// Exact a - b as an expansion in h (capacity kDifference); returns its length.
 int difference(Real a, Real b, Real* h) {
