@@ -8,6 +8,8 @@
 /// opposite that vertex, which is searched in turn. Used by GJK and by the
 /// separating-plane search.
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -228,6 +230,28 @@ struct Simplex {
       lambda[k] = r.lambda[k];
     }
     size = r.count;
+  }
+
+  /// Adds the vertex pairs a previous search left in its cache (the first
+  /// `cached_size` of `ia`, `ib`), skipping pairs that are not vertices of
+  /// hulls with `na` and `nb` vertices; `point(ia, ib)` makes a vertex.
+  template <typename MakePoint>
+  void load(const std::array<std::uint32_t, 4>& ia, const std::array<std::uint32_t, 4>& ib,
+            int cached_size, std::uint32_t na, std::uint32_t nb, MakePoint&& point) {
+    const int n = std::clamp(cached_size, 0, 4);
+    for (int k = 0; k < n; ++k) {
+      if (ia[k] < na && ib[k] < nb) add(point(ia[k], ib[k]));
+    }
+  }
+
+  /// Leaves the vertex pairs in a cache for the next search.
+  void store(std::array<std::uint32_t, 4>& ia, std::array<std::uint32_t, 4>& ib,
+             int& cached_size) const {
+    cached_size = size;
+    for (int k = 0; k < size; ++k) {
+      ia[k] = p[k].ia;
+      ib[k] = p[k].ib;
+    }
   }
 };
 

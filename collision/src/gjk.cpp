@@ -83,12 +83,7 @@ GjkResult gjk(const ConvexHull& a, const ConvexHull& b, const Transform& X_AB, G
   if (cache && cache->valid) {
     last_a = cache->support_a < na ? cache->support_a : 0;
     last_b = cache->support_b < nb ? cache->support_b : 0;
-    const int size = std::clamp(cache->simplex_size, 0, 4);
-    for (int k = 0; k < size; ++k) {
-      if (cache->simplex_a[k] < na && cache->simplex_b[k] < nb) {
-        simplex.add(make_point(cache->simplex_a[k], cache->simplex_b[k]));
-      }
-    }
+    simplex.load(cache->simplex_a, cache->simplex_b, cache->simplex_size, na, nb, make_point);
     if (simplex.size == 0) simplex.add(make_point(last_a, last_b));
   } else {
     const Vec3 v0 = a.center - X_AB.apply(b.center);
@@ -158,11 +153,7 @@ GjkResult gjk(const ConvexHull& a, const ConvexHull& b, const Transform& X_AB, G
     cache->support_a = last_a;
     cache->support_b = last_b;
     cache->direction = current.v;
-    cache->simplex_size = simplex.size;
-    for (int k = 0; k < simplex.size; ++k) {
-      cache->simplex_a[k] = simplex.p[k].ia;
-      cache->simplex_b[k] = simplex.p[k].ib;
-    }
+    simplex.store(cache->simplex_a, cache->simplex_b, cache->simplex_size);
   }
   return result;
 }

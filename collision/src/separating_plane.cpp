@@ -93,11 +93,8 @@ SeparatingPlaneResult separating_plane_test(const ConvexHull& a, const ConvexHul
   bool loaded = false;
   auto load = [&]() {
     loaded = true;
-    const int size = cache.valid ? std::clamp(cache.simplex_size, 0, 4) : 0;
-    for (int k = 0; k < size; ++k) {
-      if (cache.simplex_a[k] < na && cache.simplex_b[k] < nb) {
-        simplex.add(make_point(cache.simplex_a[k], cache.simplex_b[k]));
-      }
+    if (cache.valid) {
+      simplex.load(cache.simplex_a, cache.simplex_b, cache.simplex_size, na, nb, make_point);
     }
     if (simplex.size > 0) {
       current = simplex.nearest();
@@ -186,11 +183,7 @@ SeparatingPlaneResult separating_plane_test(const ConvexHull& a, const ConvexHul
   cache.valid = true;
   cache.support_a = ia;
   cache.support_b = ib;
-  cache.simplex_size = simplex.size;
-  for (int k = 0; k < simplex.size; ++k) {
-    cache.simplex_a[k] = simplex.p[k].ia;
-    cache.simplex_b[k] = simplex.p[k].ib;
-  }
+  simplex.store(cache.simplex_a, cache.simplex_b, cache.simplex_size);
   return result;
 }
 
