@@ -170,14 +170,14 @@ Transform Scene::world_pose(PartHandle part) const {
   // Iterative, root first, so a deep chain cannot exhaust the stack.
   std::vector<const Slot*> chain;
   for (PartHandle p = part; p.valid(); p = slot(p).parent) chain.push_back(&slot(p));
-  Transform X_WP = chain.back()->X_PC;
-  for (std::size_t k = chain.size() - 1; k > 0; --k) X_WP = compose(X_WP, chain[k - 1]->X_PC);
-  return X_WP;
+  Transform X_WC = chain.back()->X_PC;  // the root, in the world
+  for (std::size_t k = chain.size() - 1; k > 0; --k) X_WC = compose(X_WC, chain[k - 1]->X_PC);
+  return X_WC;
 }
 
-void Scene::set_world_pose(PartHandle part, const Transform& X_WP) {
-  const PartHandle p = slot(part).parent;
-  slot(part).X_PC = p.valid() ? compose(world_pose(p).inverse(), X_WP) : X_WP;
+void Scene::set_world_pose(PartHandle part, const Transform& X_WC) {
+  const PartHandle parent = slot(part).parent;
+  slot(part).X_PC = parent.valid() ? compose(world_pose(parent).inverse(), X_WC) : X_WC;
 }
 
 bool Scene::movable(PartHandle part) const { return slot(part).movable; }

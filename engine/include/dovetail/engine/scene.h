@@ -111,11 +111,12 @@ class Scene {
   void set_local_pose(std::string_view name, const Transform& X_PC) {
     set_local_pose(get(name), X_PC);
   }
-  /// X_WP = X_W(parent) * X_PC, composed from the root down.
+  /// X_WC, the part C in the world: X_WP * X_PC with P its parent (in the
+  /// scene's letters C is the part and P its parent), composed from the root down.
   Transform world_pose(PartHandle part) const;
   Transform world_pose(std::string_view name) const { return world_pose(get(name)); }
-  /// Sets the local pose so that the world pose becomes X_WP.
-  void set_world_pose(PartHandle part, const Transform& X_WP);
+  /// Sets the local pose X_PC so that the part's world pose becomes X_WC.
+  void set_world_pose(PartHandle part, const Transform& X_WC);
 
   const std::string& collision_group(PartHandle part) const;
   const std::optional<std::array<float, 3>>& color(PartHandle part) const;
