@@ -106,9 +106,9 @@ void engine_assembly(const std::string& path, double seconds, int runs) {
     options.movable = false;
     engine::Scene scene = engine::load_assembly(path, options);
     // The four largest parts move; the rest is fixed.
-    std::vector<engine::PartHandle> all = scene.parts();
-    std::vector<engine::PartHandle> with_mesh;
-    for (engine::PartHandle p : all) {
+    std::vector<engine::PartId> all = scene.parts();
+    std::vector<engine::PartId> with_mesh;
+    for (engine::PartId p : all) {
       if (scene.collision_mesh(p)) with_mesh.push_back(p);
     }
     std::stable_sort(with_mesh.begin(), with_mesh.end(), [&](auto x, auto y) {
@@ -116,17 +116,17 @@ void engine_assembly(const std::string& path, double seconds, int runs) {
     });
     // Size of the assembly: the spread of the parts' origins and meshes.
     Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-    for (engine::PartHandle p : with_mesh) {
+    for (engine::PartId p : with_mesh) {
       const collision::Bounds b = collision::mesh_bounds(*scene.collision_mesh(p));
       const Transform X = scene.world_pose(p);
       lo = lo.cwiseMin(X.apply(b.min)).cwiseMin(X.apply(b.max));
       hi = hi.cwiseMax(X.apply(b.min)).cwiseMax(X.apply(b.max));
     }
     const Real size = (hi - lo).norm();
-    std::vector<engine::PartHandle> moving(
+    std::vector<engine::PartId> moving(
         with_mesh.begin(), with_mesh.begin() + std::min<std::size_t>(4, with_mesh.size()));
     std::vector<Transform> start;
-    for (engine::PartHandle p : moving) {
+    for (engine::PartId p : moving) {
       scene.set_movable(p, true);
       start.push_back(scene.local_pose(p));
     }
@@ -172,7 +172,7 @@ void synthetic(std::size_t n, double seconds, int runs) {
     const std::vector<Transform> motion = collision::random_poses(n, 0.5, 6);
     std::vector<Transform> pose(n);
     std::vector<Vec3> velocity(n);
-    std::vector<engine::PartHandle> handles;
+    std::vector<engine::PartId> handles;
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3 cell(static_cast<Real>(i % side), static_cast<Real>((i / side) % side),
                       static_cast<Real>(i / (side * side)));

@@ -43,7 +43,7 @@ std::uint64_t state_hash(const Scene& scene) {
     hash = (hash ^ w) * 0x100000001b3ull;
     hash ^= hash >> 32;
   };
-  for (const PartHandle part : scene.parts()) {
+  for (const PartId part : scene.parts()) {
     const std::string& name = scene.name(part);
     for (std::size_t i = 0; i <= name.size(); i += 8) {
       std::uint64_t w = 0;

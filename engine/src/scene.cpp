@@ -29,7 +29,7 @@ Transform compose(const Transform& X_AB, const Transform& X_BC) {
   return X_AC;
 }
 
-const Scene::Slot& Scene::slot(PartHandle part) const {
+const Scene::Slot& Scene::slot(PartId part) const {
   if (!part.valid() || part.index >= slots_.size() || !slots_[part.index].alive ||
       slots_[part.index].generation != part.generation) {
     throw SceneError("scene: stale or invalid part handle (index " + std::to_string(part.index) +
@@ -38,34 +38,34 @@ const Scene::Slot& Scene::slot(PartHandle part) const {
   return slots_[part.index];
 }
 
-Scene::Slot& Scene::slot(PartHandle part) {
+Scene::Slot& Scene::slot(PartId part) {
   return const_cast<Slot&>(static_cast<const Scene&>(*this).slot(part));
 }
 
-bool Scene::contains(PartHandle part) const {
+bool Scene::contains(PartId part) const {
   return part.valid() && part.index < slots_.size() && slots_[part.index].alive &&
          slots_[part.index].generation == part.generation;
 }
 
-PartHandle Scene::find(std::string_view name) const {
+PartId Scene::find(std::string_view name) const {
   const auto it = std::lower_bound(by_name_.begin(), by_name_.end(), name, name_less);
   if (it == by_name_.end() || it->first != name) return {};
   return {it->second, slots_[it->second].generation};
 }
 
-PartHandle Scene::get(std::string_view name) const {
-  const PartHandle part = find(name);
+PartId Scene::get(std::string_view name) const {
+  const PartId part = find(name);
   if (!part.valid()) throw SceneError("scene: no part named " + in_quotes(name));
   return part;
 }
 
-PartHandle Scene::add_part(const PartDesc& desc) {
+PartId Scene::add_part(const PartDef& desc) {
   if (desc.name.empty()) throw SceneError("scene: a part needs a name");
   const auto at = std::lower_bound(by_name_.begin(), by_name_.end(), desc.name, name_less);
   if (at != by_name_.end() && at->first == desc.name) {
     throw SceneError("scene: duplicate part name " + in_quotes(desc.name));
   }
-  PartHandle parent;
+  PartId parent;
   if (!desc.parent.empty()) {
     parent = find(desc.parent);
     if (!parent.valid()) {
@@ -97,10 +97,10 @@ PartHandle Scene::add_part(const PartDesc& desc) {
   return {index, s.generation};
 }
 
-void Scene::remove_part(PartHandle part) {
+void Scene::remove_part(PartId part) {
   const Slot& removed = slot(part);
-  const PartHandle grandparent = removed.parent;
-  for (const PartHandle child : children(part)) set_parent(child, grandparent, true);
+  const PartId grandparent = removed.parent;
+  for (const PartId child : children(part)) set_parent(child, grandparent, true);
   Slot& s = slot(part);
   const auto at = std::lower_bound(by_name_.begin(), by_name_.end(), s.name, name_less);
   by_name_.erase(at);
@@ -111,48 +111,48 @@ void Scene::remove_part(PartHandle part) {
   --count_;
 }
 
-std::vector<PartHandle> Scene::parts() const {
-  std::vector<PartHandle> out;
+std::vector<PartId> Scene::parts() const {
+  std::vector<PartId> out;
   out.reserve(by_name_.size());
   for (const auto& [name, index] : by_name_) out.push_back({index, slots_[index].generation});
   return out;
 }
 
-std::vector<PartHandle> Scene::parts_with_tag(std::string_view tag) const {
-  std::vector<PartHandle> out;
-  for (const PartHandle part : parts()) {
+std::vector<PartId> Scene::parts_with_tag(std::string_view tag) const {
+  std::vector<PartId> out;
+  for (const PartId part : parts()) {
     if (has_tag(part, tag)) out.push_back(part);
   }
   return out;
 }
 
-const std::string& Scene::name(PartHandle part) const { return slot(part).name; }
-const std::vector<std::string>& Scene::tags(PartHandle part) const { return slot(part).tags; }
+const std::string& Scene::name(PartId part) const { return slot(part).name; }
+const std::vector<std::string>& Scene::tags(PartId part) const { return slot(part).tags; }
 
-bool Scene::has_tag(PartHandle part, std::string_view tag) const {
+bool Scene::has_tag(PartId part, std::string_view tag) const {
   const auto& t = slot(part).tags;
   return std::find(t.begin(), t.end(), tag) != t.end();
 }
 
-void Scene::add_tag(PartHandle part, const std::string& tag) {
+void Scene::add_tag(PartId part, const std::string& tag) {
   if (!has_tag(part, tag)) slot(part).tags.push_back(tag);
 }
 
-PartHandle Scene::parent(PartHandle part) const { return slot(part).parent; }
+PartId Scene::parent(PartId part) const { return slot(part).parent; }
 
-std::vector<PartHandle> Scene::children(PartHandle part) const {
+std::vector<PartId> Scene::children(PartId part) const {
   slot(part);
-  std::vector<PartHandle> out;
-  for (const PartHandle p : parts()) {
+  std::vector<PartId> out;
+  for (const PartId p : parts()) {
     if (slots_[p.index].parent == part) out.push_back(p);
   }
   return out;
 }
 
-void Scene::set_parent(PartHandle part, PartHandle parent, bool keep_world_pose) {
+void Scene::set_parent(PartId part, PartId parent, bool keep_world_pose) {
   const Transform X_WC = world_pose(part);
   if (parent.valid()) {
-    for (PartHandle p = parent; p.valid(); p = slot(p).parent) {
+    for (PartId p = parent; p.valid(); p = slot(p).parent) {
       if (p == part) {
         throw SceneError("scene: making " + in_quotes(name(parent)) + " the parent of " +
                          in_quotes(name(part)) + " would make a cycle");
@@ -163,44 +163,42 @@ void Scene::set_parent(PartHandle part, PartHandle parent, bool keep_world_pose)
   if (keep_world_pose) set_world_pose(part, X_WC);
 }
 
-const Transform& Scene::local_pose(PartHandle part) const { return slot(part).X_PC; }
-void Scene::set_local_pose(PartHandle part, const Transform& X_PC) { slot(part).X_PC = X_PC; }
+const Transform& Scene::local_pose(PartId part) const { return slot(part).X_PC; }
+void Scene::set_local_pose(PartId part, const Transform& X_PC) { slot(part).X_PC = X_PC; }
 
-Transform Scene::world_pose(PartHandle part) const {
+Transform Scene::world_pose(PartId part) const {
   // Iterative, root first, so a deep chain cannot exhaust the stack.
   std::vector<const Slot*> chain;
-  for (PartHandle p = part; p.valid(); p = slot(p).parent) chain.push_back(&slot(p));
+  for (PartId p = part; p.valid(); p = slot(p).parent) chain.push_back(&slot(p));
   Transform X_WC = chain.back()->X_PC;  // the root, in the world
   for (std::size_t k = chain.size() - 1; k > 0; --k) X_WC = compose(X_WC, chain[k - 1]->X_PC);
   return X_WC;
 }
 
-void Scene::set_world_pose(PartHandle part, const Transform& X_WC) {
-  const PartHandle parent = slot(part).parent;
+void Scene::set_world_pose(PartId part, const Transform& X_WC) {
+  const PartId parent = slot(part).parent;
   slot(part).X_PC = parent.valid() ? compose(world_pose(parent).inverse(), X_WC) : X_WC;
 }
 
-bool Scene::movable(PartHandle part) const { return slot(part).movable; }
-const std::string& Scene::collision_group(PartHandle part) const {
-  return slot(part).collision_group;
-}
-const std::optional<std::array<float, 3>>& Scene::color(PartHandle part) const {
+bool Scene::movable(PartId part) const { return slot(part).movable; }
+const std::string& Scene::collision_group(PartId part) const { return slot(part).collision_group; }
+const std::optional<std::array<float, 3>>& Scene::color(PartId part) const {
   return slot(part).color;
 }
-void Scene::set_movable(PartHandle part, bool movable) { slot(part).movable = movable; }
-void Scene::set_highlight(PartHandle part, const std::optional<std::array<float, 3>>& color) {
+void Scene::set_movable(PartId part, bool movable) { slot(part).movable = movable; }
+void Scene::set_highlight(PartId part, const std::optional<std::array<float, 3>>& color) {
   slot(part).highlight = color;
 }
-const std::optional<std::array<float, 3>>& Scene::highlight(PartHandle part) const {
+const std::optional<std::array<float, 3>>& Scene::highlight(PartId part) const {
   return slot(part).highlight;
 }
-void Scene::set_visible(PartHandle part, bool visible) { slot(part).visible = visible; }
-bool Scene::visible(PartHandle part) const { return slot(part).visible; }
+void Scene::set_visible(PartId part, bool visible) { slot(part).visible = visible; }
+bool Scene::visible(PartId part) const { return slot(part).visible; }
 
-const std::shared_ptr<const Mesh>& Scene::render_mesh(PartHandle part) const {
+const std::shared_ptr<const Mesh>& Scene::render_mesh(PartId part) const {
   return slot(part).render_mesh;
 }
-const std::shared_ptr<const Mesh>& Scene::collision_mesh(PartHandle part) const {
+const std::shared_ptr<const Mesh>& Scene::collision_mesh(PartId part) const {
   return slot(part).collision_mesh;
 }
 
@@ -284,7 +282,7 @@ Scene load_assembly(const fs::path& path, const AssemblyOptions& options, Assemb
     } else {
       ++summary.shared_meshes;
     }
-    PartDesc desc;
+    PartDef desc;
     desc.name = part.name;
     desc.tags = options.tags;
     desc.X_PC = part.X_RP;

@@ -44,7 +44,7 @@ RenderScene render_scene(const Scene& scene, const collision::StepResult* step,
   out.cameras = scene.cameras();
   std::map<collision::PartId, Highlight> by_id;
   std::size_t palette_index = 0;  // parts with a colour of their own take none
-  for (const PartHandle part : scene.parts()) {
+  for (const PartId part : scene.parts()) {
     const auto& mesh = scene.render_mesh(part);
     if (!mesh) continue;  // a group node
     // Hidden or highlighted parts keep their palette place, so the others keep their colours.
@@ -89,7 +89,7 @@ RenderScene render_scene(const Scene& scene, const collision::StepResult* step,
 RenderScene render_scene(const Simulation& simulation) {
   if (simulation.frame() == 0) return render_scene(simulation.scene());
   return render_scene(simulation.scene(), &simulation.collision_world().last_step(),
-                      [&simulation](PartHandle part) { return simulation.collision_id(part); });
+                      [&simulation](PartId part) { return simulation.collision_id(part); });
 }
 
 }  // namespace dovetail::engine

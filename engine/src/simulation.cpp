@@ -9,13 +9,12 @@
 
 namespace dovetail::engine {
 
-using collision::PartId;
 using collision::Vec3;
 
 /// A scene part as the loop last committed it.
 struct Simulation::Registered {
-  PartHandle handle;
-  PartId id;  ///< invalid for a part without a collision mesh
+  PartId handle;
+  collision::PartId id;  ///< invalid for a part without a collision mesh
   Transform X_WP;
   Box local_box;  ///< bounds of the collision mesh in the part's frame
 };
@@ -69,7 +68,7 @@ Simulation::~Simulation() = default;
 Simulation::Simulation(Simulation&&) noexcept = default;
 Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 
-collision::PartId Simulation::collision_id(PartHandle part) const {
+collision::PartId Simulation::collision_id(PartId part) const {
   if (!part.valid() || part.index >= registered_.size() || !registered_[part.index] ||
       registered_[part.index]->handle != part) {
     return {};
@@ -110,7 +109,7 @@ void Simulation::commit(std::vector<Event>& events, double now) {
       r.reset();
     }
   }
-  for (const PartHandle part : scene_.parts()) {
+  for (const PartId part : scene_.parts()) {
     const Transform X_WP = scene_.world_pose(part);
     if (part.index >= registered_.size()) registered_.resize(part.index + 1);
     std::unique_ptr<Registered>& r = registered_[part.index];
@@ -196,7 +195,7 @@ void Simulation::timer_events(std::vector<Event>& events, double now) {
 void Simulation::region_events(std::vector<Event>& events, double now) {
   for (RegionState& state : regions_) {
     std::vector<std::string> inside;
-    auto test = [&](PartHandle part) {
+    auto test = [&](PartId part) {
       if (!part.valid() || part.index >= registered_.size() || !registered_[part.index]) return;
       const Registered& r = *registered_[part.index];
       if (!r.id.valid()) return;
@@ -205,7 +204,7 @@ void Simulation::region_events(std::vector<Event>& events, double now) {
       }
     };
     if (state.region.parts.empty()) {
-      for (const PartHandle part : scene_.parts()) test(part);
+      for (const PartId part : scene_.parts()) test(part);
     } else {
       for (const std::string& name : state.region.parts) test(scene_.find(name));
       std::sort(inside.begin(), inside.end());
@@ -251,7 +250,7 @@ const FrameResult& Simulation::step() {
   // 6. Events: differences from the last frame.
   contact_events(result, events, now);
   // Removed parts' pairs have ended now; their names are no longer needed.
-  for (const PartId id : removed_) collision_names_.erase(id);
+  for (const collision::PartId id : removed_) collision_names_.erase(id);
   removed_.clear();
   timer_events(events, now);
   region_events(events, now);

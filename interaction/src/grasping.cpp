@@ -14,7 +14,7 @@ namespace dovetail::interaction {
 namespace {
 
 using engine::EventKind;
-using engine::PartHandle;
+using engine::PartId;
 
 constexpr Real kDegree = std::numbers::pi / 180;
 /// A part drawn onto a mate's axis stays drawn until it is this many times
@@ -146,7 +146,7 @@ void Grasping::add_mate(const Mate& mate) {
 
 void Grasping::hold(const std::string& part, GraspType type) {
   const engine::Scene& scene = simulation_->scene();
-  const PartHandle handle = scene.get(part);
+  const PartId handle = scene.get(part);
   if (!scene.collision_mesh(handle)) {
     throw engine::SceneError("grasping: part '" + part + "' has no collision mesh to hold");
   }
@@ -162,11 +162,11 @@ void Grasping::hold(const std::string& part, GraspType type) {
   opened_since_ = -1;
 }
 
-std::vector<PartHandle> Grasping::candidates(const engine::Scene& scene, const Transform& X_WH,
-                                             Real reach) const {
-  std::vector<PartHandle> out;
+std::vector<PartId> Grasping::candidates(const engine::Scene& scene, const Transform& X_WH,
+                                         Real reach) const {
+  std::vector<PartId> out;
   const collision::Bounds around{X_WH.t - Vec3::Constant(reach), X_WH.t + Vec3::Constant(reach)};
-  for (const PartHandle part : scene.parts()) {
+  for (const PartId part : scene.parts()) {
     const auto& mesh = scene.collision_mesh(part);
     if (!mesh || scene.has_tag(part, "hand")) continue;
     const Transform X_WP =
@@ -180,10 +180,10 @@ std::vector<PartHandle> Grasping::candidates(const engine::Scene& scene, const T
 void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
                              const JointAngles& previous, JointAngles& angles) {
   const engine::Scene& scene = simulation_->scene();
-  const std::vector<PartHandle> parts = candidates(scene, X_WH, 1.2 * model.hand_length());
+  const std::vector<PartId> parts = candidates(scene, X_WH, 1.2 * model.hand_length());
   if (parts.empty()) return;
   std::vector<SlideObstacle> obstacles;
-  for (const PartHandle part : parts) {
+  for (const PartId part : parts) {
     const bool held = held_ && scene.name(part) == *held_;
     obstacles.push_back({models_->collision_model(scene.collision_mesh(part)), nullptr,
                          held ? engine::compose(X_WH, X_HO_) : scene.world_pose(part), part.index});
@@ -219,7 +219,7 @@ void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
   }
 }
 
-std::vector<GraspContact> Grasping::touches(const engine::Scene& scene, PartHandle part) {
+std::vector<GraspContact> Grasping::touches(const engine::Scene& scene, PartId part) {
   std::vector<GraspContact> out;
   const auto& mesh = scene.collision_mesh(part);
   const collision::DistanceModel& part_model = models_->distance_model(mesh);
@@ -322,8 +322,7 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   std::optional<GraspType> found;
   std::string found_part;
   std::vector<GraspContact> found_contacts;
-  for (const PartHandle part :
-       candidates(scene, hand_->X_WH(), 1.2 * hand_->model().hand_length())) {
+  for (const PartId part : candidates(scene, hand_->X_WH(), 1.2 * hand_->model().hand_length())) {
     if (!scene.movable(part)) continue;  // fixed parts stop the fingers but are not grasped
     std::vector<GraspContact> touching = touches(scene, part);
     if (touching.empty()) continue;
@@ -374,7 +373,7 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
 
 void Grasping::carry(engine::Simulation& simulation) {
   engine::Scene& scene = simulation.scene();
-  const PartHandle part = scene.get(*held_);
+  const PartId part = scene.get(*held_);
   const auto& mesh = scene.collision_mesh(part);
   const Transform X_WO = scene.world_pose(part);
   const Transform X_WO_target = guided(scene, *held_, engine::compose(hand_->X_WH(), X_HO_));
@@ -385,8 +384,8 @@ void Grasping::carry(engine::Simulation& simulation) {
   swept.min = swept.min.cwiseMin(to.min);
   swept.max = swept.max.cwiseMax(to.max);
   std::vector<SlideObstacle> obstacles;
-  std::vector<PartHandle> handles;
-  for (const PartHandle other : scene.parts()) {
+  std::vector<PartId> handles;
+  for (const PartId other : scene.parts()) {
     const auto& other_mesh = scene.collision_mesh(other);
     if (other == part || !other_mesh || scene.has_tag(other, "hand")) continue;
     const Transform X_WB = scene.world_pose(other);
@@ -445,7 +444,7 @@ Transform Grasping::guided(const engine::Scene& scene, const std::string& part,
   for (std::size_t m = 0; m < mates_.size(); ++m) {
     const Mate& mate = mates_[m];
     if (mate.part != part) continue;
-    const PartHandle o = scene.find(mate.other);
+    const PartId o = scene.find(mate.other);
     if (!o.valid()) continue;
     const Transform X_WO = scene.world_pose(o);
     const Vec3 q_W = X_WO.apply(mate.p_OF);
@@ -495,7 +494,7 @@ void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
   engine::Scene& scene = simulation.scene();
   for (const Mate& mate : mates_) {
     if (mate.part != part) continue;
-    const PartHandle p = scene.find(mate.part), o = scene.find(mate.other);
+    const PartId p = scene.find(mate.part), o = scene.find(mate.other);
     if (!p.valid() || !o.valid()) continue;
     const Transform X_WP = scene.world_pose(p), X_WO = scene.world_pose(o);
     if (!within_tolerance(mate, X_WP, X_WO)) continue;

@@ -54,7 +54,7 @@ Hand::Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> so
   }
   for (std::size_t i = 0; i < kSegmentCount; ++i) {
     const auto segment = static_cast<Segment>(i);
-    engine::PartDesc desc;
+    engine::PartDef desc;
     desc.name = settings_.name + "." + std::string(segment_name(segment));
     desc.tags = {"hand"};
     desc.movable = true;
@@ -120,7 +120,7 @@ void Hand::pose_parts(engine::Scene& scene) const {
 
 void Hand::filter(const engine::Scene& scene, std::vector<engine::Event>& events) const {
   auto is_any_hand = [&](const std::string& name) {
-    const engine::PartHandle part = scene.find(name);
+    const engine::PartId part = scene.find(name);
     return part.valid() && scene.has_tag(part, "hand");
   };
   for (engine::Event& e : events) {

@@ -25,7 +25,7 @@ namespace {
 
 using engine::Event;
 using engine::EventKind;
-using engine::PartHandle;
+using engine::PartId;
 
 /// What a rule or a step can wait for, after the engine's events have been
 /// turned into the scenario's (the hand as one, mates by name, timers).
@@ -280,7 +280,7 @@ void push_api(lua_State* L) {
 // ---- the runner
 
 bool Runner::part_pose(const char* name, Transform& X, char* error, std::size_t size) {
-  const PartHandle p = sim_->scene().find(name);
+  const PartId p = sim_->scene().find(name);
   if (!p.valid()) {
     std::snprintf(error, size, "dt.part: no part '%s'", name);
     return false;
@@ -290,7 +290,7 @@ bool Runner::part_pose(const char* name, Transform& X, char* error, std::size_t 
 }
 
 bool Runner::set_part_pose(const char* name, const Transform& X, char* error, std::size_t size) {
-  const PartHandle p = sim_->scene().find(name);
+  const PartId p = sim_->scene().find(name);
   if (!p.valid()) {
     std::snprintf(error, size, "dt.part: no part '%s'", name);
     return false;
@@ -313,7 +313,7 @@ const MateSpec* Runner::mate(const std::string& name) const {
 void Runner::build() {
   engine::Scene scene;
   for (const PartSpec& p : scenario_.parts) {
-    engine::PartDesc desc;
+    engine::PartDef desc;
     desc.name = p.name;
     desc.tags = p.tags;
     desc.X_PC = p.X_WP;
@@ -377,7 +377,7 @@ void Runner::start_frame(std::uint64_t, double t) {
   for (const auto& [action, fired] : actions) apply(*action, t);
   engine::Scene& scene = sim_->scene();
   for (auto it = motions_.begin(); it != motions_.end();) {
-    const PartHandle p = scene.find(it->part);
+    const PartId p = scene.find(it->part);
     const double s = it->t1 > it->t0 ? std::clamp((t - it->t0) / (it->t1 - it->t0), 0.0, 1.0) : 1.0;
     if (p.valid()) {
       Transform X = scene.world_pose(p);
@@ -400,7 +400,7 @@ void Runner::apply(const Clause& action, double now) {
   } else if (w == "show" || w == "hide") {
     scene.set_visible(scene.get(a), w == "show");
   } else if (w == "move") {
-    const PartHandle p = scene.get(a);
+    const PartId p = scene.get(a);
     if (!scene.movable(p)) {
       out_.messages.push_back({now, "warn", "move: '" + a + "' is fixed and stays", action.where});
       return;
@@ -411,7 +411,7 @@ void Runner::apply(const Clause& action, double now) {
   } else if (w == "attach") {
     scene.set_parent(scene.get(a), scene.get(action.args[1].text), true);
   } else if (w == "detach") {
-    scene.set_parent(scene.get(a), PartHandle{}, true);
+    scene.set_parent(scene.get(a), PartId{}, true);
   } else if (w == "snap") {
     const interaction::Mate& m = mate(a)->mate;
     scene.set_world_pose(scene.get(m.part), interaction::mate_pose(m, scene.world_pose(m.part),
@@ -578,7 +578,7 @@ void Runner::complete_step(std::size_t i, double now, std::vector<Occurrence>& o
 void Runner::measure_penetration(double now) {
   const engine::Scene& scene = sim_->scene();
   for (const auto& [a, b] : touching_) {
-    const PartHandle pa = scene.find(a), pb = scene.find(b);
+    const PartId pa = scene.find(a), pb = scene.find(b);
     if (!pa.valid() || !pb.valid()) continue;
     const auto& ma = scene.collision_mesh(pa);
     const auto& mb = scene.collision_mesh(pb);

@@ -192,7 +192,7 @@ TEST(SceneRender, TriangleContactsHighlightOnlyTouchingTriangles) {
   // The same highlights from the scene, the step and the id map.
   const RenderScene again =
       render_scene(simulation.scene(), &simulation.collision_world().last_step(),
-                   [&](PartHandle part) { return simulation.collision_id(part); });
+                   [&](PartId part) { return simulation.collision_id(part); });
   EXPECT_EQ(again.items[0].highlighted, scene.items[0].highlighted);
   EXPECT_EQ(again.items[1].highlighted, scene.items[1].highlighted);
   EXPECT_THROW(render_scene(simulation.scene(), &simulation.collision_world().last_step()),

@@ -60,8 +60,8 @@ std::string error_of(const std::function<void()>& f) {
 
 TEST(Scene, NamesAreUniqueAndLookedUp) {
   Scene scene;
-  const PartHandle a = scene.add_part({.name = "peg", .tags = {"fastener"}, .render_mesh = box(1)});
-  const PartHandle b = scene.add_part({.name = "block", .render_mesh = box(1)});
+  const PartId a = scene.add_part({.name = "peg", .tags = {"fastener"}, .render_mesh = box(1)});
+  const PartId b = scene.add_part({.name = "block", .render_mesh = box(1)});
   EXPECT_EQ(scene.get("peg"), a);
   EXPECT_EQ(scene.find("block"), b);
   EXPECT_FALSE(scene.find("nothing").valid());
@@ -86,7 +86,7 @@ TEST(Scene, NamesAreUniqueAndLookedUp) {
   scene.remove_part(a);
   EXPECT_FALSE(scene.contains(a));
   EXPECT_THROW(scene.name(a), SceneError);
-  const PartHandle again = scene.add_part({.name = "peg"});
+  const PartId again = scene.add_part({.name = "peg"});
   EXPECT_EQ(again.index, a.index);
   EXPECT_NE(again.generation, a.generation);
 }
@@ -108,8 +108,8 @@ TEST(Scene, MovingAParentMovesItsChildren) {
   EXPECT_TRUE(scene.world_pose("frame").t.isApprox(Vec3(10, 0, 0)));
 
   // Re-parenting keeps the world pose by default.
-  const PartHandle gripper = scene.get("gripper");
-  scene.set_parent(gripper, PartHandle{});
+  const PartId gripper = scene.get("gripper");
+  scene.set_parent(gripper, PartId{});
   EXPECT_TRUE(scene.world_pose(gripper).t.isApprox(X_WG.t, 1e-12));
   EXPECT_THROW(scene.set_parent(scene.get("frame"), scene.get("arm")), SceneError);
 
@@ -156,7 +156,7 @@ TEST(Assembly, EngineLoadsAsSeparateNamedParts) {
   std::set<const collision::Mesh*> distinct;
   std::size_t triangles = 0;
   std::size_t distinct_triangles = 0;
-  for (const PartHandle part : scene.parts()) {
+  for (const PartId part : scene.parts()) {
     names.insert(scene.name(part));
     ASSERT_TRUE(scene.collision_mesh(part));
     triangles += scene.collision_mesh(part)->triangle_count();
@@ -181,7 +181,7 @@ TEST(Assembly, EngineLoadsAsSeparateNamedParts) {
   const collision::Mesh merged = import_mesh(kEngine);
   const collision::Bounds expected = collision::mesh_bounds(merged);
   Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
-  for (const PartHandle part : scene.parts()) {
+  for (const PartId part : scene.parts()) {
     const Transform X_WP = scene.world_pose(part);
     for (const Vec3& p : scene.collision_mesh(part)->vertices) {
       lo = lo.cwiseMin(X_WP.apply(p));
@@ -194,8 +194,8 @@ TEST(Assembly, EngineLoadsAsSeparateNamedParts) {
 
 TEST(Assembly, PartsGroupedIntoASubAssemblyMoveTogether) {
   Scene scene = load_assembly(kEngine);
-  const std::vector<PartHandle> parts = scene.parts();
-  const PartHandle group = scene.add_part({.name = "crank_assembly"});
+  const std::vector<PartId> parts = scene.parts();
+  const PartId group = scene.add_part({.name = "crank_assembly"});
   std::vector<Transform> before;
   for (std::size_t k = 0; k < 3; ++k) {
     before.push_back(scene.world_pose(parts[k]));
@@ -225,7 +225,7 @@ TEST(Assembly, DeclaredUnitsAndSmallFilesInMetres) {
   options.tags = {"fixture"};
   const Scene scaled = load_assembly(kData / "cube.obj", options, &report);
   EXPECT_FALSE(report.units_inferred);
-  const PartHandle part = scaled.parts().front();
+  const PartId part = scaled.parts().front();
   EXPECT_FALSE(scaled.movable(part));
   EXPECT_TRUE(scaled.has_tag(part, "fixture"));
   const collision::Bounds a = collision::mesh_bounds(*scene.collision_mesh(scene.parts()[0]));

@@ -191,7 +191,7 @@ TEST(Simulation, EngineAssemblyIsDeterministicAcrossThreads) {
   std::vector<std::string> reports;
   for (const int threads : {1, 2, 8}) {
     Simulation sim(load_assembly(kEngine), {.collision_threads = threads});
-    const std::vector<PartHandle> parts = sim.scene().parts();
+    const std::vector<PartId> parts = sim.scene().parts();
     const std::string mover = sim.scene().name(parts[parts.size() / 2]);
     const Transform X_start = sim.scene().local_pose(parts[parts.size() / 2]);
     sim.set_frame_hook([&](Simulation& s, std::uint64_t frame, double) {

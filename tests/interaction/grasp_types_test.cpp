@@ -23,8 +23,8 @@ using engine::EventKind;
 
 /// A cylinder of `radius` and `length` centred at p_H with its axis along `axis` (hand frame
 /// at the origin, so H is the world).
-engine::PartDesc cylinder_part(const std::string& name, Real radius, Real length, const Vec3& p_W,
-                               const Vec3& axis) {
+engine::PartDef cylinder_part(const std::string& name, Real radius, Real length, const Vec3& p_W,
+                              const Vec3& axis) {
   Transform X;
   X.R =
       Eigen::Quaternion<Real>::FromTwoVectors(Vec3::UnitZ(), axis.normalized()).toRotationMatrix();
@@ -47,7 +47,7 @@ struct GraspRun {
 
 /// The hand open at the origin closes to `posture` in 0.5 s, waits, lifts 50 mm in
 /// 0.5 s, opens in 0.4 s and waits.
-GraspRun run_grasp(engine::PartDesc part, const JointAngles& posture,
+GraspRun run_grasp(engine::PartDef part, const JointAngles& posture,
                    std::shared_ptr<const GloveSource> replay = nullptr, int threads = 1) {
   engine::Scene scene;
   const std::string name = part.name;
@@ -191,7 +191,7 @@ TEST(GraspTypes, AWasherSizedDiscBetweenTheThumbAndTwoFingertipsIsATripod) {
 }
 
 TEST(GraspTypes, AGraspRecordedAndReplayedFromItsTraceIsTheSameRun) {
-  const engine::PartDesc bar =
+  const engine::PartDef bar =
       cylinder_part("bar", 0.022, 0.08, Vec3(0.02, -0.0105 - 0.022 - 0.0001, -0.06), Vec3::UnitX());
   const GraspRun original = run_grasp(bar, *named_posture("power"));
   const auto trace = std::make_shared<TraceSource>(original.recorded);

@@ -8,7 +8,7 @@
 /// speaks of parts by name. The scene owns those names and the hierarchy, so
 /// a sub-assembly moves as one: a part's world pose is its parent's world
 /// pose times its local pose, X_WC = X_WP * X_PC. Parts are flat arrays
-/// addressed by PartHandle (index + generation), never by pointer; meshes are
+/// addressed by PartId (index + generation), never by pointer; meshes are
 /// shared (`shared_ptr<const Mesh>`) between instances of the same geometry.
 
 #include <array>
@@ -41,17 +41,17 @@ class SceneError : public std::runtime_error {
 
 /// Identifies a part of a Scene: slot index and generation, so a handle of a
 /// removed part is recognised as stale.
-struct PartHandle {
+struct PartId {
   std::uint32_t index = std::numeric_limits<std::uint32_t>::max();
   std::uint32_t generation = 0;
   /// Whether the handle refers to some part (it may still be stale).
   bool valid() const { return index != std::numeric_limits<std::uint32_t>::max(); }
-  friend bool operator==(const PartHandle&, const PartHandle&) = default;
-  friend auto operator<=>(const PartHandle&, const PartHandle&) = default;
+  friend bool operator==(const PartId&, const PartId&) = default;
+  friend auto operator<=>(const PartId&, const PartId&) = default;
 };
 
 /// A part to add to a scene.
-struct PartDesc {
+struct PartDef {
   std::string name{};               ///< unique in the scene, not empty
   std::vector<std::string> tags{};  ///< free labels ("fastener", "housing")
   std::string parent{};             ///< name of the parent part; empty: the world
@@ -73,68 +73,68 @@ class Scene {
  public:
   /// Adds a part. Throws SceneError for an empty or duplicate name or an
   /// unknown parent.
-  PartHandle add_part(const PartDesc& desc);
+  PartId add_part(const PartDef& def);
   /// Removes a part; its children become children of its parent, keeping
   /// their world poses. Throws SceneError for a stale handle.
-  void remove_part(PartHandle part);
+  void remove_part(PartId part);
 
   /// The part named `name`, or an invalid handle.
-  PartHandle find(std::string_view name) const;
+  PartId find(std::string_view name) const;
   /// The part named `name`; throws SceneError naming it when there is none.
-  PartHandle get(std::string_view name) const;
+  PartId get(std::string_view name) const;
   /// Whether `part` refers to a live part.
-  bool contains(PartHandle part) const;
+  bool contains(PartId part) const;
 
   /// All live parts, in name order (the deterministic order of the scene).
-  std::vector<PartHandle> parts() const;
+  std::vector<PartId> parts() const;
   /// Live parts carrying `tag`, in name order.
-  std::vector<PartHandle> parts_with_tag(std::string_view tag) const;
+  std::vector<PartId> parts_with_tag(std::string_view tag) const;
   std::size_t part_count() const { return count_; }
 
-  const std::string& name(PartHandle part) const;
-  const std::vector<std::string>& tags(PartHandle part) const;
-  bool has_tag(PartHandle part, std::string_view tag) const;
-  void add_tag(PartHandle part, const std::string& tag);
+  const std::string& name(PartId part) const;
+  const std::vector<std::string>& tags(PartId part) const;
+  bool has_tag(PartId part, std::string_view tag) const;
+  void add_tag(PartId part, const std::string& tag);
 
   /// The parent, or an invalid handle for a part placed in the world.
-  PartHandle parent(PartHandle part) const;
+  PartId parent(PartId part) const;
   /// Direct children, in name order.
-  std::vector<PartHandle> children(PartHandle part) const;
+  std::vector<PartId> children(PartId part) const;
   /// Re-parents `part` (an invalid `parent` means the world). With
   /// keep_world_pose the local pose is changed so the part stays where it
   /// is; otherwise the local pose is kept. Throws SceneError on a cycle.
-  void set_parent(PartHandle part, PartHandle parent, bool keep_world_pose = true);
+  void set_parent(PartId part, PartId parent, bool keep_world_pose = true);
 
   /// X_PC, the part in its parent's frame (the world's for a root part).
-  const Transform& local_pose(PartHandle part) const;
-  void set_local_pose(PartHandle part, const Transform& X_PC);
+  const Transform& local_pose(PartId part) const;
+  void set_local_pose(PartId part, const Transform& X_PC);
   void set_local_pose(std::string_view name, const Transform& X_PC) {
     set_local_pose(get(name), X_PC);
   }
   /// X_WC, the part C in the world: X_WP * X_PC with P its parent (in the
   /// scene's letters C is the part and P its parent), composed from the root down.
-  Transform world_pose(PartHandle part) const;
+  Transform world_pose(PartId part) const;
   Transform world_pose(std::string_view name) const { return world_pose(get(name)); }
   /// Sets the local pose X_PC so that the part's world pose becomes X_WC.
-  void set_world_pose(PartHandle part, const Transform& X_WC);
+  void set_world_pose(PartId part, const Transform& X_WC);
 
-  const std::string& collision_group(PartHandle part) const;
-  const std::optional<std::array<float, 3>>& color(PartHandle part) const;
+  const std::string& collision_group(PartId part) const;
+  const std::optional<std::array<float, 3>>& color(PartId part) const;
   /// A display colour drawn in place of the part's own while set (scripts
   /// highlight parts this way); nullopt removes it. Rendering only.
-  void set_highlight(PartHandle part, const std::optional<std::array<float, 3>>& color);
-  const std::optional<std::array<float, 3>>& highlight(PartHandle part) const;
+  void set_highlight(PartId part, const std::optional<std::array<float, 3>>& color);
+  const std::optional<std::array<float, 3>>& highlight(PartId part) const;
   /// Whether the part is drawn (default true). Rendering only: a hidden part
   /// still collides.
-  void set_visible(PartHandle part, bool visible);
-  bool visible(PartHandle part) const;
+  void set_visible(PartId part, bool visible);
+  bool visible(PartId part) const;
 
-  bool movable(PartHandle part) const;
-  void set_movable(PartHandle part, bool movable);
+  bool movable(PartId part) const;
+  void set_movable(PartId part, bool movable);
 
-  const std::shared_ptr<const collision::Mesh>& render_mesh(PartHandle part) const;
+  const std::shared_ptr<const collision::Mesh>& render_mesh(PartId part) const;
   /// The collision mesh (the render mesh unless another was given); may be null.
-  const std::shared_ptr<const collision::Mesh>& collision_mesh(PartHandle part) const;
+  const std::shared_ptr<const collision::Mesh>& collision_mesh(PartId part) const;
 
   /// Adds a named camera (in the world frame) for rendering. Throws
   /// SceneError for an empty or duplicate name.
@@ -148,7 +148,7 @@ class Scene {
     bool alive = false;
     std::string name;
     std::vector<std::string> tags;
-    PartHandle parent;
+    PartId parent;
     Transform X_PC;
     bool movable = true;
     std::string collision_group;
@@ -158,8 +158,8 @@ class Scene {
     std::shared_ptr<const collision::Mesh> render_mesh;
     std::shared_ptr<const collision::Mesh> collision_mesh;
   };
-  const Slot& slot(PartHandle part) const;
-  Slot& slot(PartHandle part);
+  const Slot& slot(PartId part) const;
+  Slot& slot(PartId part);
 
   std::vector<Slot> slots_;
   std::vector<std::uint32_t> free_;

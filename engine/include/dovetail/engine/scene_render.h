@@ -20,7 +20,7 @@ class Simulation;
 
 /// Maps a scene part to its id in the collision world, or an invalid id when
 /// it has none (Simulation::collision_id).
-using CollisionIdOf = std::function<collision::PartId(PartHandle)>;
+using CollisionIdOf = std::function<collision::PartId(PartId)>;
 
 /// One RenderItem per part with a render mesh, in name order, posed at the
 /// part's world pose X_WP, in the part's own colour if it has one, otherwise

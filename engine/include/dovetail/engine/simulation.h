@@ -148,7 +148,7 @@ class Simulation {
   /// The collision world, read only (for instance its last step's contacts).
   const collision::CollisionWorld& collision_world() const { return *world_; }
   /// The collision id of a part, or an invalid id when it has no collision mesh.
-  collision::PartId collision_id(PartHandle part) const;
+  collision::PartId collision_id(PartId part) const;
 
  private:
   struct Registered;

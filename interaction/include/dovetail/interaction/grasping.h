@@ -155,9 +155,9 @@ class Grasping {
   void limit_fingers(const HandModel& model, const Transform& X_WH, const JointAngles& previous,
                      JointAngles& angles);
   void update(engine::Simulation& simulation, std::uint64_t frame, Real t);
-  std::vector<engine::PartHandle> candidates(const engine::Scene& scene, const Transform& X_WH,
-                                             Real reach) const;
-  std::vector<GraspContact> touches(const engine::Scene& scene, engine::PartHandle part);
+  std::vector<engine::PartId> candidates(const engine::Scene& scene, const Transform& X_WH,
+                                         Real reach) const;
+  std::vector<GraspContact> touches(const engine::Scene& scene, engine::PartId part);
   void carry(engine::Simulation& simulation);
   Transform guided(const engine::Scene& scene, const std::string& part,
                    const Transform& X_WP_target);
@@ -186,7 +186,7 @@ class Grasping {
   bool sliding_ = false;
   std::string sliding_on_;
   SlideResult last_slide_{};
-  std::vector<engine::PartHandle> contact_parts_;  ///< the parts of last_slide_'s obstacle ids
+  std::vector<engine::PartId> contact_parts_;  ///< the parts of last_slide_'s obstacle ids
   InteractionStats stats_{};
 };
 

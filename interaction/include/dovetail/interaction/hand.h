@@ -84,9 +84,7 @@ class Hand {
   const HandPose& pose() const { return pose_; }
   const Transform& X_WH() const { return X_WH_; }
   /// The scene part of a segment.
-  engine::PartHandle part(Segment segment) const {
-    return parts_[static_cast<std::size_t>(segment)];
-  }
+  engine::PartId part(Segment segment) const { return parts_[static_cast<std::size_t>(segment)]; }
   /// The segment of a part name of this hand, or nullopt.
   std::optional<Segment> segment_of(const std::string& part_name) const;
 
@@ -103,7 +101,7 @@ class Hand {
   HandModel model_;
   std::shared_ptr<const GloveSource> source_;
   HandSettings settings_;
-  std::array<engine::PartHandle, kSegmentCount> parts_{};
+  std::array<engine::PartId, kSegmentCount> parts_{};
   std::map<std::string, Segment, std::less<>> segment_by_part_;
   GloveSample sample_{};
   JointAngles glove_angles_{};
