@@ -5,9 +5,9 @@
 //
 // Built as the `tri_tri_bench` target with DOVETAIL_BUILD_BENCH=ON, or alone
 // from the repository root:
-//   g++ -O3 -DNDEBUG -std=c++20 -ffp-contract=off -I collision/include
-//       -I /usr/include/eigen3 bench/tri_tri_bench.cpp collision/src/predicates.cpp
-//       collision/src/tri_tri.cpp -o tri_tri_bench
+//   g++ -O3 -DNDEBUG -std=c++20 -ffp-contract=off -I collision/include -I collision/src
+//       -I /usr/include/eigen3 bench/tri_tri_bench.cpp collision/src/core/predicates.cpp
+//       collision/src/core/tri_tri.cpp -o tri_tri_bench
 // An optional argument runs only the workloads whose name contains it.
 
 #include <algorithm>

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "octree.h"
-#include "uniform_grid.h"
+#include "broadphase/octree.h"
+#include "broadphase/uniform_grid.h"
 
 namespace dovetail::collision {
 namespace {

@@ -13,7 +13,7 @@
 #include "dovetail/collision/containment.h"
 #include "dovetail/collision/model.h"
 #include "dovetail/collision/primitives.h"
-#include "tri_distance.h"
+#include "proximity/tri_distance.h"
 
 namespace dovetail::collision {
 namespace {

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "convex_internal.h"
+#include "convex/convex_internal.h"
 #include "dovetail/collision/predicates.h"
 #include "dovetail/collision/tri_tri.h"
 

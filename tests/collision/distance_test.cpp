@@ -19,8 +19,8 @@
 #include "dovetail/collision/pose_sampling.h"
 #include "dovetail/collision/primitives.h"
 #include "dovetail/collision/tri_tri.h"
-#include "rss_tree.h"
-#include "tri_distance.h"
+#include "proximity/rss_tree.h"
+#include "proximity/tri_distance.h"
 
 namespace dovetail::collision {
 namespace {

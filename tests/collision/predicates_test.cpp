@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "../support/random_geometry.h"
-#include "predicates_inline.h"
+#include "core/predicates_inline.h"
 
 namespace dovetail::collision {
 namespace {

@@ -1,0 +1,53 @@
+#include "dovetail/collision/broadphase.h"
+
+#include <array>
+#include <stdexcept>
+
+#include "broadphase/brute_broadphase.h"
+#include "broadphase/octree.h"
+#include "broadphase/sweep_and_prune.h"
+#include "broadphase/uniform_grid.h"
+
+namespace dovetail::collision {
+
+namespace {
+
+constexpr std::array<BroadphaseMethod, 4> kBroadphases = {
+    BroadphaseMethod::kBrute, BroadphaseMethod::kSweepAndPrune, BroadphaseMethod::kGrid,
+    BroadphaseMethod::kOctree};
+constexpr std::array<std::string_view, 4> kBroadphaseNames = {"brute", "sap", "grid", "octree"};
+
+}  // namespace
+
+std::string_view broadphase_name(BroadphaseMethod method) {
+  for (std::size_t i = 0; i < kBroadphases.size(); ++i) {
+    if (kBroadphases[i] == method) return kBroadphaseNames[i];
+  }
+  return "unknown";
+}
+
+std::optional<BroadphaseMethod> parse_broadphase(std::string_view name) {
+  for (std::size_t i = 0; i < kBroadphases.size(); ++i) {
+    if (kBroadphaseNames[i] == name) return kBroadphases[i];
+  }
+  return std::nullopt;
+}
+
+std::span<const BroadphaseMethod> all_broadphases() { return kBroadphases; }
+
+std::unique_ptr<Broadphase> make_broadphase(BroadphaseMethod method,
+                                            const BroadphaseSettings& settings) {
+  switch (method) {
+    case BroadphaseMethod::kBrute:
+      return std::make_unique<BruteBroadphase>();
+    case BroadphaseMethod::kSweepAndPrune:
+      return std::make_unique<SweepAndPrune>();
+    case BroadphaseMethod::kGrid:
+      return std::make_unique<UniformGrid>(settings.grid_cell);
+    case BroadphaseMethod::kOctree:
+      return std::make_unique<Octree>(settings.octree_leaf_size, settings.octree_max_depth);
+  }
+  throw std::invalid_argument("make_broadphase: unknown method");
+}
+
+}  // namespace dovetail::collision

@@ -1,3 +1,0 @@
-#pragma once
-// The OBB tree is declared beside the AABB tree, its sibling reference hierarchy.
-#include "aabb_tree.h"

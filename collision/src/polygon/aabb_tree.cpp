@@ -1,0 +1,199 @@
+#include "polygon/aabb_tree.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "polygon/pair_traversal.h"
+#include "polygon/principal_axes.h"
+
+namespace dovetail::collision {
+
+// ---------------------------------------------------------------- AABB tree
+
+AabbTree::AabbTree(const Mesh& mesh, int max_leaf_size) {
+  max_abs_ = detail::max_abs_coordinate(mesh);
+  const detail::BinaryLayout layout = detail::build_binary_layout(mesh, max_leaf_size);
+  leaves_ = layout.leaves;
+  depth_ = layout.depth;
+  const std::size_t n = layout.nodes.size();
+  std::vector<Vec3> lo(n, Vec3::Constant(std::numeric_limits<Real>::infinity()));
+  std::vector<Vec3> hi(n, Vec3::Constant(-std::numeric_limits<Real>::infinity()));
+  for (std::size_t i = n; i-- > 0;) {
+    const detail::LayoutNode& node = layout.nodes[i];
+    if (node.is_leaf()) {
+      for (std::uint32_t s = node.begin; s < node.end; ++s) {
+        lo[i] = lo[i].cwiseMin(layout.triangles[s].lo);
+        hi[i] = hi[i].cwiseMax(layout.triangles[s].hi);
+      }
+    } else {
+      lo[i] = lo[node.first_child].cwiseMin(lo[node.first_child + 1]);
+      hi[i] = hi[node.first_child].cwiseMax(hi[node.first_child + 1]);
+    }
+  }
+  nodes_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      nodes_[i].lo[k] = detail::round_down(lo[i][k]);
+      nodes_[i].hi[k] = detail::round_up(hi[i][k]);
+    }
+    nodes_[i].link = detail::NodeLink::from(layout.nodes[i]);
+  }
+  for (const detail::BuildTriangle& t : layout.triangles) order_.push_back(t.index);
+}
+
+std::size_t AabbTree::bytes() const {
+  return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
+         order_.capacity() * sizeof(std::uint32_t);
+}
+
+class AabbPolicy {
+ public:
+  using EncA = detail::NoEnclosure;
+  struct EncB {
+    Vec3 centre;  ///< B's box centre in A's frame
+    Vec3 half;    ///< B's half extents along B's axes
+  };
+
+  EncA enclose_a(std::uint32_t) const { return {}; }
+
+  AabbPolicy(const AabbTree& a, const AabbTree& b, const Transform& X_AB)
+      : a_(a), b_(b), X_AB_(X_AB), margin_(detail::query_margin(a.max_abs_, b.max_abs_, X_AB)) {}
+
+  EncB enclose_b(std::uint32_t n) const {
+    const AabbTree::Node& node = b_.nodes_[n];
+    const Vec3 lo(node.lo[0], node.lo[1], node.lo[2]);
+    const Vec3 hi(node.hi[0], node.hi[1], node.hi[2]);
+    return {X_AB_.apply((lo + hi) * 0.5), (hi - lo) * 0.5};
+  }
+
+  bool overlap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
+    const AabbTree::Node& node = a_.nodes_[n];
+    const Vec3 lo(node.lo[0], node.lo[1], node.lo[2]);
+    const Vec3 hi(node.hi[0], node.hi[1], node.hi[2]);
+    return detail::boxes_overlap(X_AB_.R, e.centre - (lo + hi) * 0.5, (hi - lo) * 0.5, e.half,
+                                 margin_);
+  }
+
+  detail::NodeLink link_a(std::uint32_t n) const { return a_.nodes_[n].link; }
+  detail::NodeLink link_b(std::uint32_t n) const { return b_.nodes_[n].link; }
+  Real size_a(std::uint32_t n) const { return size(a_.nodes_[n]); }
+  Real size_b(std::uint32_t n) const { return size(b_.nodes_[n]); }
+  const std::uint32_t* slots_a() const { return a_.order_.data(); }
+  const std::uint32_t* slots_b() const { return b_.order_.data(); }
+
+ private:
+  static Real size(const AabbTree::Node& n) {
+    return (n.hi[0] - n.lo[0]) + (n.hi[1] - n.lo[1]) + (n.hi[2] - n.lo[2]);
+  }
+  const AabbTree& a_;
+  const AabbTree& b_;
+  const Transform& X_AB_;
+  Real margin_;
+};
+
+CollideResult AabbTree::collide(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
+                                const Transform& X_AB, const CollideRequest& request) const {
+  return detail::collide_with_policy<AabbPolicy>(*this, b, mesh_a, mesh_b, X_AB, request);
+}
+
+std::unique_ptr<SplitQuery> AabbTree::split(const Mesh& mesh_a, const AabbTree& b,
+                                            const Mesh& mesh_b, const Transform& X_AB,
+                                            const CollideRequest& request) const {
+  return std::make_unique<detail::SplitTraversal<detail::PolicyContext<AabbPolicy>>>(
+      mesh_a, mesh_b, X_AB, request, *this, b);
+}
+
+// ----------------------------------------------------------------- OBB tree
+
+ObbTree::ObbTree(const Mesh& mesh, int max_leaf_size) {
+  max_abs_ = detail::max_abs_coordinate(mesh);
+  const detail::BinaryLayout layout = detail::build_binary_layout(mesh, max_leaf_size);
+  leaves_ = layout.leaves;
+  depth_ = layout.depth;
+  const std::size_t n = layout.nodes.size();
+  const std::vector<detail::Moments> moments = detail::node_moments(layout, mesh);
+  nodes_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const detail::LayoutNode& node = layout.nodes[i];
+    Node& out = nodes_[i];
+    out.axes = node.end - node.begin == 1
+                   ? detail::triangle_axes(mesh, layout.triangles[node.begin].index)
+                   : detail::covariance_axes(moments[i]);
+    const Mat3 to_box = out.axes.transpose();
+    Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
+    Vec3 hi = -lo;
+    for (std::uint32_t s = node.begin; s < node.end; ++s) {
+      for (std::uint32_t v : mesh.triangles[layout.triangles[s].index]) {
+        const Vec3 p = to_box * mesh.vertices[v];
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+    }
+    out.centre = out.axes * ((lo + hi) * 0.5);
+    out.half = (hi - lo) * 0.5;
+    out.link = detail::NodeLink::from(node);
+  }
+  for (const detail::BuildTriangle& t : layout.triangles) order_.push_back(t.index);
+}
+
+std::size_t ObbTree::bytes() const {
+  return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
+         order_.capacity() * sizeof(std::uint32_t);
+}
+
+class ObbPolicy {
+ public:
+  using EncA = detail::NoEnclosure;
+  struct EncB {
+    Mat3 axes;  ///< B's box axes in A's frame
+    Vec3 centre;
+    Vec3 half;
+  };
+
+  EncA enclose_a(std::uint32_t) const { return {}; }
+
+  ObbPolicy(const ObbTree& a, const ObbTree& b, const Transform& X_AB)
+      : a_(a), b_(b), X_AB_(X_AB), margin_(detail::query_margin(a.max_abs_, b.max_abs_, X_AB)) {
+    // Box frames are fitted, not exact: widen the margin by the size of the
+    // rounding in expressing a box in another box's frame.
+    margin_ += 0x1.0p-40 * (a.max_abs_ + b.max_abs_);
+  }
+
+  EncB enclose_b(std::uint32_t n) const {
+    const ObbTree::Node& node = b_.nodes_[n];
+    return {X_AB_.R * node.axes, X_AB_.apply(node.centre), node.half};
+  }
+
+  bool overlap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
+    const ObbTree::Node& node = a_.nodes_[n];
+    return detail::oriented_boxes_overlap(node.axes, node.centre, node.half, e.axes, e.centre,
+                                          e.half, margin_);
+  }
+
+  detail::NodeLink link_a(std::uint32_t n) const { return a_.nodes_[n].link; }
+  detail::NodeLink link_b(std::uint32_t n) const { return b_.nodes_[n].link; }
+  Real size_a(std::uint32_t n) const { return a_.nodes_[n].half.sum(); }
+  Real size_b(std::uint32_t n) const { return b_.nodes_[n].half.sum(); }
+  const std::uint32_t* slots_a() const { return a_.order_.data(); }
+  const std::uint32_t* slots_b() const { return b_.order_.data(); }
+
+ private:
+  const ObbTree& a_;
+  const ObbTree& b_;
+  const Transform& X_AB_;
+  Real margin_;
+};
+
+CollideResult ObbTree::collide(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
+                               const Transform& X_AB, const CollideRequest& request) const {
+  return detail::collide_with_policy<ObbPolicy>(*this, b, mesh_a, mesh_b, X_AB, request);
+}
+
+std::unique_ptr<SplitQuery> ObbTree::split(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
+                                           const Transform& X_AB,
+                                           const CollideRequest& request) const {
+  return std::make_unique<detail::SplitTraversal<detail::PolicyContext<ObbPolicy>>>(
+      mesh_a, mesh_b, X_AB, request, *this, b);
+}
+
+}  // namespace dovetail::collision

@@ -1,0 +1,78 @@
+#pragma once
+// Reference hierarchies with box volumes: the AABB tree (boxes aligned with
+// the mesh's own frame) and the OBB tree (Gottschalk, Lin, Manocha,
+// "OBB-Tree", SIGGRAPH 1996: boxes fitted by covariance). Both are queried by
+// the 15-axis separating-axis test.
+
+#include <cstdint>
+#include <vector>
+
+#include "dovetail/collision/collide.h"
+#include "dovetail/collision/mesh.h"
+#include "dovetail/collision/model.h"
+#include "polygon/binary_layout.h"
+
+namespace dovetail::collision {
+
+/// AABB tree over one mesh; immutable after construction.
+class AabbTree {
+ public:
+  explicit AabbTree(const Mesh& mesh, int max_leaf_size = 2);
+
+  CollideResult collide(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
+                        const Transform& X_AB, const CollideRequest& request) const;
+  /// The same query divided into independent parts (see SplitQuery).
+  std::unique_ptr<SplitQuery> split(const Mesh& mesh_a, const AabbTree& b, const Mesh& mesh_b,
+                                    const Transform& X_AB, const CollideRequest& request) const;
+
+  std::size_t node_count() const { return nodes_.size(); }
+  std::size_t leaf_count() const { return leaves_; }
+  std::size_t depth() const { return depth_; }
+  std::size_t bytes() const;
+
+ private:
+  friend class AabbPolicy;
+  struct Node {
+    float lo[3];
+    float hi[3];
+    detail::NodeLink link;
+  };
+  std::vector<Node> nodes_;
+  std::vector<std::uint32_t> order_;
+  Real max_abs_ = 0;
+  std::size_t leaves_ = 0;
+  std::size_t depth_ = 0;
+};
+
+/// OBB tree over one mesh; immutable after construction.
+class ObbTree {
+ public:
+  explicit ObbTree(const Mesh& mesh, int max_leaf_size = 2);
+
+  CollideResult collide(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
+                        const Transform& X_AB, const CollideRequest& request) const;
+  /// The same query divided into independent parts (see SplitQuery).
+  std::unique_ptr<SplitQuery> split(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,
+                                    const Transform& X_AB, const CollideRequest& request) const;
+
+  std::size_t node_count() const { return nodes_.size(); }
+  std::size_t leaf_count() const { return leaves_; }
+  std::size_t depth() const { return depth_; }
+  std::size_t bytes() const;
+
+ private:
+  friend class ObbPolicy;
+  struct Node {
+    Mat3 axes;  ///< columns: box axes in the mesh's frame (orthonormal)
+    Vec3 centre;
+    Vec3 half;
+    detail::NodeLink link;
+  };
+  std::vector<Node> nodes_;
+  std::vector<std::uint32_t> order_;
+  Real max_abs_ = 0;
+  std::size_t leaves_ = 0;
+  std::size_t depth_ = 0;
+};
+
+}  // namespace dovetail::collision

@@ -1,0 +1,306 @@
+#include "dovetail/collision/containment.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <numbers>
+#include <numeric>
+#include <tuple>
+#include <vector>
+
+#include "core/disjoint_sets.h"
+#include "core/predicates_inline.h"
+
+namespace dovetail::collision {
+
+namespace {
+
+/// Vertex ids with equal positions merged: the smallest index of each position.
+std::vector<std::uint32_t> welded_ids(const std::vector<Vec3>& vertices) {
+  std::vector<std::uint32_t> order(vertices.size());
+  std::iota(order.begin(), order.end(), std::uint32_t{0});
+  const auto key = [&](std::uint32_t i) {
+    return std::make_tuple(vertices[i].x(), vertices[i].y(), vertices[i].z());
+  };
+  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {
+    return std::make_pair(key(i), i) < std::make_pair(key(j), j);
+  });
+  std::vector<std::uint32_t> id(vertices.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    id[order[k]] = (k > 0 && key(order[k]) == key(order[k - 1])) ? id[order[k - 1]] : order[k];
+  }
+  return id;
+}
+
+/// A directed edge of a triangle, between welded vertices.
+struct Edge {
+  std::uint32_t from;
+  std::uint32_t to;
+  std::uint32_t triangle;
+  friend auto operator<=>(const Edge&, const Edge&) = default;
+};
+
+std::vector<Edge> directed_edges(const Mesh& mesh) {
+  const std::vector<std::uint32_t> id = welded_ids(mesh.vertices);
+  std::vector<Edge> edges;
+  edges.reserve(3 * mesh.triangles.size());
+  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+    const TriangleIndices& f = mesh.triangles[t];
+    for (int k = 0; k < 3; ++k) edges.push_back({id[f[k]], id[f[(k + 1) % 3]], t});
+  }
+  std::sort(edges.begin(), edges.end());
+  return edges;
+}
+
+/// Connected surface components (shells) of a mesh: triangles joined through
+/// shared edges. Returns the shell of each triangle and the shell count.
+std::pair<std::vector<std::uint32_t>, std::size_t> shells(const Mesh& mesh) {
+  detail::DisjointSets sets(mesh.triangles.size());
+  std::vector<Edge> edges = directed_edges(mesh);
+  for (Edge& e : edges) {
+    if (e.from > e.to) std::swap(e.from, e.to);
+  }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t k = 1; k < edges.size(); ++k) {
+    if (edges[k].from == edges[k - 1].from && edges[k].to == edges[k - 1].to) {
+      sets.join(edges[k].triangle, edges[k - 1].triangle);
+    }
+  }
+  std::vector<std::uint32_t> shell(mesh.triangles.size());
+  std::vector<std::uint32_t> number(mesh.triangles.size(), UINT32_MAX);
+  std::size_t count = 0;
+  for (std::uint32_t t = 0; t < shell.size(); ++t) {
+    const std::size_t r = sets.find(t);
+    if (number[r] == UINT32_MAX) number[r] = static_cast<std::uint32_t>(count++);
+    shell[t] = number[r];
+  }
+  return {std::move(shell), count};
+}
+
+/// Parity of crossings per shell, or a verdict that needs no parity.
+struct RayOutcome {
+  enum { kCounted, kOnSurface, kDegenerate } status = kCounted;
+  std::vector<char> odd;  ///< per shell: the segment crossed it an odd number of times
+};
+
+bool same_closed_side(int e1, int e2, int e3) {
+  return (e1 >= 0 && e2 >= 0 && e3 >= 0) || (e1 <= 0 && e2 <= 0 && e3 <= 0);
+}
+
+/// Crossings of segment p -> q (q outside the mesh's bounds) with every
+/// triangle, decided by exact signs. Degenerate when the segment meets an
+/// edge or vertex, or lies in a triangle's plane.
+RayOutcome cast(const std::vector<Vec3>& vertices, const std::vector<TriangleIndices>& triangles,
+                const std::vector<std::uint32_t>& shell, std::size_t shell_count, const Vec3& p,
+                const Vec3& q) {
+  RayOutcome out;
+  out.odd.assign(shell_count, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const Vec3& a = vertices[triangles[t][0]];
+    const Vec3& b = vertices[triangles[t][1]];
+    const Vec3& c = vertices[triangles[t][2]];
+    const int sp = detail::orient3d_filtered(a, b, c, p);
+    const int sq = detail::orient3d_filtered(a, b, c, q);
+    if (sp == 0 && sq == 0) return {RayOutcome::kDegenerate, {}};
+    if (sp == sq || sq == 0) continue;  // q, outside the bounds, is in no triangle
+    const int e1 = detail::orient3d_filtered(p, q, a, b);
+    const int e2 = detail::orient3d_filtered(p, q, b, c);
+    const int e3 = detail::orient3d_filtered(p, q, c, a);
+    if (sp == 0) {
+      // p on the plane: on the surface when the line through p meets the closed triangle.
+      if (same_closed_side(e1, e2, e3)) return {RayOutcome::kOnSurface, {}};
+      continue;
+    }
+    if (!same_closed_side(e1, e2, e3)) continue;
+    if (e1 == 0 || e2 == 0 || e3 == 0) return {RayOutcome::kDegenerate, {}};
+    out.odd[shell[t]] ^= 1;
+  }
+  return out;
+}
+
+/// A fixed sequence of directions in general position (no component zero,
+/// none along a coordinate plane or diagonal), the same on every platform.
+Vec3 ray_direction(int k) {
+  const Real golden = std::numbers::phi - 1;
+  const Real u = std::fmod(0.1234 + k * golden, 1.0);
+  const Real v = std::fmod(0.3719 + k * 0.7548776662466927, 1.0);
+  const Real z = 0.2 + 0.6 * u;
+  const Real angle = 2 * std::numbers::pi * (0.05 + 0.9 * v);
+  return Vec3(std::cos(angle) + 0.017, std::sin(angle) + 0.031, z);
+}
+
+/// Generalized winding number (sum of solid angles / 4 pi), only used when
+/// every one of the fixed ray directions is degenerate.
+Real winding_number(const std::vector<Vec3>& vertices,
+                    const std::vector<TriangleIndices>& triangles,
+                    const std::vector<std::uint32_t>& shell, std::size_t s, const Vec3& p) {
+  Real sum = 0;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    if (shell[t] != s) continue;
+    const Vec3 a = vertices[triangles[t][0]] - p;
+    const Vec3 b = vertices[triangles[t][1]] - p;
+    const Vec3 c = vertices[triangles[t][2]] - p;
+    const Real la = a.norm(), lb = b.norm(), lc = c.norm();
+    const Real num = a.dot(b.cross(c));
+    const Real den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    sum += 2 * std::atan2(num, den);
+  }
+  return sum / (4 * std::numbers::pi);
+}
+
+/// Location of p against the surface (vertices, triangles), overall and per shell.
+struct Located {
+  PointLocation location = PointLocation::kOutside;
+  bool in_some_shell = false;
+};
+
+Located locate(const std::vector<Vec3>& vertices, const std::vector<TriangleIndices>& triangles,
+               const std::vector<std::uint32_t>& shell, std::size_t shell_count, const Vec3& p) {
+  Vec3 lo = vertices[triangles[0][0]];
+  Vec3 hi = lo;
+  for (const TriangleIndices& f : triangles) {
+    for (std::uint32_t i : f) {
+      lo = lo.cwiseMin(vertices[i]);
+      hi = hi.cwiseMax(vertices[i]);
+    }
+  }
+  const Real reach = 4 * ((hi - lo).norm() + (p - 0.5 * (lo + hi)).norm()) + 1;
+  constexpr int kDirections = 64;
+  for (int k = 0; k < kDirections; ++k) {
+    const Vec3 q = p + reach * ray_direction(k).normalized();
+    const RayOutcome r = cast(vertices, triangles, shell, shell_count, p, q);
+    if (r.status == RayOutcome::kOnSurface) return {PointLocation::kOnSurface, true};
+    if (r.status == RayOutcome::kDegenerate) continue;
+    int total = 0;
+    for (char odd : r.odd) total ^= odd;
+    const bool any = std::find(r.odd.begin(), r.odd.end(), 1) != r.odd.end();
+    return {total ? PointLocation::kInside : PointLocation::kOutside, any};
+  }
+  Located out;
+  int total = 0;
+  for (std::size_t s = 0; s < shell_count; ++s) {
+    const bool odd = std::abs(std::lround(winding_number(vertices, triangles, shell, s, p))) % 2;
+    total ^= odd;
+    out.in_some_shell = out.in_some_shell || odd;
+  }
+  out.location = total ? PointLocation::kInside : PointLocation::kOutside;
+  return out;
+}
+
+/// Is point p (in the mesh's frame) in the solid, and in some shell, of `mesh` with `vertices`?
+Located locate_in(const Mesh& mesh, const std::vector<Vec3>& vertices, const Vec3& p) {
+  const auto [shell, count] = shells(mesh);
+  return locate(vertices, mesh.triangles, shell, count, p);
+}
+
+/// One vertex of each shell of `part` (the first vertex of the shell's
+/// first triangle): with the surfaces apart, a shell lies wholly on one side
+/// of the other part's surface, so its vertex speaks for it.
+std::vector<std::uint32_t> shell_vertices(const Mesh& part) {
+  const auto [shell, count] = shells(part);
+  std::vector<std::uint32_t> vertex(count, UINT32_MAX);
+  for (std::size_t t = 0; t < shell.size(); ++t) {
+    if (vertex[shell[t]] == UINT32_MAX) vertex[shell[t]] = part.triangles[t][0];
+  }
+  return vertex;
+}
+
+/// Whether every shell of the part whose vertices are `part_vertices` (in
+/// `solid`'s frame) lies in the solid of `solid`, and whether every one lies
+/// inside some shell of it (in its solid or a cavity it encloses).
+std::pair<Inside, Inside> shells_inside(const Mesh& solid, const std::vector<Vec3>& solid_vertices,
+                                        const Mesh& part, const std::vector<Vec3>& part_vertices) {
+  const auto [shell, count] = shells(solid);
+  bool all_inside = true, all_enclosed = true;
+  for (const std::uint32_t v : shell_vertices(part)) {
+    const Located l = locate(solid_vertices, solid.triangles, shell, count, part_vertices[v]);
+    all_inside = all_inside && l.location == PointLocation::kInside;
+    all_enclosed = all_enclosed && l.location != PointLocation::kOnSurface && l.in_some_shell;
+  }
+  return {all_inside ? Inside::kYes : Inside::kNo, all_enclosed ? Inside::kYes : Inside::kNo};
+}
+
+}  // namespace
+
+bool is_closed(const Mesh& mesh) {
+  const std::vector<Edge> edges = directed_edges(mesh);
+  const auto same = [](const Edge& x, const Edge& y) { return x.from == y.from && x.to == y.to; };
+  for (std::size_t k = 0; k < edges.size(); ++k) {
+    const Edge& e = edges[k];
+    // Each directed edge once, and its reverse exactly once.
+    if (k + 1 < edges.size() && same(e, edges[k + 1])) return false;
+    const Edge reverse{e.to, e.from, 0};
+    const auto it = std::lower_bound(edges.begin(), edges.end(), reverse);
+    if (it == edges.end() || !same(*it, reverse)) return false;
+  }
+  return true;
+}
+
+PointLocation locate_point(const Mesh& mesh, const Vec3& p_M) {
+  return locate_in(mesh, mesh.vertices, p_M).location;
+}
+
+bool point_inside(const Mesh& mesh, const Vec3& p_M) {
+  return locate_point(mesh, p_M) != PointLocation::kOutside;
+}
+
+PointLocator::PointLocator(const Mesh& mesh, const Transform& X_FM)
+    : mesh_(mesh), closed_(is_closed(mesh)) {
+  vertices_F_.reserve(mesh.vertices.size());
+  for (const Vec3& v : mesh.vertices) vertices_F_.push_back(X_FM.apply(v));
+  // Inside or outside is the parity over all triangles; which shell a
+  // crossing belongs to matters only for "enclosed by a shell", which a
+  // location does not report, so every triangle counts as one shell.
+  shell_.assign(mesh.triangles.size(), 0);
+  shell_count_ = 1;
+}
+
+PointLocation PointLocator::locate(const Vec3& p_F) const {
+  return dovetail::collision::locate(vertices_F_, mesh_.triangles, shell_, shell_count_, p_F)
+      .location;
+}
+
+ContainmentResult contains(const CollisionModel& outer, const CollisionModel& inner,
+                           const Transform& X_outer_inner) {
+  ContainmentResult result;
+  const Mesh& mo = outer.mesh();
+  const Mesh& mi = inner.mesh();
+  const bool outer_closed = is_closed(mo);
+  const bool inner_closed = is_closed(mi);
+  result.surfaces_intersect = outer.collide(inner, X_outer_inner).colliding;
+  if (result.surfaces_intersect) {
+    if (outer_closed) result.inner_in_outer = result.inner_enclosed_by_outer = Inside::kNo;
+    if (inner_closed) result.outer_in_inner = result.outer_enclosed_by_inner = Inside::kNo;
+    return result;
+  }
+  // Disjoint surfaces: one vertex of each shell decides for that shell, and a
+  // part is inside only when all its shells are. Both parts are taken in
+  // outer's frame, inner's vertices mapped by the same Transform::apply as
+  // the collision query, so the points are those it tested.
+  std::vector<Vec3> inner_in_outer_frame(mi.vertices.size());
+  for (std::size_t i = 0; i < mi.vertices.size(); ++i) {
+    inner_in_outer_frame[i] = X_outer_inner.apply(mi.vertices[i]);
+  }
+  if (outer_closed) {
+    std::tie(result.inner_in_outer, result.inner_enclosed_by_outer) =
+        shells_inside(mo, mo.vertices, mi, inner_in_outer_frame);
+  }
+  if (inner_closed) {
+    std::tie(result.outer_in_inner, result.outer_enclosed_by_inner) =
+        shells_inside(mi, inner_in_outer_frame, mo, mo.vertices);
+  }
+  return result;
+}
+
+ContainmentResult contains(const Mesh& outer, const Mesh& inner, const Transform& X_outer_inner) {
+  // Models over the caller's meshes for this call only: an empty owner, no copy.
+  const auto model_outer = build_model(
+      Method::kAabb, std::shared_ptr<const Mesh>(std::shared_ptr<const Mesh>(), &outer));
+  const auto model_inner = build_model(
+      Method::kAabb, std::shared_ptr<const Mesh>(std::shared_ptr<const Mesh>(), &inner));
+  return contains(*model_outer, *model_inner, X_outer_inner);
+}
+
+}  // namespace dovetail::collision

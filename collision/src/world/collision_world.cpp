@@ -1,0 +1,695 @@
+#include "dovetail/collision/collision_world.h"
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <stdexcept>
+#include <unordered_map>
+#include <utility>
+
+#include "core/vertex_triangles.h"
+#include "dovetail/collision/convex.h"
+#include "dovetail/collision/distance.h"
+#include "dovetail/collision/task_system.h"
+#include "dovetail/collision/tri_tri.h"
+#include "polygon/hierarchy_common.h"
+
+namespace dovetail::collision {
+
+namespace {
+
+/// What parts with the same mesh share: built once, on first need.
+struct Shape {
+  std::shared_ptr<const Mesh> mesh;
+  std::shared_ptr<const CollisionModel> model;  ///< polygon level, built for the first exact pair
+  /// The cross-check's polygon level (WorldSettings::cross_check), on first need.
+  std::shared_ptr<const CollisionModel> check_model;
+  /// Distance hierarchy, built for the first exact distance query.
+  std::shared_ptr<const DistanceModel> distance_model;
+  std::shared_ptr<const ConvexHull> hull;  ///< convex level and tight world boxes
+  bool hull_failed = false;                ///< flat part: no hull, conservative boxes
+  Vec3 local_min, local_max;               ///< bounds in the part's frame
+  Real max_abs = 0;
+  /// Triangles around each vertex. Built with the model in pairs mode; used
+  /// to follow a moving contact from one triangle to the next.
+  detail::VertexTriangles around;
+};
+
+struct Part {
+  PartId id;
+  std::shared_ptr<Shape> shape;
+  Transform X_WP;
+  bool movable = true;
+  bool alive = false;
+  bool in_broadphase = false;
+  bool dirty = true;
+  LevelOfDetail level = LevelOfDetail::kExact;
+  std::string name;
+  std::array<std::uint32_t, 6>
+      extremal{};  ///< hull vertices extremal along +-x, +-y, +-z last step
+};
+
+/// Per-pair state kept across steps (temporal coherence of the convex level).
+struct PairState {
+  SeparatingPlaneCache plane;
+  GjkCache gjk;
+  /// First-hit mode: the triangle pair that intersected last step. Parts in
+  /// contact usually still touch there, which then decides the pair at once.
+  TrianglePair witness;
+  bool has_witness = false;
+  /// First-hit mode: the subtree pair around the last hit, searched next
+  /// when the witness and its neighbours no longer intersect.
+  TraversalHint hint;
+};
+
+std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<std::uint64_t>(a) << 32) | b;
+}
+
+/// X_AB = X_WA^-1 X_WB.
+Transform relative(const Transform& X_WA, const Transform& X_WB) {
+  Transform X;
+  X.R = X_WA.R.transpose() * X_WB.R;
+  X.t = X_WA.R.transpose() * (X_WB.t - X_WA.t);
+  return X;
+}
+
+/// The work of one candidate pair, filled in by whichever thread evaluates it.
+struct PairWork {
+  std::uint32_t a = 0, b = 0;
+  LevelOfDetail level = LevelOfDetail::kExact;
+  PairState* state = nullptr;
+  // Outputs.
+  bool colliding = false;
+  bool convex_tested = false;
+  bool convex_separated = false;
+  bool cached_plane = false;
+  bool polygon = false;
+  bool search_capped = false;  ///< the separating plane or GJK stopped at its iteration cap
+  CollideResult result;
+};
+
+}  // namespace
+
+struct CollisionWorld::Impl {
+  WorldSettings settings;
+  std::unique_ptr<TaskSystem> tasks;
+  std::unique_ptr<Broadphase> broadphase;
+  std::vector<Part> parts;
+  std::vector<std::uint32_t> free_slots;  ///< removed slots, reused smallest first
+  std::map<const Mesh*, std::shared_ptr<Shape>> shapes;
+  std::unordered_map<std::uint64_t, bool> interest;
+  std::unordered_map<std::uint64_t, LevelOfDetail> levels;
+  std::unordered_map<std::uint64_t, PairState> pair_states;
+  std::vector<ProxyPair> candidates;
+  std::vector<PairWork> work;
+  StepResult result;
+  std::uint64_t steps = 0;  ///< step() calls so far, for the captures' context
+
+  Part& part(PartId id) {
+    if (id.index >= parts.size() || !parts[id.index].alive || parts[id.index].id != id) {
+      throw std::invalid_argument("collision world: unknown or removed part");
+    }
+    return parts[id.index];
+  }
+
+  std::shared_ptr<Shape> shape_for(const std::shared_ptr<const Mesh>& mesh) {
+    std::shared_ptr<Shape>& shape = shapes[mesh.get()];
+    if (!shape) {
+      shape = std::make_shared<Shape>();
+      shape->mesh = mesh;
+      const Bounds bounds = mesh_bounds(*mesh);
+      shape->local_min = bounds.min;
+      shape->local_max = bounds.max;
+      shape->max_abs = detail::max_abs_coordinate(*mesh);
+    }
+    return shape;
+  }
+
+  void ensure_hull(Shape& shape) {
+    if (shape.hull || shape.hull_failed) return;
+    try {
+      shape.hull = std::make_shared<const ConvexHull>(
+          compute_convex_hull(shape.mesh->vertices, shape.mesh->source));
+    } catch (const std::invalid_argument&) {
+      shape.hull_failed = true;  // a flat part: conservative boxes, no convex level
+    }
+  }
+
+  void ensure_distance_model(Shape& shape) {
+    if (!shape.distance_model) shape.distance_model = build_distance_model(shape.mesh);
+  }
+
+  void ensure_model(Shape& shape) {
+    if (shape.model) return;
+    shape.model = build_model(settings.method, shape.mesh);
+    if (settings.contacts == ContactDetail::kPairs)
+      shape.around = detail::VertexTriangles(*shape.mesh);
+  }
+
+  /// The part's world box: extremal hull vertices found by walking from last
+  /// step's, or the transformed local box for a part without a hull; widened
+  /// by a margin far above rounding so the box holds the part as every later
+  /// stage computes it.
+  Aabb world_box(Part& p) {
+    const Shape& shape = *p.shape;
+    const Transform& X = p.X_WP;
+    Aabb box;
+    if (shape.hull) {
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 d_P = X.R.row(k).transpose();  // world axis k in the part's frame
+        p.extremal[2 * k] = shape.hull->support(d_P, p.extremal[2 * k]);
+        p.extremal[2 * k + 1] = shape.hull->support(-d_P, p.extremal[2 * k + 1]);
+        box.max[k] = X.apply(shape.hull->vertices[p.extremal[2 * k]])[k];
+        box.min[k] = X.apply(shape.hull->vertices[p.extremal[2 * k + 1]])[k];
+      }
+    } else {
+      const Vec3 centre = X.apply((shape.local_min + shape.local_max) * 0.5);
+      const Vec3 half = X.R.cwiseAbs() * ((shape.local_max - shape.local_min) * 0.5);
+      box.min = centre - half;
+      box.max = centre + half;
+    }
+    const Real margin = 0x1.0p-36 * (X.t.cwiseAbs().sum() + 3 * shape.max_abs);
+    box.min.array() -= margin;
+    box.max.array() += margin;
+    return box;
+  }
+
+  bool interested(const Part& a, const Part& b) const {
+    const auto it = interest.find(pair_key(a.id.index, b.id.index));
+    if (it != interest.end()) return it->second;
+    return a.movable || b.movable;
+  }
+
+  LevelOfDetail level_of(const Part& a, const Part& b) const {
+    const auto it = levels.find(pair_key(a.id.index, b.id.index));
+    if (it != levels.end()) return it->second;
+    return std::min(a.level, b.level);
+  }
+
+  /// Decides one pair up to the polygon level; returns whether the polygon
+  /// level must still decide it.
+  bool evaluate_coarse(PairWork& w) {
+    const Part& a = parts[w.a];
+    const Part& b = parts[w.b];
+    if (w.level == LevelOfDetail::kBox) {
+      w.colliding = true;
+      return false;
+    }
+    const Transform X_AB = relative(a.X_WP, b.X_WP);
+    const bool have_hulls = a.shape->hull && b.shape->hull;
+    if (have_hulls && (settings.convex_level || w.level == LevelOfDetail::kHull)) {
+      const SeparatingPlaneResult plane =
+          separating_plane_test(*a.shape->hull, *b.shape->hull, X_AB, w.state->plane);
+      w.convex_tested = true;
+      w.cached_plane = plane.cache_hit;
+      w.search_capped = plane.gave_up && !plane.overlap &&
+                        plane.iterations >= SeparatingPlaneSettings{}.max_iterations;
+      if (plane.separated) {
+        w.convex_separated = true;
+        return false;
+      }
+      if (w.level == LevelOfDetail::kHull) {
+        const GjkResult g = gjk(*a.shape->hull, *b.shape->hull, X_AB, &w.state->gjk);
+        w.colliding = g.intersecting;
+        w.search_capped = w.search_capped || g.hit_iteration_cap;
+        return false;
+      }
+    } else if (w.level == LevelOfDetail::kHull) {
+      w.level = LevelOfDetail::kExact;  // a flat part has no hull: decide exactly
+    }
+    w.polygon = true;
+    return true;
+  }
+
+  /// All intersecting triangle pairs, or only whether there is one.
+  CollideRequest polygon_request() const {
+    return {.all_pairs = settings.contacts == ContactDetail::kTriangles};
+  }
+
+  /// The polygon level of one pair, in one piece.
+  void evaluate_polygon(PairWork& w) {
+    const Part& a = parts[w.a];
+    const Part& b = parts[w.b];
+    const Transform X_AB = relative(a.X_WP, b.X_WP);
+    const CollideRequest request = polygon_request();
+    if (!request.all_pairs && w.state->has_witness) {
+      std::uint64_t tests = 0;
+      if (follow_witness(*a.shape, *b.shape, X_AB, w.state->witness, tests)) {
+        w.result =
+            CollideResult{.colliding = true, .pairs = {w.state->witness}, .stats = {0, tests}};
+        w.colliding = true;
+        return;
+      }
+      w.result.stats.triangle_tests = tests;
+    }
+    const std::uint64_t witness_tests = w.result.stats.triangle_tests;
+    CollideRequest hinted = request;
+    if (!request.all_pairs) hinted.hint = &w.state->hint;
+    w.result = a.shape->model->collide(*b.shape->model, X_AB, hinted);
+    w.result.stats.triangle_tests += witness_tests;
+    w.colliding = w.result.colliding;
+    w.state->has_witness = !request.all_pairs && w.colliding;
+    if (w.state->has_witness) w.state->witness = w.result.pairs.front();
+  }
+
+  /// Exact test of one triangle pair at a pose (B's vertices mapped by
+  /// Transform::apply, as the hierarchies do).
+  static bool pair_intersects(const Mesh& a, const Mesh& b, const Transform& X_AB,
+                              const TrianglePair& t) {
+    const TriangleIndices& ta = a.triangles[t.a];
+    const TriangleIndices& tb = b.triangles[t.b];
+    return triangles_intersect(a.vertices[ta[0]], a.vertices[ta[1]], a.vertices[ta[2]],
+                               X_AB.apply(b.vertices[tb[0]]), X_AB.apply(b.vertices[tb[1]]),
+                               X_AB.apply(b.vertices[tb[2]]));
+  }
+
+  /// Follows last step's contact: the witness pair itself, then each of its
+  /// triangles against the triangles around the other's vertices (the
+  /// contact usually moves to a neighbour). On success `witness` is the pair
+  /// found. A hit is a proof; a miss proves nothing and the caller traverses.
+  static bool follow_witness(const Shape& a, const Shape& b, const Transform& X_AB,
+                             TrianglePair& witness, std::uint64_t& tests) {
+    ++tests;
+    if (pair_intersects(*a.mesh, *b.mesh, X_AB, witness)) return true;
+    const TrianglePair last = witness;
+    for (std::uint32_t v : a.mesh->triangles[last.a]) {
+      for (std::uint32_t k = a.around.offsets[v]; k < a.around.offsets[v + 1]; ++k) {
+        const TrianglePair candidate{a.around.triangles[k], last.b};
+        if (candidate.a == last.a) continue;
+        ++tests;
+        if (pair_intersects(*a.mesh, *b.mesh, X_AB, candidate)) return witness = candidate, true;
+      }
+    }
+    for (std::uint32_t v : b.mesh->triangles[last.b]) {
+      for (std::uint32_t k = b.around.offsets[v]; k < b.around.offsets[v + 1]; ++k) {
+        const TrianglePair candidate{last.a, b.around.triangles[k]};
+        if (candidate.b == last.b) continue;
+        ++tests;
+        if (pair_intersects(*a.mesh, *b.mesh, X_AB, candidate)) return witness = candidate, true;
+      }
+    }
+    return false;
+  }
+
+  /// The polygon level of heavy pairs, each divided into parts, all parts of
+  /// all pairs in one parallel loop (fine grain, balanced across pairs).
+  void evaluate_split(const std::vector<std::size_t>& heavy_pairs) {
+    std::vector<std::unique_ptr<SplitQuery>> queries(heavy_pairs.size());
+    tasks->parallel_for(heavy_pairs.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t q = begin; q < end; ++q) {
+        const PairWork& w = work[heavy_pairs[q]];
+        queries[q] = parts[w.a].shape->model->split(*parts[w.b].shape->model,
+                                                    relative(parts[w.a].X_WP, parts[w.b].X_WP),
+                                                    polygon_request());
+      }
+    });
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> jobs;  // (query, part)
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+      for (std::size_t i = 0; i < queries[q]->parts(); ++i) {
+        jobs.emplace_back(static_cast<std::uint32_t>(q), static_cast<std::uint32_t>(i));
+      }
+    }
+    tasks->parallel_for(jobs.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t j = begin; j < end; ++j) queries[jobs[j].first]->run(jobs[j].second);
+    });
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+      PairWork& w = work[heavy_pairs[q]];
+      w.result = queries[q]->result();
+      w.colliding = w.result.colliding;
+    }
+  }
+
+  /// A pair worth splitting over the threads: both parts large.
+  bool heavy(const PairWork& w) const {
+    constexpr std::size_t kHeavyProduct = std::size_t{1} << 20;
+    return parts[w.a].shape->mesh->triangle_count() * parts[w.b].shape->mesh->triangle_count() >=
+           kHeavyProduct;
+  }
+
+  /// Distance of parts a and b, computed with the smaller index as A (the
+  /// orientation of the pair's caches, as in step()) and returned in the
+  /// caller's order.
+  PartDistance distance(PartId id_a, PartId id_b, const PartDistanceRequest& request) {
+    if (id_a == id_b) throw std::invalid_argument("collision world: distance of a part to itself");
+    Part& first = part(id_a);
+    Part& second = part(id_b);
+    const bool swapped = id_b.index < id_a.index;
+    Part& a = swapped ? second : first;
+    Part& b = swapped ? first : second;
+    const LevelOfDetail level = request.level ? *request.level : level_of(a, b);
+    ensure_hull(*a.shape);
+    ensure_hull(*b.shape);
+    const bool hulls = a.shape->hull && b.shape->hull;
+    const Transform X_AB = relative(a.X_WP, b.X_WP);
+    PartDistance r;
+    if (level != LevelOfDetail::kExact && hulls) {
+      PairState& state = pair_states[pair_key(a.id.index, b.id.index)];
+      r.warm_started = request.warm_start && state.gjk.valid;
+      GjkCache cold;
+      GjkCache& cache = request.warm_start ? state.gjk : cold;
+      const GjkResult g = gjk(*a.shape->hull, *b.shape->hull, X_AB, &cache);
+      if (!request.warm_start) state.gjk = cold;
+      r.level = LevelOfDetail::kHull;
+      r.distance = g.distance;
+      r.intersecting = g.intersecting;
+      r.p_W = a.X_WP.apply(g.closest_a);
+      r.q_W = a.X_WP.apply(g.closest_b);
+      r.feature_a = g.feature_a;
+      r.feature_b = g.feature_b;
+      r.gjk_iterations = g.iterations;
+    } else {
+      ensure_distance_model(*a.shape);
+      ensure_distance_model(*b.shape);
+      const DistanceResult d = collision::distance(*a.shape->distance_model,
+                                                   *b.shape->distance_model, X_AB, request.exact);
+      r.level = LevelOfDetail::kExact;
+      r.distance = d.distance;
+      r.intersecting = d.distance == 0;
+      r.p_W = a.X_WP.apply(d.p_A);
+      r.q_W = a.X_WP.apply(d.q_A);
+      r.triangle_a = d.triangle_a;
+      r.triangle_b = d.triangle_b;
+      r.stats = d.stats;
+    }
+    if (swapped) {
+      std::swap(r.p_W, r.q_W);
+      std::swap(r.feature_a, r.feature_b);
+      std::swap(r.triangle_a, r.triangle_b);
+    }
+    return r;
+  }
+
+  bool within(PartId id_a, PartId id_b, Real eps, const PartDistanceRequest& request) {
+    if (!(eps >= 0)) throw std::invalid_argument("collision world: tolerance must be >= 0");
+    if (id_a == id_b) throw std::invalid_argument("collision world: distance of a part to itself");
+    Part& first = part(id_a);
+    Part& second = part(id_b);
+    Part& a = id_b.index < id_a.index ? second : first;
+    Part& b = id_b.index < id_a.index ? first : second;
+    const LevelOfDetail level = request.level ? *request.level : level_of(a, b);
+    ensure_hull(*a.shape);
+    ensure_hull(*b.shape);
+    if (level != LevelOfDetail::kExact && a.shape->hull && b.shape->hull) {
+      const PartDistance d = distance(a.id, b.id, request);
+      return d.intersecting || d.distance <= eps;
+    }
+    ensure_distance_model(*a.shape);
+    ensure_distance_model(*b.shape);
+    return within_tolerance(*a.shape->distance_model, *b.shape->distance_model,
+                            relative(a.X_WP, b.X_WP), eps)
+        .within;
+  }
+
+  void prepare() {
+    std::vector<Shape*> shapes_in_use;
+    std::unordered_map<const Shape*, std::size_t> index;
+    for (const Part& p : parts) {
+      if (p.alive && index.emplace(p.shape.get(), shapes_in_use.size()).second) {
+        shapes_in_use.push_back(p.shape.get());
+      }
+    }
+    // Distinct shapes are independent: each task builds one shape's data.
+    const auto build = [&](const std::vector<Shape*>& todo, auto&& what) {
+      tasks->parallel_for(todo.size(), 1, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) what(*todo[i]);
+      });
+    };
+    build(shapes_in_use, [&](Shape& shape) { ensure_hull(shape); });
+
+    // Models for every part that step() could take to the polygon level: a
+    // part at the exact level, a part of a pair set to the exact level, and,
+    // when some part is flat (no hull, so its pairs are decided exactly),
+    // every part, since any may meet that one.
+    std::vector<char> needs_model(shapes_in_use.size(), 0);
+    bool any_flat = false;
+    for (const Part& p : parts) {
+      if (!p.alive) continue;
+      any_flat = any_flat || p.shape->hull_failed;
+      if (p.level == LevelOfDetail::kExact) needs_model[index.at(p.shape.get())] = 1;
+    }
+    for (const auto& [key, level] : levels) {
+      if (level != LevelOfDetail::kExact) continue;
+      for (const std::uint64_t i : {key >> 32, key & 0xffffffffu}) {
+        const Part& p = parts[i];
+        if (p.alive) needs_model[index.at(p.shape.get())] = 1;
+      }
+    }
+    std::vector<Shape*> todo;
+    for (std::size_t i = 0; i < shapes_in_use.size(); ++i) {
+      if (needs_model[i] || any_flat) todo.push_back(shapes_in_use[i]);
+    }
+    build(todo, [&](Shape& shape) { ensure_model(shape); });
+  }
+
+  /// Failure capture after the pairs are decided, serially and in pair
+  /// order (so the files do not depend on the threads): capped searches,
+  /// poses that are not finite, and the cross-check's disagreements.
+  void capture_suspects() {
+    for (const PairWork& w : work) {
+      const Part& a = parts[w.a];
+      const Part& b = parts[w.b];
+      const auto record = [&](CaptureKind kind, std::string what) {
+        settings.capture->record(
+            {.kind = kind,
+             .what = std::move(what),
+             .context = "step " + std::to_string(steps) + ": '" + a.name + "' and '" + b.name + "'",
+             .a = a.shape->mesh,
+             .b = b.shape->mesh,
+             .X_AB = relative(a.X_WP, b.X_WP)});
+      };
+      const bool finite = a.X_WP.R.allFinite() && a.X_WP.t.allFinite() && b.X_WP.R.allFinite() &&
+                          b.X_WP.t.allFinite();
+      if (!finite) {
+        record(CaptureKind::kNonFinite, "a part's pose is not finite");
+        continue;
+      }
+      if (w.search_capped) {
+        record(CaptureKind::kIterationCap,
+               w.level == LevelOfDetail::kHull
+                   ? "GJK or the separating-plane search stopped at its cap"
+                   : "the separating-plane search stopped at its cap");
+      }
+      if (!settings.cross_check || w.level != LevelOfDetail::kExact) continue;
+      if (!w.polygon && !w.convex_separated) continue;
+      for (Shape* shape : {a.shape.get(), b.shape.get()}) {
+        if (!shape->check_model)
+          shape->check_model = build_model(*settings.cross_check, shape->mesh);
+      }
+      const bool check =
+          a.shape->check_model->collide(*b.shape->check_model, relative(a.X_WP, b.X_WP)).colliding;
+      if (check == w.colliding) continue;
+      const std::string verdict = w.colliding ? "intersecting" : "separate";
+      const std::string other = check ? "intersecting" : "separate";
+      record(CaptureKind::kMethodsDisagree,
+             (w.polygon ? std::string(method_name(settings.method)) + " says " + verdict
+                        : std::string("the convex level separated the hulls")) +
+                 ", " + std::string(method_name(*settings.cross_check)) + " says " + other);
+    }
+  }
+
+  const StepResult& step() {
+    StepResult next;
+    // 1. World boxes of new and moved parts; broad phase.
+    for (Part& p : parts) {
+      if (!p.alive) continue;
+      if (p.dirty || !p.in_broadphase) {
+        ensure_hull(*p.shape);
+        const Aabb box = world_box(p);
+        if (p.in_broadphase)
+          broadphase->move(p.id.index, box);
+        else
+          broadphase->add(p.id.index, box);
+        p.in_broadphase = true;
+        p.dirty = false;
+      }
+      ++next.stats.parts;
+    }
+    broadphase->pairs(candidates);
+    next.stats.box_pairs = candidates.size();
+
+    // 2. Pairs of interest, their levels, and what they need built (serially).
+    work.clear();
+    for (const ProxyPair& c : candidates) {
+      const Part& a = parts[c.a];
+      const Part& b = parts[c.b];
+      if (!interested(a, b)) continue;
+      PairWork w;
+      w.a = c.a;
+      w.b = c.b;
+      w.level = level_of(a, b);
+      if (w.level != LevelOfDetail::kBox) {
+        w.state = &pair_states[pair_key(c.a, c.b)];
+        if (w.level == LevelOfDetail::kExact || a.shape->hull_failed || b.shape->hull_failed) {
+          ensure_model(*a.shape);
+          ensure_model(*b.shape);
+        }
+      }
+      work.push_back(std::move(w));
+    }
+    next.stats.tested_pairs = work.size();
+
+    // 3. Decide the pairs in parallel over pairs (coarse grain); the polygon
+    //    level of heavy pairs is deferred and then split over the threads one
+    //    pair at a time (fine grain). Either way each pair's result is the same.
+    // First-hit queries are not split: a divided query may do different work
+    // than an undivided one, and the counters must not depend on the threads.
+    const bool split_heavy =
+        tasks->thread_count() > 1 && settings.contacts == ContactDetail::kTriangles;
+    std::vector<char> deferred(work.size(), 0);
+    tasks->parallel_for(work.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        if (!evaluate_coarse(work[i])) continue;
+        if (split_heavy && heavy(work[i]))
+          deferred[i] = 1;
+        else
+          evaluate_polygon(work[i]);
+      }
+    });
+    std::vector<std::size_t> heavy_pairs;
+    for (std::size_t i = 0; i < work.size(); ++i) {
+      if (deferred[i]) heavy_pairs.push_back(i);
+    }
+    if (!heavy_pairs.empty()) evaluate_split(heavy_pairs);
+
+    if (settings.capture) capture_suspects();
+    ++steps;
+
+    // 4. Gather in pair order: contacts sorted by (a, b, triangle_a, triangle_b).
+    for (const PairWork& w : work) {
+      StepStats& s = next.stats;
+      s.convex_tests += w.convex_tested;
+      s.convex_separated += w.convex_separated;
+      s.cached_planes += w.cached_plane;
+      s.polygon_pairs += w.polygon;
+      s.polygon.volume_tests += w.result.stats.volume_tests;
+      s.polygon.triangle_tests += w.result.stats.triangle_tests;
+      if (!w.colliding) continue;
+      const PartPair pair{parts[w.a].id, parts[w.b].id};
+      next.colliding.push_back(pair);
+      if (w.polygon && settings.contacts == ContactDetail::kTriangles) {
+        for (const TrianglePair& t : w.result.pairs)
+          next.contacts.push_back({pair.a, pair.b, t.a, t.b});
+      } else {
+        next.contacts.push_back({pair.a, pair.b, kNoTriangle, kNoTriangle});
+      }
+    }
+    next.stats.colliding_pairs = next.colliding.size();
+
+    // 5. Changes since the last step.
+    std::set_difference(next.colliding.begin(), next.colliding.end(), result.colliding.begin(),
+                        result.colliding.end(), std::back_inserter(next.began));
+    std::set_difference(result.colliding.begin(), result.colliding.end(), next.colliding.begin(),
+                        next.colliding.end(), std::back_inserter(next.ended));
+    result = std::move(next);
+    return result;
+  }
+};
+
+CollisionWorld::CollisionWorld(const WorldSettings& settings) : impl_(std::make_unique<Impl>()) {
+  impl_->settings = settings;
+  impl_->tasks = make_task_system(settings.threads);
+  impl_->broadphase = make_broadphase(settings.broadphase);
+}
+
+CollisionWorld::~CollisionWorld() = default;
+
+PartId CollisionWorld::add_part(const PartDef& def) {
+  if (!def.mesh)
+    throw std::invalid_argument("collision world: part '" + def.name + "' has no mesh");
+  Impl& w = *impl_;
+  std::uint32_t index;
+  if (!w.free_slots.empty()) {
+    const auto smallest = std::min_element(w.free_slots.begin(), w.free_slots.end());
+    index = *smallest;
+    w.free_slots.erase(smallest);
+  } else {
+    index = static_cast<std::uint32_t>(w.parts.size());
+    w.parts.emplace_back();
+  }
+  Part& p = w.parts[index];
+  const std::uint32_t generation = p.id.generation + (p.id.valid() ? 1 : 0);
+  p = Part{};
+  p.id = {index, generation};
+  p.shape = w.shape_for(def.mesh);
+  p.X_WP = def.X_WP;
+  p.movable = def.movable;
+  p.level = def.level;
+  p.name = def.name;
+  p.alive = true;
+  return p.id;
+}
+
+void CollisionWorld::remove_part(PartId id) {
+  Impl& w = *impl_;
+  Part& p = w.part(id);
+  if (p.in_broadphase) w.broadphase->remove(id.index);
+  p.alive = false;
+  p.in_broadphase = false;
+  p.shape.reset();
+  w.free_slots.push_back(id.index);
+  // Forget every per-pair setting and cache of the slot (order does not matter).
+  auto involves = [&](std::uint64_t key) {
+    return (key >> 32) == id.index || (key & 0xffffffffu) == id.index;
+  };
+  std::erase_if(w.pair_states, [&](const auto& kv) { return involves(kv.first); });
+  std::erase_if(w.interest, [&](const auto& kv) { return involves(kv.first); });
+  std::erase_if(w.levels, [&](const auto& kv) { return involves(kv.first); });
+}
+
+void CollisionWorld::set_pose(PartId id, const Transform& X_WP) {
+  Part& p = impl_->part(id);
+  p.X_WP = X_WP;
+  p.dirty = true;
+}
+
+const Transform& CollisionWorld::pose(PartId id) const { return impl_->part(id).X_WP; }
+const std::string& CollisionWorld::name(PartId id) const { return impl_->part(id).name; }
+
+std::size_t CollisionWorld::part_count() const {
+  return static_cast<std::size_t>(std::count_if(impl_->parts.begin(), impl_->parts.end(),
+                                                [](const Part& p) { return p.alive; }));
+}
+
+void CollisionWorld::set_interest(PartId a, PartId b, bool interested) {
+  impl_->part(a);
+  impl_->part(b);
+  impl_->interest[pair_key(a.index, b.index)] = interested;
+}
+
+void CollisionWorld::set_pair_level(PartId a, PartId b, LevelOfDetail level) {
+  impl_->part(a);
+  impl_->part(b);
+  impl_->levels[pair_key(a.index, b.index)] = level;
+}
+
+PartDistance CollisionWorld::distance(PartId a, PartId b, const PartDistanceRequest& request) {
+  return impl_->distance(a, b, request);
+}
+
+bool CollisionWorld::within(PartId a, PartId b, Real eps, const PartDistanceRequest& request) {
+  return impl_->within(a, b, eps, request);
+}
+
+void CollisionWorld::prepare() { impl_->prepare(); }
+
+const StepResult& CollisionWorld::step() { return impl_->step(); }
+const StepResult& CollisionWorld::last_step() const { return impl_->result; }
+
+std::size_t CollisionWorld::model_bytes() const {
+  std::size_t bytes = 0;
+  for (const auto& [mesh, shape] : impl_->shapes) {
+    if (shape->model) bytes += shape->model->info().bytes;
+    if (shape->distance_model) bytes += shape->distance_model->info().bytes;
+    if (shape->hull) {
+      bytes += shape->hull->vertices.size() * sizeof(Vec3) +
+               shape->hull->faces.size() * sizeof(TriangleIndices) +
+               (shape->hull->neighbors.size() + shape->hull->neighbor_offsets.size()) *
+                   sizeof(std::uint32_t);
+    }
+  }
+  return bytes;
+}
+
+}  // namespace dovetail::collision
