@@ -70,6 +70,7 @@ for format in png svg; do
   if [ "$format" = png ]; then term="pngcairo size 900,560 font 'sans,10'"; else term="svg size 900,560 font 'sans,10'"; fi
   gnuplot <<GNUPLOT
 set terminal $term
+set termoption noenhanced
 set output "docs/images/sliding_sweep.$format"
 set title "Sliding a 10,240-triangle peg into its hole: gap left at contact against cost"
 set xlabel "interaction step, 95th percentile over the frames in contact (ms)"
