@@ -13,7 +13,7 @@ namespace {
 constexpr const char* kHelp =
     R"(usage: dovetail inspect MESH [--json] [--method M] [--parts]
 
-Reads a mesh file (any format assimp reads) as `query` does and reports what
+Reads a mesh file (OBJ, STL, PLY, glTF or GLB) as `query` does and reports what
 was found: vertices, triangles, validation findings (degenerate triangles
 removed, unused vertices, skipped point/line primitives, notes), the file's cameras
 (by name, for `render --camera`), bounds, and
@@ -43,100 +43,102 @@ struct PartRow {
 
 }  // namespace
 
-int inspect_command(std::span<const std::string> argv) {
-  const Args args("inspect", argv, {"method"}, {"json", "parts"});
-  if (args.help()) {
-    std::fputs(kHelp, stdout);
-    return kExitOk;
-  }
-  args.expect_positional(1, "one mesh file");
-  const std::string& path = args.positional()[0];
-  std::vector<collision::Method> methods;
-  if (args.value("method")) {
-    methods.push_back(args.method(collision::Method::kBoxtree));
-  } else {
-    methods.assign(collision::all_methods().begin(), collision::all_methods().end());
-  }
+namespace {
 
-  const LoadedMesh loaded = load_mesh(path);
-  const collision::Mesh& mesh = *loaded.mesh;
-  const collision::Bounds bounds = collision::mesh_bounds(mesh);
-  const double diagonal = (bounds.max - bounds.min).norm();
+/// What inspect found: the merged mesh, its parts (with --parts) and each method's hierarchy.
+struct Inspection {
+  std::string path;
+  LoadedMesh loaded;
+  collision::Bounds bounds{};
+  double diagonal = 0;
+  std::vector<PartRow> parts{};
+  std::vector<MethodRow> rows{};
+};
 
+/// The file's mesh instances, each as its own part.
+std::vector<PartRow> part_rows(const std::string& path) {
   std::vector<PartRow> parts;
-  if (args.flag("parts")) {
-    engine::ImportOptions per_part;
-    per_part.merge = false;
-    try {
-      for (const engine::ImportedPart& part : engine::import_file(path, per_part).parts) {
-        parts.push_back({part.name, part.mesh.vertex_count(), part.mesh.triangle_count()});
-      }
-    } catch (const collision::MeshError& e) {
-      throw InputError(e.what());
+  engine::ImportOptions per_part;
+  per_part.merge = false;
+  try {
+    for (const engine::ImportedPart& part : engine::import_file(path, per_part).parts) {
+      parts.push_back({part.name, part.mesh.vertex_count(), part.mesh.triangle_count()});
     }
+  } catch (const collision::MeshError& e) {
+    throw InputError(e.what());
   }
+  return parts;
+}
 
+/// Builds each method's hierarchy once, timed, with a progress line on a terminal.
+std::vector<MethodRow> method_rows(const std::vector<collision::Method>& methods,
+                                   const std::shared_ptr<const collision::Mesh>& mesh) {
   const bool terminal = stderr_is_terminal();
   std::vector<MethodRow> rows;
   for (collision::Method m : methods) {
     if (terminal) {
       std::fprintf(stderr, "\rbuilding %-8s", std::string(collision::method_name(m)).c_str());
     }
-    const BuiltModel built = build_timed(m, loaded.mesh);
+    const BuiltModel built = build_timed(m, mesh);
     rows.push_back({m, built.model->info(), built.build_ms});
   }
   if (terminal) std::fputs("\r                 \r", stderr);
+  return rows;
+}
 
-  const collision::MeshValidation& v = loaded.validation;
-  if (args.flag("json")) {
-    std::vector<std::string> notes;
-    for (const std::string& note : loaded.report.notes) notes.push_back(json_string(note));
-    std::vector<std::string> cameras;
-    for (const auto& camera : loaded.report.cameras) cameras.push_back(json_string(camera.first));
-    std::vector<std::string> method_items;
-    for (const MethodRow& row : rows) {
-      JsonLine item;
-      item.add("method", collision::method_name(row.method))
-          .add("nodes", std::uint64_t{row.info.nodes})
-          .add("leaves", std::uint64_t{row.info.leaves})
-          .add("depth", std::uint64_t{row.info.depth})
-          .add("bytes", std::uint64_t{row.info.bytes})
-          .add("bytes_per_triangle", row.info.bytes_per_triangle)
-          .add("build_ms", round_ms(row.build_ms));
-      method_items.push_back(item.str());
-    }
-    JsonLine json;
-    json.add("file", path)
-        .add("vertices", std::uint64_t{mesh.vertex_count()})
-        .add("triangles", std::uint64_t{mesh.triangle_count()})
-        .add("input_vertices", std::uint64_t{v.input_vertices})
-        .add("input_triangles", std::uint64_t{v.input_triangles})
-        .add("degenerate_removed", std::uint64_t{v.degenerate_removed})
-        .add("unused_vertices", std::uint64_t{v.unused_vertices})
-        .add("skipped_line_or_point_primitives",
-             std::uint64_t{loaded.report.skipped_line_or_point_primitives})
-        .add_raw("notes", json_array(notes))
-        .add_raw("cameras", json_array(cameras))
-        .add_raw("bounds_min", json_vec(bounds.min))
-        .add_raw("bounds_max", json_vec(bounds.max))
-        .add("diagonal", diagonal);
-    if (args.flag("parts")) {
-      std::vector<std::string> part_items;
-      for (const PartRow& part : parts) {
-        JsonLine item;
-        item.add("name", part.name)
-            .add("vertices", std::uint64_t{part.vertices})
-            .add("triangles", std::uint64_t{part.triangles});
-        part_items.push_back(item.str());
-      }
-      json.add_raw("parts", json_array(part_items));
-    }
-    json.add_raw("methods", json_array(method_items));
-    std::fputs((json.str() + "\n").c_str(), stdout);
-    return kExitOk;
+void print_json(const Inspection& x, bool with_parts) {
+  const collision::Mesh& mesh = *x.loaded.mesh;
+  const collision::MeshValidation& v = x.loaded.validation;
+  std::vector<std::string> notes;
+  for (const std::string& note : x.loaded.report.notes) notes.push_back(json_string(note));
+  std::vector<std::string> cameras;
+  for (const auto& camera : x.loaded.report.cameras) cameras.push_back(json_string(camera.first));
+  std::vector<std::string> method_items;
+  for (const MethodRow& row : x.rows) {
+    JsonLine item;
+    item.add("method", collision::method_name(row.method))
+        .add("nodes", std::uint64_t{row.info.nodes})
+        .add("leaves", std::uint64_t{row.info.leaves})
+        .add("depth", std::uint64_t{row.info.depth})
+        .add("bytes", std::uint64_t{row.info.bytes})
+        .add("bytes_per_triangle", row.info.bytes_per_triangle)
+        .add("build_ms", round_ms(row.build_ms));
+    method_items.push_back(item.str());
   }
+  JsonLine json;
+  json.add("file", x.path)
+      .add("vertices", std::uint64_t{mesh.vertex_count()})
+      .add("triangles", std::uint64_t{mesh.triangle_count()})
+      .add("input_vertices", std::uint64_t{v.input_vertices})
+      .add("input_triangles", std::uint64_t{v.input_triangles})
+      .add("degenerate_removed", std::uint64_t{v.degenerate_removed})
+      .add("unused_vertices", std::uint64_t{v.unused_vertices})
+      .add("skipped_line_or_point_primitives",
+           std::uint64_t{x.loaded.report.skipped_line_or_point_primitives})
+      .add_raw("notes", json_array(notes))
+      .add_raw("cameras", json_array(cameras))
+      .add_raw("bounds_min", json_vec(x.bounds.min))
+      .add_raw("bounds_max", json_vec(x.bounds.max))
+      .add("diagonal", x.diagonal);
+  if (with_parts) {
+    std::vector<std::string> part_items;
+    for (const PartRow& part : x.parts) {
+      JsonLine item;
+      item.add("name", part.name)
+          .add("vertices", std::uint64_t{part.vertices})
+          .add("triangles", std::uint64_t{part.triangles});
+      part_items.push_back(item.str());
+    }
+    json.add_raw("parts", json_array(part_items));
+  }
+  json.add_raw("methods", json_array(method_items));
+  std::fputs((json.str() + "\n").c_str(), stdout);
+}
 
-  std::printf("file                %s\n", path.c_str());
+void print_text(const Inspection& x, bool with_parts) {
+  const collision::Mesh& mesh = *x.loaded.mesh;
+  const collision::MeshValidation& v = x.loaded.validation;
+  std::printf("file                %s\n", x.path.c_str());
   std::printf("vertices            %zu\n", mesh.vertex_count());
   std::printf("triangles           %zu\n", mesh.triangle_count());
   std::printf("read                %zu vertices, %zu triangles\n", v.input_vertices,
@@ -144,31 +146,58 @@ int inspect_command(std::span<const std::string> argv) {
   std::printf("degenerate removed  %zu\n", v.degenerate_removed);
   std::printf("unused vertices     %zu\n", v.unused_vertices);
   std::printf("skipped primitives  %zu (points and lines)\n",
-              loaded.report.skipped_line_or_point_primitives);
-  std::printf("bounds min          %.9g %.9g %.9g\n", bounds.min.x(), bounds.min.y(),
-              bounds.min.z());
-  std::printf("bounds max          %.9g %.9g %.9g\n", bounds.max.x(), bounds.max.y(),
-              bounds.max.z());
-  std::printf("diagonal            %.9g\n", diagonal);
-  for (const std::string& note : loaded.report.notes) {
+              x.loaded.report.skipped_line_or_point_primitives);
+  std::printf("bounds min          %.9g %.9g %.9g\n", x.bounds.min.x(), x.bounds.min.y(),
+              x.bounds.min.z());
+  std::printf("bounds max          %.9g %.9g %.9g\n", x.bounds.max.x(), x.bounds.max.y(),
+              x.bounds.max.z());
+  std::printf("diagonal            %.9g\n", x.diagonal);
+  for (const std::string& note : x.loaded.report.notes) {
     std::printf("note                %s\n", note.c_str());
   }
-  for (const auto& camera : loaded.report.cameras) {
+  for (const auto& camera : x.loaded.report.cameras) {
     std::printf("camera              %s\n", camera.first.c_str());
   }
-  if (args.flag("parts")) {
+  if (with_parts) {
     std::printf("\n%-32s %10s %10s\n", "part", "vertices", "triangles");
-    for (const PartRow& part : parts) {
+    for (const PartRow& part : x.parts) {
       std::printf("%-32s %10zu %10zu\n", part.name.c_str(), part.vertices, part.triangles);
     }
   }
   std::printf("\n%-8s %10s %10s %6s %12s %10s %10s\n", "method", "nodes", "leaves", "depth",
               "bytes", "bytes/tri", "build ms");
-  for (const MethodRow& row : rows) {
+  for (const MethodRow& row : x.rows) {
     std::printf("%-8s %10zu %10zu %6zu %12zu %10.2f %10.3f\n",
                 std::string(collision::method_name(row.method)).c_str(), row.info.nodes,
                 row.info.leaves, row.info.depth, row.info.bytes, row.info.bytes_per_triangle,
                 row.build_ms);
+  }
+}
+
+}  // namespace
+
+int inspect_command(std::span<const std::string> argv) {
+  const Args args("inspect", argv, {"method"}, {"json", "parts"});
+  if (args.help()) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  args.expect_positional(1, "one mesh file");
+  std::vector<collision::Method> methods;
+  if (args.value("method")) {
+    methods.push_back(args.method(collision::Method::kBoxtree));
+  } else {
+    methods.assign(collision::all_methods().begin(), collision::all_methods().end());
+  }
+  Inspection x{.path = args.positional()[0], .loaded = load_mesh(args.positional()[0])};
+  x.bounds = collision::mesh_bounds(*x.loaded.mesh);
+  x.diagonal = (x.bounds.max - x.bounds.min).norm();
+  if (args.flag("parts")) x.parts = part_rows(x.path);
+  x.rows = method_rows(methods, x.loaded.mesh);
+  if (args.flag("json")) {
+    print_json(x, args.flag("parts"));
+  } else {
+    print_text(x, args.flag("parts"));
   }
   return kExitOk;
 }

@@ -28,7 +28,7 @@ constexpr const char* kHelp =
 
 Tests mesh B against mesh A at every pose of a pose list.
 
-  A, B           mesh files (any format assimp reads), each merged into one mesh
+  A, B           mesh files (OBJ, STL, PLY, glTF or GLB), each merged into one mesh
   --poses FILE   pose list: one pose of B in A's frame per line, `tx ty tz qw qx qy qz`
                  (extra columns ignored, `#` lines and blank lines skipped)
   --method M     boxtree (default), dop6, dop14, dop18, dop26, aabb, obb, brute;
@@ -146,6 +146,176 @@ struct ModelSummary {
 
 }  // namespace
 
+namespace {
+
+/// What the command line asks of a query run.
+struct QueryOptions {
+  std::string path_a, path_b, poses_path;
+  std::optional<std::string> out_path;
+  Mode mode = Mode::kCollide;
+  bool distance_mode = false;   ///< --distance or --tolerance
+  bool distance_brute = false;  ///< ... by brute force instead of the RSS tree
+  collision::Method method = collision::Method::kBoxtree;  ///< collision modes only
+  double tolerance = 0;
+  collision::ContactRequest contact_request;
+  collision::CollideRequest request;
+  int threads = 1;
+};
+
+QueryOptions parse_query_options(const Args& args) {
+  args.expect_positional(2, "two mesh files A and B");
+  QueryOptions o;
+  o.path_a = args.positional()[0];
+  o.path_b = args.positional()[1];
+  o.poses_path = args.required("poses");
+  o.mode = parse_mode(args);
+  o.distance_mode = o.mode == Mode::kDistance || o.mode == Mode::kTolerance;
+  o.distance_brute = o.distance_mode && distance_method_is_brute(args, o.mode);
+  if (!o.distance_mode && args.value("method") == "rss") {
+    throw UsageError(
+        "query: method 'rss' (the distance hierarchy) answers --distance and --tolerance only; "
+        "collision methods: " +
+        method_list());
+  }
+  // The collision method (not used by the distance modes, which have their own).
+  o.method = o.distance_mode ? collision::Method::kBrute : args.method(collision::Method::kBoxtree);
+  o.tolerance = args.number("tolerance", 0.0).value_or(0.0);
+  o.contact_request.touching_tolerance =
+      args.number("contact-tolerance", 0.0).value_or(o.contact_request.touching_tolerance);
+  o.threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
+  o.out_path = args.value("out");
+  o.request.all_pairs = args.flag("all-pairs");
+  return o;
+}
+
+/// The poses up to the first bad line, and that line's error (reported after
+/// the results of the good poses are written).
+struct PoseBatch {
+  std::vector<collision::Transform> poses;
+  std::optional<std::string> error;
+};
+
+PoseBatch read_poses(engine::PoseListReader& reader) {
+  PoseBatch batch;
+  try {
+    while (std::optional<engine::PoseEntry> pose = reader.next()) batch.poses.push_back(pose->X_AB);
+  } catch (const engine::PoseListError& e) {
+    batch.error = e.what();
+  }
+  return batch;
+}
+
+/// A mode's results: per-pose lines, its own summary keys (`counts` after
+/// query_ms_total, `extras` after threads) and the work done.
+struct QueryOutcome {
+  std::string lines;
+  ModelSummary models;
+  JsonLine counts;
+  JsonLine extras;
+  collision::CollideStats stats;
+  double query_ms = 0;
+};
+
+QueryOutcome run_distance_mode(const QueryOptions& o, const LoadedMesh& a, const LoadedMesh& b,
+                               const std::vector<collision::Transform>& poses) {
+  QueryOutcome r;
+  DistanceInputs inputs{.mesh_a = a.mesh.get(), .mesh_b = b.mesh.get()};
+  BuiltDistanceModel model_a;
+  BuiltDistanceModel model_b;
+  if (!o.distance_brute) {
+    model_a = build_distance_timed(a.mesh);
+    model_b = build_distance_timed(b.mesh);
+    inputs.model_a = model_a.model.get();
+    inputs.model_b = model_b.model.get();
+    r.models = {model_a.build_ms, model_b.build_ms, model_a.model->info().bytes,
+                model_b.model->info().bytes};
+  }
+  if (o.mode == Mode::kDistance) {
+    const DistanceQueryResult result = run_distance_queries(inputs, poses, o.threads);
+    r.lines.reserve(20 * poses.size());
+    for (double d : result.distances) r.lines += format_distance(d) + "\n";
+    r.counts.add("colliding", result.colliding_count)
+        .add("distance_min", result.distance_min)
+        .add("distance_max", result.distance_max);
+    r.stats = result.stats;
+    r.query_ms = result.wall_ms;
+  } else {
+    const ToleranceQueryResult result =
+        run_tolerance_queries(inputs, poses, o.tolerance, o.threads);
+    r.lines.reserve(2 * poses.size());
+    for (std::uint8_t w : result.within) r.lines += w != 0 ? "1\n" : "0\n";
+    r.counts.add("tolerance", o.tolerance).add("within", result.within_count);
+    r.stats = result.stats;
+    r.query_ms = result.wall_ms;
+  }
+  return r;
+}
+
+QueryOutcome run_collision_mode(const QueryOptions& o, const LoadedMesh& a, const LoadedMesh& b,
+                                const std::vector<collision::Transform>& poses) {
+  QueryOutcome r;
+  const BuiltModel model_a = build_timed(o.method, a.mesh);
+  const BuiltModel model_b = build_timed(o.method, b.mesh);
+  r.models = {model_a.build_ms, model_b.build_ms, model_a.model->info().bytes,
+              model_b.model->info().bytes};
+  if (o.mode == Mode::kContacts) {
+    const ContactQueryResult result =
+        run_contact_queries(*model_a.model, *model_b.model, poses, o.contact_request, o.threads);
+    for (const std::string& line : result.lines) r.lines += line + "\n";
+    r.counts.add("colliding", result.colliding_count);
+    r.extras.add("pairs_total", result.pairs_total)
+        .add("contact_tolerance", o.contact_request.touching_tolerance)
+        .add("patches_total", result.patches_total)
+        .add("patches_face", result.face_patches)
+        .add("patches_curve", result.curve_patches)
+        .add("patches_point", result.point_patches)
+        .add("patches_penetrating", result.penetrating_patches);
+    r.stats = result.stats;
+    r.query_ms = result.wall_ms;
+  } else {
+    const PoseQueryResult result =
+        run_pose_queries(*model_a.model, *model_b.model, poses, o.request, o.threads);
+    r.lines.reserve(2 * poses.size());
+    for (std::uint8_t c : result.colliding) r.lines += c != 0 ? "1\n" : "0\n";
+    r.counts.add("colliding", result.colliding_count);
+    if (o.request.all_pairs) r.extras.add("pairs_total", result.pairs_total);
+    r.stats = result.stats;
+    r.query_ms = result.wall_ms;
+  }
+  return r;
+}
+
+/// The one-line JSON summary.
+JsonLine query_summary(const QueryOptions& o, const LoadedMesh& a, const LoadedMesh& b,
+                       std::size_t queries, const QueryOutcome& r) {
+  const std::string_view method_shown = !o.distance_mode   ? collision::method_name(o.method)
+                                        : o.distance_brute ? std::string_view("brute")
+                                                           : std::string_view("rss");
+  JsonLine json;
+  json.add("method", method_shown)
+      .add("mode", mode_name(o.mode))
+      .add("a", o.path_a)
+      .add("b", o.path_b)
+      .add("triangles_a", std::uint64_t{a.mesh->triangle_count()})
+      .add("triangles_b", std::uint64_t{b.mesh->triangle_count()})
+      .add("build_ms", round_ms(r.models.build_ms_a + r.models.build_ms_b))
+      .add("build_ms_a", round_ms(r.models.build_ms_a))
+      .add("build_ms_b", round_ms(r.models.build_ms_b))
+      .add("queries", std::uint64_t{queries})
+      .add("query_ms_total", round_ms(r.query_ms))
+      .add_all(r.counts)
+      .add("model_bytes", r.models.bytes_a + r.models.bytes_b)
+      .add("model_bytes_a", r.models.bytes_a)
+      .add("model_bytes_b", r.models.bytes_b)
+      .add("volume_tests", r.stats.volume_tests)
+      .add("triangle_tests", r.stats.triangle_tests)
+      .add("threads", o.threads)
+      .add_all(r.extras);
+  return json;
+}
+
+}  // namespace
+
 int query_command(std::span<const std::string> argv) {
   const Args args("query", argv,
                   {"poses", "method", "out", "threads", "tolerance", "contact-tolerance"},
@@ -154,165 +324,42 @@ int query_command(std::span<const std::string> argv) {
     std::fputs(kHelp, stdout);
     return kExitOk;
   }
-  args.expect_positional(2, "two mesh files A and B");
-  const std::string poses_path = args.required("poses");
-  const Mode mode = parse_mode(args);
-  const bool distance_mode = mode == Mode::kDistance || mode == Mode::kTolerance;
-  const bool distance_brute = distance_mode && distance_method_is_brute(args, mode);
-  if (!distance_mode && args.value("method") == "rss") {
-    throw UsageError(
-        "query: method 'rss' (the distance hierarchy) answers --distance and --tolerance only; "
-        "collision methods: " +
-        method_list());
-  }
-  // The collision method (not used by the distance modes, which have their own).
-  const collision::Method method =
-      distance_mode ? collision::Method::kBrute : args.method(collision::Method::kBoxtree);
-  const double tolerance = args.number("tolerance", 0.0).value_or(0.0);
-  collision::ContactRequest contact_request;
-  contact_request.touching_tolerance =
-      args.number("contact-tolerance", 0.0).value_or(contact_request.touching_tolerance);
-  const int threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
-  const std::optional<std::string> out_path = args.value("out");
-  collision::CollideRequest request;
-  request.all_pairs = args.flag("all-pairs");
+  const QueryOptions o = parse_query_options(args);
 
   // Open the output first: an unwritable destination should fail before any work.
   std::ofstream out;
-  if (out_path) {
-    const std::string inputs[] = {args.positional()[0], args.positional()[1], poses_path};
-    refuse_overwriting_input("query", *out_path, inputs);
-    out.open(*out_path, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(*out_path + ": cannot be written: " + std::strerror(errno));
+  if (o.out_path) {
+    const std::string inputs[] = {o.path_a, o.path_b, o.poses_path};
+    refuse_overwriting_input("query", *o.out_path, inputs);
+    out.open(*o.out_path, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(*o.out_path + ": cannot be written: " + std::strerror(errno));
   }
-
   std::optional<engine::PoseListReader> reader;
   try {
-    reader.emplace(poses_path);
+    reader.emplace(o.poses_path);
   } catch (const engine::PoseListError& e) {
     throw InputError(e.what());
   }
+  const LoadedMesh a = load_mesh(o.path_a);
+  const LoadedMesh b = load_mesh(o.path_b);
+  print_notes(o.path_a, a);
+  print_notes(o.path_b, b);
 
-  const std::string& path_a = args.positional()[0];
-  const std::string& path_b = args.positional()[1];
-  const LoadedMesh a = load_mesh(path_a);
-  const LoadedMesh b = load_mesh(path_b);
-  print_notes(path_a, a);
-  print_notes(path_b, b);
-
-  // Every good pose up to the first bad line; the error is reported after the
-  // lines of those poses are written.
-  std::vector<collision::Transform> poses;
-  std::optional<std::string> pose_error;
-  try {
-    while (std::optional<engine::PoseEntry> pose = reader->next()) poses.push_back(pose->X_AB);
-  } catch (const engine::PoseListError& e) {
-    pose_error = e.what();
-  }
-
-  // Per-pose lines, the mode's own summary keys and the work done. `counts`
-  // come after query_ms_total, `extras` after threads.
-  std::string lines;
-  ModelSummary models;
-  JsonLine counts;
-  JsonLine extras;
-  collision::CollideStats stats;
-  double query_ms = 0;
-  if (distance_mode) {
-    DistanceInputs inputs{.mesh_a = a.mesh.get(), .mesh_b = b.mesh.get()};
-    BuiltDistanceModel model_a;
-    BuiltDistanceModel model_b;
-    if (!distance_brute) {
-      model_a = build_distance_timed(a.mesh);
-      model_b = build_distance_timed(b.mesh);
-      inputs.model_a = model_a.model.get();
-      inputs.model_b = model_b.model.get();
-      models = {model_a.build_ms, model_b.build_ms, model_a.model->info().bytes,
-                model_b.model->info().bytes};
-    }
-    if (mode == Mode::kDistance) {
-      const DistanceQueryResult result = run_distance_queries(inputs, poses, threads);
-      lines.reserve(20 * poses.size());
-      for (double d : result.distances) lines += format_distance(d) + "\n";
-      counts.add("colliding", result.colliding_count)
-          .add("distance_min", result.distance_min)
-          .add("distance_max", result.distance_max);
-      stats = result.stats;
-      query_ms = result.wall_ms;
-    } else {
-      const ToleranceQueryResult result = run_tolerance_queries(inputs, poses, tolerance, threads);
-      lines.reserve(2 * poses.size());
-      for (std::uint8_t w : result.within) lines += w != 0 ? "1\n" : "0\n";
-      counts.add("tolerance", tolerance).add("within", result.within_count);
-      stats = result.stats;
-      query_ms = result.wall_ms;
-    }
-  } else {
-    const BuiltModel model_a = build_timed(method, a.mesh);
-    const BuiltModel model_b = build_timed(method, b.mesh);
-    models = {model_a.build_ms, model_b.build_ms, model_a.model->info().bytes,
-              model_b.model->info().bytes};
-    if (mode == Mode::kContacts) {
-      const ContactQueryResult result =
-          run_contact_queries(*model_a.model, *model_b.model, poses, contact_request, threads);
-      for (const std::string& line : result.lines) lines += line + "\n";
-      counts.add("colliding", result.colliding_count);
-      extras.add("pairs_total", result.pairs_total)
-          .add("contact_tolerance", contact_request.touching_tolerance)
-          .add("patches_total", result.patches_total)
-          .add("patches_face", result.face_patches)
-          .add("patches_curve", result.curve_patches)
-          .add("patches_point", result.point_patches)
-          .add("patches_penetrating", result.penetrating_patches);
-      stats = result.stats;
-      query_ms = result.wall_ms;
-    } else {
-      const PoseQueryResult result =
-          run_pose_queries(*model_a.model, *model_b.model, poses, request, threads);
-      lines.reserve(2 * poses.size());
-      for (std::uint8_t c : result.colliding) lines += c != 0 ? "1\n" : "0\n";
-      counts.add("colliding", result.colliding_count);
-      if (request.all_pairs) extras.add("pairs_total", result.pairs_total);
-      stats = result.stats;
-      query_ms = result.wall_ms;
-    }
-  }
-
-  if (out_path) {
-    out.write(lines.data(), static_cast<std::streamsize>(lines.size()));
+  const PoseBatch batch = read_poses(*reader);
+  const QueryOutcome r = o.distance_mode ? run_distance_mode(o, a, b, batch.poses)
+                                         : run_collision_mode(o, a, b, batch.poses);
+  if (o.out_path) {
+    out.write(r.lines.data(), static_cast<std::streamsize>(r.lines.size()));
     out.close();
-    if (!out) throw InputError(*out_path + ": write failed: " + std::strerror(errno));
+    if (!out) throw InputError(*o.out_path + ": write failed: " + std::strerror(errno));
   } else {
-    std::fwrite(lines.data(), 1, lines.size(), stdout);
+    std::fwrite(r.lines.data(), 1, r.lines.size(), stdout);
   }
-
-  const std::string_view method_shown = !distance_mode   ? collision::method_name(method)
-                                        : distance_brute ? std::string_view("brute")
-                                                         : std::string_view("rss");
-  JsonLine json;
-  json.add("method", method_shown)
-      .add("mode", mode_name(mode))
-      .add("a", path_a)
-      .add("b", path_b)
-      .add("triangles_a", std::uint64_t{a.mesh->triangle_count()})
-      .add("triangles_b", std::uint64_t{b.mesh->triangle_count()})
-      .add("build_ms", round_ms(models.build_ms_a + models.build_ms_b))
-      .add("build_ms_a", round_ms(models.build_ms_a))
-      .add("build_ms_b", round_ms(models.build_ms_b))
-      .add("queries", std::uint64_t{poses.size()})
-      .add("query_ms_total", round_ms(query_ms))
-      .add_all(counts)
-      .add("model_bytes", models.bytes_a + models.bytes_b)
-      .add("model_bytes_a", models.bytes_a)
-      .add("model_bytes_b", models.bytes_b)
-      .add("volume_tests", stats.volume_tests)
-      .add("triangle_tests", stats.triangle_tests)
-      .add("threads", threads)
-      .add_all(extras);
-  if (pose_error) json.add("error", *pose_error);
+  JsonLine json = query_summary(o, a, b, batch.poses.size(), r);
+  if (batch.error) json.add("error", *batch.error);
   std::fputs((json.str() + "\n").c_str(), stdout);
 
-  if (pose_error) throw InputError(*pose_error);
+  if (batch.error) throw InputError(*batch.error);
   return kExitOk;
 }
 

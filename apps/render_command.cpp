@@ -28,7 +28,7 @@ constexpr const char* kHelp =
 
 Draws a mesh or assembly file off-screen and writes the picture as PNG.
 
-  INPUT          any mesh or assembly file assimp reads (OBJ, STL, PLY, glTF/GLB, ...);
+  INPUT          a mesh or assembly file (OBJ, STL, PLY, glTF or GLB);
                  every mesh instance becomes a part with its own palette colour
   --out PNG      the image to write
   --width W      image width in pixels, 1 to 16384 (default 1024)

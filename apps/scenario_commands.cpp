@@ -80,8 +80,8 @@ std::filesystem::path default_scenario() {
       "run: no scenario given and no scenarios/ folder found (see 'dovetail run --help')");
 }
 
-int run_scenario_command(const Args& args, const std::filesystem::path& scenario,
-                         std::optional<std::filesystem::path> trace) {
+/// The run's options from the command line (run and replay share them).
+scripting::RunOptions run_options(const Args& args, std::optional<std::filesystem::path> trace) {
   scripting::RunOptions options;
   options.trace = std::move(trace);
   if (auto v = args.value("record")) options.record = *v;
@@ -93,8 +93,7 @@ int run_scenario_command(const Args& args, const std::filesystem::path& scenario
   if (options.render_every > 0 && !options.render_dir)
     throw UsageError("run: --every needs --render DIR");
   options.threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
-  const bool quiet = args.flag("quiet");
-  options.progress = !quiet && stderr_is_terminal();
+  options.progress = !args.flag("quiet") && stderr_is_terminal();
   if (auto v = args.value("capture")) {
     options.capture_dir = *v;
     make_folder(*v);
@@ -107,18 +106,18 @@ int run_scenario_command(const Args& args, const std::filesystem::path& scenario
                        "' (boxtree, dop6, dop14, dop18, dop26, aabb, obb, brute)");
     }
   }
-  if (!std::filesystem::exists(scenario)) throw InputError(scenario.string() + ": no such file");
-  if (options.trace && !std::filesystem::exists(*options.trace)) {
-    throw InputError(options.trace->string() + ": no such file");
-  }
+  return options;
+}
 
-  const scripting::RunOutcome outcome = scripting::run_scenario(scenario, options);
-  if (auto path = args.value("report")) {
-    std::ofstream out(*path, std::ios::binary);
-    out << outcome.to_json();
-    out.flush();
-    if (!out) throw InputError(*path + ": cannot be written");
-  }
+void write_report(const std::string& path, const scripting::RunOutcome& outcome) {
+  std::ofstream out(path, std::ios::binary);
+  out << outcome.to_json();
+  out.flush();
+  if (!out) throw InputError(path + ": cannot be written");
+}
+
+/// Warnings, failures and suspect queries, on standard error.
+void print_problems(const scripting::RunOptions& options, const scripting::RunOutcome& outcome) {
   for (const std::string& w : outcome.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   if (options.capture_dir && outcome.suspect_queries > 0) {
     std::fprintf(stderr, "warning: %zu suspect collision queries, %zu capture files in %s\n",
@@ -127,27 +126,32 @@ int run_scenario_command(const Args& args, const std::filesystem::path& scenario
   }
   const std::string failures = outcome.failure_summary();
   if (!failures.empty()) std::fputs(failures.c_str(), stderr);
-  if (!quiet) {
-    std::size_t passed = 0;
-    for (const auto& e : outcome.expectations) passed += e.passed ? 1 : 0;
-    std::printf("%s: %s (%zu/%zu expectations, %llu frames, %.2f s wall)\n", outcome.name.c_str(),
-                std::string(scripting::status_name(outcome.status)).c_str(), passed,
-                outcome.expectations.size(), static_cast<unsigned long long>(outcome.report.frames),
-                outcome.wall_seconds);
-    for (const auto& s : outcome.steps) {
-      if (s.done_at) {
-        std::printf("  step %-20s done at t=%.3f s%s\n", s.name.c_str(), *s.done_at,
-                    s.out_of_order ? " (out of order)" : "");
-      } else {
-        std::printf("  step %-20s not done\n", s.name.c_str());
-      }
+}
+
+/// The summary on standard output: outcome, steps, state hash, final frame.
+void print_summary(const scripting::RunOutcome& outcome) {
+  std::size_t passed = 0;
+  for (const auto& e : outcome.expectations) passed += e.passed ? 1 : 0;
+  std::printf("%s: %s (%zu/%zu expectations, %llu frames, %.2f s wall)\n", outcome.name.c_str(),
+              std::string(scripting::status_name(outcome.status)).c_str(), passed,
+              outcome.expectations.size(), static_cast<unsigned long long>(outcome.report.frames),
+              outcome.wall_seconds);
+  for (const auto& s : outcome.steps) {
+    if (s.done_at) {
+      std::printf("  step %-20s done at t=%.3f s%s\n", s.name.c_str(), *s.done_at,
+                  s.out_of_order ? " (out of order)" : "");
+    } else {
+      std::printf("  step %-20s not done\n", s.name.c_str());
     }
-    std::printf("  state_hash 0x%016llx\n",
-                static_cast<unsigned long long>(outcome.report.state_hash));
-    if (outcome.final_frame)
-      std::printf("  final frame: %s\n", outcome.final_frame->string().c_str());
   }
-  switch (outcome.status) {
+  std::printf("  state_hash 0x%016llx\n",
+              static_cast<unsigned long long>(outcome.report.state_hash));
+  if (outcome.final_frame)
+    std::printf("  final frame: %s\n", outcome.final_frame->string().c_str());
+}
+
+int exit_code(scripting::RunOutcome::Status status) {
+  switch (status) {
     case scripting::RunOutcome::Status::kPassed:
       return kExitOk;
     case scripting::RunOutcome::Status::kFailed:
@@ -156,6 +160,20 @@ int run_scenario_command(const Args& args, const std::filesystem::path& scenario
       return kExitInputError;
   }
   return kExitInputError;
+}
+
+int run_scenario_command(const Args& args, const std::filesystem::path& scenario,
+                         std::optional<std::filesystem::path> trace) {
+  const scripting::RunOptions options = run_options(args, std::move(trace));
+  if (!std::filesystem::exists(scenario)) throw InputError(scenario.string() + ": no such file");
+  if (options.trace && !std::filesystem::exists(*options.trace)) {
+    throw InputError(options.trace->string() + ": no such file");
+  }
+  const scripting::RunOutcome outcome = scripting::run_scenario(scenario, options);
+  if (auto path = args.value("report")) write_report(*path, outcome);
+  print_problems(options, outcome);
+  if (!args.flag("quiet")) print_summary(outcome);
+  return exit_code(outcome.status);
 }
 
 }  // namespace
