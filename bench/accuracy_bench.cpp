@@ -35,6 +35,7 @@
 #include "dovetail/collision/pose_sampling.h"
 #include "dovetail/collision/primitives.h"
 #include "dovetail/engine/mesh_import.h"
+#include "mesh_pair.h"
 
 namespace {
 
@@ -102,18 +103,9 @@ Options parse(int argc, char** argv) {
 }
 
 int run(const Options& options) {
-  std::shared_ptr<const collision::Mesh> a, b;
-  if (options.mesh_a.empty()) {
-    a = std::make_shared<const collision::Mesh>(collision::make_sphere(0.6, 5));
-    b = std::make_shared<const collision::Mesh>(collision::make_torus(0.7, 0.25, 128, 64));
-  } else {
-    a = std::make_shared<const collision::Mesh>(engine::import_mesh(options.mesh_a));
-    b = options.mesh_b == options.mesh_a
-            ? a
-            : std::make_shared<const collision::Mesh>(engine::import_mesh(options.mesh_b));
-  }
-  std::printf("A: %s (%zu triangles)\nB: %s (%zu triangles)\n", a->source.c_str(),
-              a->triangle_count(), b->source.c_str(), b->triangle_count());
+  const bench::MeshPair pair = bench::mesh_pair(options.mesh_a, options.mesh_b);
+  const std::shared_ptr<const collision::Mesh>& a = pair.a;
+  const std::shared_ptr<const collision::Mesh>& b = pair.b;
 
   collision::ContactPoseSettings pose_settings;
   pose_settings.directions = options.directions;

@@ -26,6 +26,7 @@
 #include "dovetail/collision/primitives.h"
 #include "dovetail/engine/mesh_import.h"
 #include "fcl_peer.h"
+#include "mesh_pair.h"
 
 namespace {
 
@@ -84,7 +85,7 @@ Options parse(int argc, char** argv) {
 }
 
 /// The mesh moved and scaled uniformly so that its bounding box fits [-1, 1]^3, centred.
-std::shared_ptr<const collision::Mesh> normalized(collision::Mesh m) {
+collision::Mesh normalized(collision::Mesh m) {
   Vec3 lo = m.vertices.front(), hi = lo;
   for (const Vec3& v : m.vertices) {
     lo = lo.cwiseMin(v);
@@ -93,7 +94,7 @@ std::shared_ptr<const collision::Mesh> normalized(collision::Mesh m) {
   const Vec3 centre = (lo + hi) / 2;
   const Real half = ((hi - lo) / 2).maxCoeff();
   for (Vec3& v : m.vertices) v = (v - centre) / half;
-  return std::make_shared<const collision::Mesh>(std::move(m));
+  return m;
 }
 
 struct Cell {
@@ -110,16 +111,9 @@ struct Contender {
 };
 
 int run(const Options& options) {
-  std::shared_ptr<const collision::Mesh> a, b;
-  if (options.mesh_a.empty()) {
-    a = normalized(collision::make_sphere(0.6, 5));
-    b = normalized(collision::make_torus(0.7, 0.25, 128, 64));
-  } else {
-    a = normalized(engine::import_mesh(options.mesh_a));
-    b = options.mesh_b == options.mesh_a ? a : normalized(engine::import_mesh(options.mesh_b));
-  }
-  std::printf("A: %s (%zu triangles)\nB: %s (%zu triangles)\n", a->source.c_str(),
-              a->triangle_count(), b->source.c_str(), b->triangle_count());
+  const bench::MeshPair pair = bench::mesh_pair(options.mesh_a, options.mesh_b, normalized);
+  const std::shared_ptr<const collision::Mesh>& a = pair.a;
+  const std::shared_ptr<const collision::Mesh>& b = pair.b;
 
   std::vector<Contender> contenders;
   for (const Method m : collision::all_methods()) {

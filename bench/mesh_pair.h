@@ -1,0 +1,44 @@
+#pragma once
+// The pair of meshes a two-object benchmark runs on: two files (one mesh
+// shared when both name the same file) or, without files, the generated
+// sphere and torus of the built-in scene.
+
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "dovetail/collision/mesh.h"
+#include "dovetail/collision/primitives.h"
+#include "dovetail/engine/mesh_import.h"
+
+namespace dovetail::bench {
+
+struct MeshPair {
+  std::shared_ptr<const collision::Mesh> a, b;
+};
+
+/// The meshes of `path_a` and `path_b` (both empty: the built-in pair), each
+/// passed through `prepare` once, then printed as `A: ...` and `B: ...`.
+inline MeshPair mesh_pair(
+    const std::string& path_a, const std::string& path_b,
+    const std::function<collision::Mesh(collision::Mesh)>& prepare = [](collision::Mesh m) {
+      return m;
+    }) {
+  const auto make = [&](collision::Mesh m) {
+    return std::make_shared<const collision::Mesh>(prepare(std::move(m)));
+  };
+  MeshPair pair;
+  if (path_a.empty()) {
+    pair.a = make(collision::make_sphere(0.6, 5));
+    pair.b = make(collision::make_torus(0.7, 0.25, 128, 64));
+  } else {
+    pair.a = make(engine::import_mesh(path_a));
+    pair.b = path_b == path_a ? pair.a : make(engine::import_mesh(path_b));
+  }
+  std::printf("A: %s (%zu triangles)\nB: %s (%zu triangles)\n", pair.a->source.c_str(),
+              pair.a->triangle_count(), pair.b->source.c_str(), pair.b->triangle_count());
+  return pair;
+}
+
+}  // namespace dovetail::bench
