@@ -71,15 +71,6 @@ collision::Aabb read_box(LineReader& reader, std::uint64_t frame, std::uint64_t 
   return box;
 }
 
-std::string broadphase_list() {
-  std::string names;
-  for (collision::BroadphaseMethod m : collision::all_broadphases()) {
-    if (!names.empty()) names += ", ";
-    names += collision::broadphase_name(m);
-  }
-  return names;
-}
-
 }  // namespace
 
 int broadphase_command(std::span<const std::string> argv) {

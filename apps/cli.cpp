@@ -195,6 +195,15 @@ std::string method_list() {
   return list;
 }
 
+std::string broadphase_list() {
+  std::string names;
+  for (collision::BroadphaseMethod m : collision::all_broadphases()) {
+    if (!names.empty()) names += ", ";
+    names += collision::broadphase_name(m);
+  }
+  return names;
+}
+
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();

@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "dovetail/collision/broadphase.h"
 #include "dovetail/collision/model.h"
 #include "dovetail/engine/json.h"
 #include "dovetail/engine/mesh_import.h"
@@ -87,6 +88,8 @@ void refuse_overwriting_input(const std::string& command, const std::string& out
 
 /// "boxtree, dop6, ..., brute".
 std::string method_list();
+/// The broad phases' names, "brute, sap, ...".
+std::string broadphase_list();
 
 /// Milliseconds since `start`.
 double ms_since(std::chrono::steady_clock::time_point start);

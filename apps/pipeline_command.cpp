@@ -80,14 +80,14 @@ collision::Transform read_pose(LineReader& reader, std::uint64_t frame, std::uin
   return X;
 }
 
-template <typename Parse, typename Name, typename All>
-auto choose(const Args& args, const char* option, Parse parse, Name name, All all,
-            decltype(parse("")) fallback) {
+/// The value of `option` parsed by `parse`, or `fallback` when absent; an
+/// unknown name is a usage error listing `valid`.
+template <typename Parse, typename T>
+T named_option(const Args& args, const char* option, Parse parse, T fallback,
+               const std::string& valid) {
   const std::optional<std::string> text = args.value(option);
   if (!text) return fallback;
-  if (const auto m = parse(*text)) return m;
-  std::string valid;
-  for (const auto m : all()) valid += (valid.empty() ? "" : ", ") + std::string(name(m));
+  if (const std::optional<T> m = parse(*text)) return *m;
   throw UsageError("pipeline: unknown --" + std::string(option) + " '" + *text +
                    "'; valid: " + valid);
 }
@@ -102,12 +102,11 @@ int pipeline_command(std::span<const std::string> argv) {
   }
   args.expect_positional(0, "no positional arguments");
   const std::string scene_path = args.required("scene");
-  const collision::BroadphaseMethod broadphase = *choose(
-      args, "broadphase", collision::parse_broadphase, collision::broadphase_name,
-      collision::all_broadphases, std::optional(collision::BroadphaseMethod::kSweepAndPrune));
+  const collision::BroadphaseMethod broadphase =
+      named_option(args, "broadphase", collision::parse_broadphase,
+                   collision::BroadphaseMethod::kSweepAndPrune, broadphase_list());
   const collision::Method method =
-      *choose(args, "method", collision::parse_method, collision::method_name,
-              collision::all_methods, std::optional(collision::Method::kObb));
+      named_option(args, "method", collision::parse_method, collision::Method::kObb, method_list());
   const int threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
   const std::optional<std::string> out_path = args.value("out");
 

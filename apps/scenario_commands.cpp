@@ -102,8 +102,7 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
     if (!options.capture_dir) throw UsageError("run: --cross-check needs --capture DIR");
     options.cross_check = collision::parse_method(*v);
     if (!options.cross_check) {
-      throw UsageError("run: unknown --cross-check method '" + *v +
-                       "' (boxtree, dop6, dop14, dop18, dop26, aabb, obb, brute)");
+      throw UsageError("run: unknown --cross-check method '" + *v + "' (" + method_list() + ")");
     }
   }
   return options;

@@ -450,6 +450,7 @@ struct CollisionWorld::Impl {
     for (const PairWork& w : work) {
       const Part& a = parts[w.a];
       const Part& b = parts[w.b];
+      const Transform X_AB = relative(a.X_WP, b.X_WP);
       const auto record = [&](CaptureKind kind, std::string what) {
         settings.capture->record(
             {.kind = kind,
@@ -457,7 +458,7 @@ struct CollisionWorld::Impl {
              .context = "step " + std::to_string(steps) + ": '" + a.name + "' and '" + b.name + "'",
              .a = a.shape->mesh,
              .b = b.shape->mesh,
-             .X_AB = relative(a.X_WP, b.X_WP)});
+             .X_AB = X_AB});
       };
       const bool finite = a.X_WP.R.allFinite() && a.X_WP.t.allFinite() && b.X_WP.R.allFinite() &&
                           b.X_WP.t.allFinite();
@@ -477,8 +478,7 @@ struct CollisionWorld::Impl {
         if (!shape->check_model)
           shape->check_model = build_model(*settings.cross_check, shape->mesh);
       }
-      const bool check =
-          a.shape->check_model->collide(*b.shape->check_model, relative(a.X_WP, b.X_WP)).colliding;
+      const bool check = a.shape->check_model->collide(*b.shape->check_model, X_AB).colliding;
       if (check == w.colliding) continue;
       const std::string verdict = w.colliding ? "intersecting" : "separate";
       const std::string other = check ? "intersecting" : "separate";
