@@ -137,17 +137,13 @@ Affine node_to_root(const aiNode& node) {
 /// The file's perspective cameras in its root frame, named uniquely (`_2`,
 /// `_3`, ... for repeated names; `camera` for an empty one).
 ///
-/// Assimp gives a horizontal field of view, from which the vertical one
-/// follows with the aspect ratio. Two quirks of assimp 5.2's glTF importer
-/// are undone: its "horizontal" angle is yfov x aspect ratio (so the
-/// vertical one is that over the aspect ratio), and it copies the camera
-/// node's translation into the camera's own position (assimp issue 5054),
-/// although the node transform places the camera too.
-void collect_cameras(const fs::path& path, const aiScene& scene, ImportReport& report) {
-  std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  const bool gltf = extension == ".gltf" || extension == ".glb";
+/// Of the formats read (check_format), only glTF and GLB carry cameras, so
+/// two quirks of assimp 5.2's glTF importer are undone: its "horizontal"
+/// angle is yfov x aspect ratio (so the vertical one is that over the
+/// aspect ratio), and it copies the camera node's translation into the
+/// camera's own position (assimp issue 5054), although the node transform
+/// places the camera too.
+void collect_cameras(const aiScene& scene, ImportReport& report) {
   // Assimp ties a camera to the node of the same name. With repeated names
   // the k-th camera of a name takes the k-th node of that name, depth first.
   std::map<std::string, std::vector<const aiNode*>> nodes_named;
@@ -179,7 +175,7 @@ void collect_cameras(const fs::path& path, const aiScene& scene, ImportReport& r
     }
     const Affine X_RN = node != nullptr ? node_to_root(*node) : Affine::Identity();
     aiVector3D position = camera.mPosition;
-    if (gltf && node != nullptr) {
+    if (node != nullptr) {
       const aiMatrix4x4& m = node->mTransformation;
       if (position == aiVector3D(m.a4, m.b4, m.c4)) position = aiVector3D(0, 0, 0);
     }
@@ -192,11 +188,8 @@ void collect_cameras(const fs::path& path, const aiScene& scene, ImportReport& r
     out.eye = eye;
     out.target = eye + look.normalized();
     out.up = up;
-    // assimp 5.2: the glTF importer hands over yfov x aspect; the others a
-    // true horizontal angle.
-    const double fov_y = gltf ? camera.mHorizontalFOV / aspect
-                              : 2 * std::atan(std::tan(0.5 * camera.mHorizontalFOV) / aspect);
-    out.fov_y_degrees = fov_y * 180 / std::numbers::pi;
+    // assimp 5.2: the glTF importer hands over yfov x aspect.
+    out.fov_y_degrees = camera.mHorizontalFOV / aspect * 180 / std::numbers::pi;
     if (!out.eye.allFinite() || !out.target.allFinite() || !out.up.allFinite() ||
         !(out.up.squaredNorm() > 0) || !(out.fov_y_degrees > 0 && out.fov_y_degrees < 180)) {
       report.notes.push_back("skipped camera '" + name +
@@ -437,7 +430,7 @@ ImportReport import_scene(const fs::path& path, const aiScene& scene, const Impo
     part.name = path.filename().string();
     part.mesh = validate(std::move(geometry), path.string(), options.limits, part.validation);
     report.parts.push_back(std::move(part));
-    collect_cameras(path, scene, report);
+    collect_cameras(scene, report);
     return report;
   }
 
@@ -457,7 +450,7 @@ ImportReport import_scene(const fs::path& path, const aiScene& scene, const Impo
         validate(std::move(geometry), path.string() + "#" + name, options.limits, part.validation);
     report.parts.push_back(std::move(part));
   }
-  collect_cameras(path, scene, report);
+  collect_cameras(scene, report);
   return report;
 }
 
