@@ -281,10 +281,15 @@ SlidingRuns sliding_runs(int runs, const std::string& pictures,
   const auto peg = std::make_shared<const collision::Mesh>(banded_cylinder(0.01, kLength, 256, 19));
   SlidingRuns out;
   out.triangles = peg->triangle_count();
-  const auto block_model = collision::build_model(collision::Method::kObb, block);
-  const auto peg_model = collision::build_model(collision::Method::kObb, peg);
-  const auto block_distance = collision::build_distance_model(block);
-  const auto peg_distance = collision::build_distance_model(peg);
+  // The measuring models, built only when measuring.
+  std::shared_ptr<const collision::CollisionModel> block_model, peg_model;
+  std::shared_ptr<const collision::DistanceModel> block_distance, peg_distance;
+  if (measure_penetration) {
+    block_model = collision::build_model(collision::Method::kObb, block);
+    peg_model = collision::build_model(collision::Method::kObb, peg);
+    block_distance = collision::build_distance_model(block);
+    peg_distance = collision::build_distance_model(peg);
+  }
   for (int run = 0; run < runs; ++run) {
     Transform X_WPeg;
     X_WPeg.R = interaction::rotation_z_deg(-2) * interaction::rotation_x_deg(90);
