@@ -126,6 +126,8 @@ int broadphase_command(std::span<const std::string> argv) {
     objects = reader.count((*header)[0], "the object count N");
     frames = reader.count((*header)[1], "the frame count F");
     if (objects > kMaxObjects) reader.fail("more than 2^32 - 1 objects");
+    // Frames of no boxes take no lines, so nothing in the file would bound F.
+    if (objects == 0 && frames > 0) reader.fail("no objects (N = 0) but F > 0 frames");
 
     // Frame by frame: read every box, then update and query the broad phase.
     std::vector<collision::Aabb> boxes;

@@ -150,6 +150,8 @@ int pipeline_command(std::span<const std::string> argv) {
     parts = reader.count((*header)[0], "the part count N");
     frames = reader.count((*header)[1], "the frame count F");
     if (parts > 1'000'000) reader.fail("more than 1,000,000 parts");
+    // Frames of no parts take no lines, so nothing in the file would bound F.
+    if (parts == 0 && frames > 0) reader.fail("no parts (N = 0) but F > 0 frames");
 
     // The meshes, each file read once however many parts use it.
     std::map<std::string, std::shared_ptr<const collision::Mesh>> meshes;

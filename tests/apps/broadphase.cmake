@@ -52,6 +52,9 @@ dovetail_cli_test(broadphase_header EXIT 1 ARGS broadphase --boxes ${bp_data}/ba
 dovetail_cli_test(broadphase_frame_count EXIT 1
                   ARGS broadphase --boxes ${bp_data}/bad_frame_count.txt
                   STDERR "bad_frame_count.txt:1: the frame count F must be a non-negative integer")
+# Found by the box_file fuzz target: F was unbounded when frames have no lines.
+dovetail_cli_test(broadphase_no_objects EXIT 1 ARGS broadphase --boxes ${bp_data}/no_objects.txt
+                  STDERR "no_objects.txt:1: no objects [^\n]*but F > 0 frames")
 dovetail_cli_test(broadphase_empty EXIT 1 ARGS broadphase --boxes ${bp_data}/empty.txt
                   STDERR "empty.txt:1: empty file")
 dovetail_cli_test(broadphase_missing_file EXIT 1 ARGS broadphase --boxes ${bp_data}/no_such.txt

@@ -23,6 +23,8 @@ foreach(combo "sap;obb;1" "grid;boxtree;2" "octree;dop18;8" "brute;aabb;1" "sap;
 endforeach()
 
 # ---- bad input: an error naming file and line, exit 1, the frames before it written
+dovetail_cli_test(pipeline_no_parts EXIT 1 ARGS pipeline --scene ${pl_data}/no_parts.txt
+                  STDERR "no_parts.txt:1: no parts [^\n]*but F > 0 frames")
 dovetail_cli_test(pipeline_zero_quaternion EXIT 1
                   ARGS pipeline --scene ${pl_data}/zero_quaternion.txt
                   STDERR "zero_quaternion.txt:5: the quaternion has no length")
