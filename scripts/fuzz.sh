@@ -8,7 +8,8 @@
 # adds goes to build-fuzz/corpus/<target>/, crashes, hangs and out-of-memory
 # inputs to build-fuzz/crashes/<target>/. Prints per target the executions,
 # the time and the crash files found; exits 1 when a target found any.
-# Environment: BUILD_DIR (default build-fuzz), JOBS (default: number of cores).
+# Environment: BUILD_DIR (default build-fuzz), JOBS (default: number of cores),
+# FUZZ_SEED (libFuzzer's -seed; unset, each run explores differently).
 # docs/reliability.md explains the targets and records their results.
 set -eu
 
@@ -54,6 +55,8 @@ for t in $targets; do
   crashes="$build/crashes/$t"
   mkdir -p "$corpus" "$crashes"
   dict=""
+  seed=""
+  [ -n "${FUZZ_SEED:-}" ] && seed="-seed=$FUZZ_SEED"
   [ -f "$root/fuzz/$t.dict" ] && dict="-dict=$root/fuzz/$t.dict"
   case "$t" in mesh_*) [ -f "$root/fuzz/mesh.dict" ] && dict="-dict=$root/fuzz/mesh.dict" ;; esac
   # Assimp (the system library behind the mesh targets) leaks on some
@@ -67,7 +70,7 @@ for t in $targets; do
   start=$(date +%s)
   # shellcheck disable=SC2086
   ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=$leaks" "$build/fuzz/fuzz_$t" -max_total_time="$seconds" -max_len="$(max_len "$t")" -timeout=10 \
-    -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$crashes/" $dict \
+    -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$crashes/" $dict $seed \
     "$corpus" "$root/fuzz/corpus/$t" >"$log" 2>&1 || true
   elapsed=$(($(date +%s) - start))
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
