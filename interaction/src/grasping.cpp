@@ -153,6 +153,7 @@ void Grasping::hold(const std::string& part, GraspType type) {
   held_ = part;
   type_ = type;
   last_slide_ = {};
+  fronts_.clear();
   contact_parts_.clear();
   X_HO_ = engine::compose(hand_->X_WH().inverse(), scene.world_pose(handle));
   for (std::size_t d = 0; d < kDigitCount; ++d) {
@@ -415,6 +416,7 @@ void Grasping::carry(engine::Simulation& simulation) {
   }
   request.previous_contacts = previous;
   request.start_proof = &last_slide_.proof;
+  request.fronts = &fronts_;
   last_slide_ = slide(request, settings_.sliding);
   contact_parts_ = handles;
   stats_.slide_queries += static_cast<std::uint64_t>(last_slide_.collision_queries);

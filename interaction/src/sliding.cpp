@@ -52,7 +52,10 @@ void contacts_at(const SlideRequest& request, const Transform& X_WP_free, const 
     const Transform X_OP = engine::compose(o.X_WO.inverse(), X_WP_hit);
     ++queries;
     const std::vector<collision::ContactPatch> patches = collision::compute_contacts(
-        *o.model, *request.part, X_OP, {.estimate_depth = false, .nearly_coplanar_pairs = false});
+        *o.model, *request.part, X_OP,
+        {.estimate_depth = false,
+         .nearly_coplanar_pairs = false,
+         .front = request.fronts ? &request.fronts->of(o.model, request.part) : nullptr});
     const collision::Mesh& obstacle_mesh = o.model->mesh();
     for (const collision::ContactPatch& patch : patches) {
       const std::size_t first = out.size();
@@ -123,17 +126,26 @@ Vec6 project(const Vec6& x_d, const std::vector<Vec6>& a, const std::vector<Real
 }
 
 /// The part at X_WP against every obstacle, exact first-hit queries: the
-/// first hit, or nothing when the pose is collision-free.
+/// first hit, or nothing when the pose is collision-free. With `fronts`, each
+/// query starts from the part's front for that obstacle.
 std::optional<Hit> first_hit(const collision::CollisionModel& part, const Transform& X_WP,
-                             std::span<const SlideObstacle> obstacles, int* queries) {
+                             std::span<const SlideObstacle> obstacles, int* queries,
+                             const std::shared_ptr<const collision::CollisionModel>& part_shared,
+                             SlideFronts* fronts) {
   for (std::size_t i = 0; i < obstacles.size(); ++i) {
     const SlideObstacle& o = obstacles[i];
     const Transform X_OP = engine::compose(o.X_WO.inverse(), X_WP);
     if (queries) ++*queries;
-    const collision::CollideResult r = o.model->collide(part, X_OP);
+    collision::SeparationFront* front = fronts ? &fronts->of(o.model, part_shared) : nullptr;
+    const collision::CollideResult r = o.model->collide(part, X_OP, {.front = front});
     if (r.colliding) return Hit{i, r.pairs.front()};
   }
   return std::nullopt;
+}
+
+/// first_hit for the request's part and obstacles, from its fronts.
+std::optional<Hit> first_hit(const SlideRequest& request, const Transform& X_WP, int& queries) {
+  return first_hit(*request.part, X_WP, request.obstacles, &queries, request.part, request.fronts);
 }
 
 /// Whether the one triangle pair of `hit` intersects with the part at X_WP:
@@ -173,15 +185,14 @@ struct Bracket {
 /// The contact pose of a move whose end collides, by halving the bracket
 /// with a first-hit query of the whole part each time, until it moves a
 /// point less than the resolution or the query budget is spent.
-Bracket bracket_halving(const collision::CollisionModel& part,
-                        std::span<const SlideObstacle> obstacles, const Move& motion, Real size,
-                        Hit hit, const SlidingSettings& settings, int& queries) {
+Bracket bracket_halving(const SlideRequest& request, const Move& motion, Hit hit,
+                        const SlidingSettings& settings, int& queries) {
   Bracket b{.pair_at_hit = hit};
-  for (int i = 0;
-       i < settings.bisection_steps && motion.reach(b.hit - b.free, size) > settings.resolution_m;
+  for (int i = 0; i < settings.bisection_steps &&
+                  motion.reach(b.hit - b.free, request.size) > settings.resolution_m;
        ++i) {
     const Real mid = (b.free + b.hit) / 2;
-    if (const std::optional<Hit> h = first_hit(part, motion.at(mid), obstacles, &queries)) {
+    if (const std::optional<Hit> h = first_hit(request, motion.at(mid), queries)) {
       b.hit = mid;
       b.pair_at_hit = *h;
     } else {
@@ -198,21 +209,22 @@ Bracket bracket_halving(const collision::CollisionModel& part,
 /// earlier; go on with it. Each query thus moves the colliding end to an
 /// earlier pair's contact, and a move that meets one new facet costs two
 /// queries where halving with whole-part queries costs ten or more.
-Bracket bracket_guided(const collision::CollisionModel& part,
-                       std::span<const SlideObstacle> obstacles, const Move& motion, Real size,
-                       Hit hit, const SlidingSettings& settings, int& queries) {
+Bracket bracket_guided(const SlideRequest& request, const Move& motion, Hit hit,
+                       const SlidingSettings& settings, int& queries) {
   Bracket b{.pair_at_hit = hit};
   for (int i = 0; i < settings.bisection_steps; ++i) {
     // Halve on the pair: it touches after b.hit and (the whole part being free there) not
     // after b.free.
     Real lo = b.free;
-    while (motion.reach(b.hit - lo, size) > settings.resolution_m) {
+    while (motion.reach(b.hit - lo, request.size) > settings.resolution_m) {
       const Real mid = (lo + b.hit) / 2;
       if (mid <= lo || mid >= b.hit) break;  // no double left between them
-      (pair_collides(part, motion.at(mid), obstacles[hit.obstacle], hit.pair) ? b.hit : lo) = mid;
+      (pair_collides(*request.part, motion.at(mid), request.obstacles[hit.obstacle], hit.pair)
+           ? b.hit
+           : lo) = mid;
     }
     if (lo == b.free) break;  // the pair touches within the resolution of the free end
-    const std::optional<Hit> earlier = first_hit(part, motion.at(lo), obstacles, &queries);
+    const std::optional<Hit> earlier = first_hit(request, motion.at(lo), queries);
     if (!earlier) {
       b.free = lo;
       break;
@@ -272,13 +284,12 @@ Mat3 rotation_from_vector(const Vec3& w) {
 
 bool collides(const collision::CollisionModel& part, const Transform& X_WP,
               std::span<const SlideObstacle> obstacles, int* queries) {
-  return first_hit(part, X_WP, obstacles, queries).has_value();
+  return first_hit(part, X_WP, obstacles, queries, nullptr, nullptr).has_value();
 }
 
 SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) {
   SlideResult result;
   result.X_WP = request.X_WP;
-  const collision::CollisionModel& part = *request.part;
   auto centre = [&](const Transform& X) { return X.apply(request.p_PC); };
   auto measure_stretch = [&] {
     result.stretch_m = (centre(request.X_WP_target) - centre(result.X_WP)).norm();
@@ -291,7 +302,7 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
     return result;
   }
   if (!proves_free(request.start_proof, request) &&
-      collides(part, result.X_WP, request.obstacles, &result.collision_queries)) {
+      first_hit(request, result.X_WP, result.collision_queries)) {
     result.status = SlideStatus::kBlocked;
     return result;
   }
@@ -350,8 +361,7 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
     const Vec3 v = allowed.head<3>(), w = allowed.tail<3>();
     // 1. Try the move; where it collides, bisect toward the exact contact pose.
     const Move motion{result.X_WP, c, v, w};
-    const std::optional<Hit> end_hit =
-        first_hit(part, motion.at(1), request.obstacles, &result.collision_queries);
+    const std::optional<Hit> end_hit = first_hit(request, motion.at(1), result.collision_queries);
     if (!end_hit) {
       result.X_WP = motion.at(1);
       follow_contacts(c, v, w);
@@ -360,11 +370,10 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
       continue;
     }
     result.status = SlideStatus::kSliding;
-    const Bracket bracket = settings.pair_guided
-                                ? bracket_guided(part, request.obstacles, motion, request.size,
-                                                 *end_hit, settings, result.collision_queries)
-                                : bracket_halving(part, request.obstacles, motion, request.size,
-                                                  *end_hit, settings, result.collision_queries);
+    const Bracket bracket =
+        settings.pair_guided
+            ? bracket_guided(request, motion, *end_hit, settings, result.collision_queries)
+            : bracket_halving(request, motion, *end_hit, settings, result.collision_queries);
     const Real free = bracket.free;
     result.X_WP = motion.at(free);
     follow_contacts(c, free * v, free * w);
@@ -408,7 +417,27 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
   result.proof.part = request.part;
   result.proof.X_WP = result.X_WP;
   result.proof.obstacles.assign(request.obstacles.begin(), request.obstacles.end());
+  if (request.fronts) request.fronts->keep_only(request.obstacles, request.part);
   return result;
+}
+
+collision::SeparationFront& SlideFronts::of(
+    const std::shared_ptr<const collision::CollisionModel>& obstacle,
+    const std::shared_ptr<const collision::CollisionModel>& part) {
+  for (Kept& k : fronts_) {
+    if (k.obstacle == obstacle && k.part == part) return k.front;
+  }
+  fronts_.push_back({obstacle, part, {}});
+  return fronts_.back().front;
+}
+
+void SlideFronts::keep_only(std::span<const SlideObstacle> obstacles,
+                            const std::shared_ptr<const collision::CollisionModel>& part) {
+  std::erase_if(fronts_, [&](const Kept& k) {
+    return k.part != part ||
+           std::none_of(obstacles.begin(), obstacles.end(),
+                        [&](const SlideObstacle& o) { return o.model == k.obstacle; });
+  });
 }
 
 }  // namespace dovetail::interaction

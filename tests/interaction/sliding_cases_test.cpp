@@ -229,5 +229,40 @@ TEST(SlidingCases, AProofOfAFreePoseCoversOnlyTheObstaclesAtTheirPoses) {
   EXPECT_EQ(off.collision_queries, without.collision_queries);
 }
 
+TEST(SlidingCases, FrontsChangeTheWorkNotThePath) {
+  // The cube pressed onto the block and dragged across it, step after step,
+  // once with the part's fronts kept between queries and once without.
+  const CubeOverBlock scene;
+  SlideRequest with = scene.request(), without = scene.request();
+  without.part = with.part;  // one part model for both, as a held part has
+  SlideFronts fronts;
+  with.fronts = &fronts;
+  SlideResult last_with, last_without;
+  for (int step = 0; step < 40; ++step) {
+    const Transform target{Mat3::Identity(), Vec3(0.0005 * step, 0.02, 0.0002 * step)};
+    with.X_WP_target = without.X_WP_target = target;
+    const SlideResult a = slide(with);
+    const SlideResult b = slide(without);
+    ASSERT_TRUE(same_pose(a.X_WP, b.X_WP)) << "step " << step;
+    ASSERT_EQ(a.status, b.status) << "step " << step;
+    ASSERT_EQ(a.contacts.size(), b.contacts.size()) << "step " << step;
+    ASSERT_EQ(a.collision_queries, b.collision_queries) << "step " << step;
+    // As a held part goes on: from where the step left it, against its contacts.
+    last_with = a;
+    last_without = b;
+    with.X_WP = a.X_WP;
+    without.X_WP = b.X_WP;
+    with.previous_contacts = last_with.contacts;
+    without.previous_contacts = last_without.contacts;
+  }
+  EXPECT_NE(last_with.status, SlideStatus::kReached) << "pressed onto the face";
+  EXPECT_GT(with.X_WP.t.x(), 0.015) << "dragged across the face";
+  EXPECT_EQ(fronts.size(), 1U);
+  // A step among other obstacles forgets the fronts of those no longer there.
+  with.obstacles = {};
+  slide(with);
+  EXPECT_EQ(fronts.size(), 0U);
+}
+
 }  // namespace
 }  // namespace dovetail::interaction

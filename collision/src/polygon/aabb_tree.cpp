@@ -134,6 +134,23 @@ ObbTree::ObbTree(const Mesh& mesh, int max_leaf_size) {
     out.link = detail::NodeLink::from(node);
   }
   for (const detail::BuildTriangle& t : layout.triangles) order_.push_back(t.index);
+  if (!nodes_.empty()) {
+    ball_centre_ = nodes_.front().centre;
+    for (const Node& node : nodes_) {
+      ball_radius_ = std::max(ball_radius_, (node.centre - ball_centre_).norm() + node.half.norm());
+    }
+  }
+}
+
+Real ObbTree::reach(const Transform& X_from, const Transform& X_to) const {
+  // A point p = c + u of a box, |u| <= r, moves by (R_to - R_from) p + (t_to - t_from):
+  // at most |dR c + dt| + |dR|_F r, the Frobenius norm bounding the spectral one.
+  const Mat3 dR = X_to.R - X_from.R;
+  const Real move = (dR * ball_centre_ + (X_to.t - X_from.t)).norm() + dR.norm() * ball_radius_;
+  // Rounding of this sum and of the boxes placed at either pose: relative 2^-40,
+  // as the query margin.
+  const Real scale = ball_centre_.norm() + ball_radius_ + X_from.t.norm() + X_to.t.norm();
+  return move * (1 + 0x1.0p-40) + 0x1.0p-40 * scale;
 }
 
 std::size_t ObbTree::bytes() const {
@@ -168,6 +185,12 @@ class ObbPolicy {
     const ObbTree::Node& node = a_.nodes_[n];
     return detail::oriented_boxes_overlap(node.axes, node.centre, node.half, e.axes, e.centre,
                                           e.half, margin_);
+  }
+
+  Real gap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
+    const ObbTree::Node& node = a_.nodes_[n];
+    return detail::oriented_boxes_gap(node.axes, node.centre, node.half, e.axes, e.centre, e.half,
+                                      margin_);
   }
 
   detail::NodeLink link_a(std::uint32_t n) const { return a_.nodes_[n].link; }

@@ -60,6 +60,11 @@ class ObbTree {
   std::size_t depth() const { return depth_; }
   std::size_t bytes() const;
 
+  /// At least how far any point of any box of this tree moves when the
+  /// tree's pose in another frame changes from X_from to X_to, with room for
+  /// the rounding of both (SeparationFront).
+  Real reach(const Transform& X_from, const Transform& X_to) const;
+
  private:
   friend class ObbPolicy;
   struct Node {
@@ -73,6 +78,9 @@ class ObbTree {
   Real max_abs_ = 0;
   std::size_t leaves_ = 0;
   std::size_t depth_ = 0;
+  /// A ball holding every box of the tree (centre, radius), for reach().
+  Vec3 ball_centre_ = Vec3::Zero();
+  Real ball_radius_ = 0;
 };
 
 }  // namespace dovetail::collision

@@ -3,7 +3,9 @@
 // volume test tree). B's volume is brought into A's frame once per B node
 // (the policy's Enc) and re-used while A descends; the larger node descends.
 
+#include <concepts>
 #include <deque>
+#include <span>
 #include <vector>
 
 #include "polygon/binary_layout.h"
@@ -19,6 +21,15 @@ namespace dovetail::collision::detail {
 ///   NodeLink link_a(uint32_t), link_b(uint32_t) const;
 ///   Real size_a(uint32_t), size_b(uint32_t) const;
 ///   const uint32_t* slots_a(), *slots_b() const;  leaf slot -> triangle index
+/// and, for policies that keep a SeparationFront (HasGap):
+///   Real gap(uint32_t a, const EncA&, uint32_t b, const EncB&) const;
+///                                          > 0 exactly when overlap() is false
+template <typename Policy>
+concept HasGap = requires(const Policy& p, const typename Policy::EncA& ea,
+                          const typename Policy::EncB& eb) {
+  { p.gap(0u, ea, 0u, eb) } -> std::same_as<Real>;
+};
+
 template <typename Policy>
 class PairTraversal {
  public:
@@ -73,27 +84,63 @@ class PairTraversal {
     hint_levels_ = levels;
   }
 
+  /// Writes the cut of what follows into `out` (SeparationFront): every node
+  /// pair found apart, with its gap, and every leaf pair tested, depth first.
+  void record_front(std::vector<SeparationFront::Entry>* out) { front_out_ = out; }
+
+  /// The traversal from a front recorded at a pose from which B has since
+  /// moved by at most `reach` in A's frame, in the front's order: an entry
+  /// apart by more than that is still apart (kept, its gap less `reach`);
+  /// the others are tested again and descended as from the roots.
+  void run_from_front(std::span<const SeparationFront::Entry> front, Real reach) {
+    for (const SeparationFront::Entry& f : front) {
+      if (f.gap > reach) {
+        if (front_out_) front_out_->push_back({f.node_a, f.node_b, f.gap - reach});
+        continue;
+      }
+      const Entry e{f.node_a, p_.enclose_a(f.node_a), f.node_b, p_.enclose_b(f.node_b)};
+      if (overlapping(e)) visit(e.a, e.enc_a, e.b, e.enc_b, 0);
+      if (tester_.done()) return;
+    }
+  }
+
   /// A first-hit query that searches the hinted subtree pair first (when it
-  /// still overlaps) and the whole trees only when that finds nothing.
-  void run_hinted(TraversalHint& hint, std::size_t node_count_a, std::size_t node_count_b) {
+  /// still overlaps) and then `whole()`, the whole trees, only when that
+  /// finds nothing. What the subtree pair adds to a recorded front is
+  /// dropped: the whole traversal records it again.
+  template <typename Whole>
+  void run_hinted(TraversalHint& hint, std::size_t node_count_a, std::size_t node_count_b,
+                  Whole&& whole) {
     // A hint at the roots would only repeat the traversal below.
     const bool at_roots = hint.node_a == 0 && hint.node_b == 0;
     if (hint.valid && !at_roots && hint.node_a < node_count_a && hint.node_b < node_count_b) {
       const Entry e{hint.node_a, p_.enclose_a(hint.node_a), hint.node_b, p_.enclose_b(hint.node_b)};
       if (overlapping(e)) run_from(e);
       if (tester_.done()) return;
+      if (front_out_) front_out_->clear();
     }
     // Kept after a miss: parts that part briefly often meet again there, and
     // a stale hint costs at most one more search of its subtree pair.
-    run();
+    whole();
   }
 
  private:
   Entry root_entry() const { return {0, p_.enclose_a(0), 0, p_.enclose_b(0)}; }
 
-  bool overlapping(const Entry& e) {
+  bool overlapping(const Entry& e) { return overlapping(e.a, e.enc_a, e.b, e.enc_b); }
+
+  /// One volume test; a pair found apart joins the recorded front.
+  bool overlapping(std::uint32_t a, const EncA& enc_a, std::uint32_t b, const EncB& enc_b) {
     tester_.count_volume_test();
-    return p_.overlap(e.a, e.enc_a, e.b, e.enc_b);
+    if constexpr (HasGap<Policy>) {
+      if (front_out_) {
+        const Real gap = p_.gap(a, enc_a, b, enc_b);
+        if (!(gap > 0)) return true;
+        front_out_->push_back({a, b, gap});
+        return false;
+      }
+    }
+    return p_.overlap(a, enc_a, b, enc_b);
   }
 
   /// Calls next(child entry) for every overlapping child pair of a non-leaf pair.
@@ -126,6 +173,7 @@ class PairTraversal {
     if (la.is_leaf() && lb.is_leaf()) {
       tester_.test_leaves(p_.slots_a() + la.first_slot(), la.count(),
                           p_.slots_b() + lb.first_slot(), lb.count());
+      if (front_out_) front_out_->push_back({a, b, -1});
       if (hint_ && tester_.done()) {
         *hint_ = {a, b, true};
         hint_countdown_ = hint_levels_;
@@ -135,15 +183,13 @@ class PairTraversal {
     if (!la.is_leaf() && (lb.is_leaf() || p_.size_a(a) >= p_.size_b(b))) {
       for (std::uint32_t c = la.first_child(); c < la.first_child() + 2; ++c) {
         const EncA enc_c = p_.enclose_a(c);
-        tester_.count_volume_test();
-        if (p_.overlap(c, enc_c, b, enc_b)) visit(c, enc_c, b, enc_b, depth + 1);
+        if (overlapping(c, enc_c, b, enc_b)) visit(c, enc_c, b, enc_b, depth + 1);
         if (tester_.done()) return unwind(a, b);
       }
     } else {
       for (std::uint32_t c = lb.first_child(); c < lb.first_child() + 2; ++c) {
         const EncB enc_c = p_.enclose_b(c);
-        tester_.count_volume_test();
-        if (p_.overlap(a, enc_a, c, enc_c)) visit(a, enc_a, c, enc_c, depth + 1);
+        if (overlapping(a, enc_a, c, enc_c)) visit(a, enc_a, c, enc_c, depth + 1);
         if (tester_.done()) return unwind(a, b);
       }
     }
@@ -161,6 +207,7 @@ class PairTraversal {
   const Policy& p_;
   LeafTester& tester_;
   TraversalHint* hint_ = nullptr;
+  std::vector<SeparationFront::Entry>* front_out_ = nullptr;
   int hint_levels_ = 0;
   int hint_countdown_ = 0;
   int max_depth_ = -1;  ///< negative: exact
@@ -182,7 +229,8 @@ struct PolicyContext {
 };
 
 /// A whole query over two trees of one policy type (the policy is built from
-/// the trees and the pose): the traversal from the roots, sorted result.
+/// the trees and the pose): the traversal from the roots, or from the
+/// request's SeparationFront where the policy keeps one; sorted result.
 template <typename Policy, typename Tree>
 CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh_a,
                                   const Mesh& mesh_b, const Transform& X_AB,
@@ -191,14 +239,41 @@ CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh
   LeafTester tester(mesh_a, mesh_b, X_AB, request.all_pairs, result);
   const Policy policy(a, b, X_AB);
   PairTraversal<Policy> traversal(policy, tester);
+  SeparationFront* front = nullptr;
+  if constexpr (HasGap<Policy>) {
+    if (request.max_depth < 0) front = request.front;
+  }
+  const bool from_front = front && front->valid && front->tree_a == &a && front->tree_b == &b &&
+                          front->nodes_a == a.node_count() && front->nodes_b == b.node_count() &&
+                          front->entries.size() <= 2 * front->root_entries;
+  if (front) {
+    front->scratch.clear();
+    traversal.record_front(&front->scratch);
+  }
+  const auto whole = [&] {
+    if constexpr (HasGap<Policy>) {
+      if (from_front) return traversal.run_from_front(front->entries, b.reach(front->X_AB, X_AB));
+    }
+    traversal.run();
+  };
   if (request.max_depth >= 0 && !request.all_pairs) {
     traversal.cut_at_depth(request.max_depth);
     traversal.run();
   } else if (request.hint && !request.all_pairs) {
     traversal.record_hint(request.hint, kHintLevels);
-    traversal.run_hinted(*request.hint, a.node_count(), b.node_count());
+    traversal.run_hinted(*request.hint, a.node_count(), b.node_count(), whole);
   } else {
-    traversal.run();
+    whole();
+  }
+  if (front && !tester.done()) {  // the whole cut was visited
+    front->entries.swap(front->scratch);
+    front->X_AB = X_AB;
+    front->tree_a = &a;
+    front->tree_b = &b;
+    front->nodes_a = a.node_count();
+    front->nodes_b = b.node_count();
+    if (!from_front) front->root_entries = front->entries.size();
+    front->valid = true;
   }
   tester.finish();
   return result;
@@ -209,14 +284,17 @@ struct NoEnclosure {};
 
 /// The twelve separating axes after A's faces: B's face axes and the nine
 /// edge-edge axes A_i x B_j (R: B's axes in A's frame, absR = |R|, T: B's
-/// centre in A's frame).
-inline bool boxes_overlap_remaining_axes(const Mat3& R, const Mat3& absR, const Vec3& T,
-                                         const Vec3& ea, const Vec3& eb, Real margin) {
+/// centre in A's frame). Returns the gap on the first axis that separates the
+/// boxes (> 0), or 0 when none does. On an edge-edge axis, whose length is at
+/// most 1, the gap is scaled by that length: never more than the true one.
+inline Real boxes_gap_remaining_axes(const Mat3& R, const Mat3& absR, const Vec3& T, const Vec3& ea,
+                                     const Vec3& eb, Real margin) {
   // B's face axes.
   for (int j = 0; j < 3; ++j) {
     const Real ra = absR(0, j) * ea[0] + absR(1, j) * ea[1] + absR(2, j) * ea[2];
     const Real t = R(0, j) * T[0] + R(1, j) * T[1] + R(2, j) * T[2];
-    if (std::abs(t) > ra + eb[j] + margin) return false;
+    const Real gap = std::abs(t) - (ra + eb[j] + margin);
+    if (gap > 0) return gap;
   }
   // Edge-edge axes A_i x B_j.
   for (int i = 0; i < 3; ++i) {
@@ -226,16 +304,19 @@ inline bool boxes_overlap_remaining_axes(const Mat3& R, const Mat3& absR, const 
       const Real ra = ea[i1] * absR(i2, j) + ea[i2] * absR(i1, j);
       const Real rb = eb[j1] * absR(i, j2) + eb[j2] * absR(i, j1);
       const Real t = T[i2] * R(i1, j) - T[i1] * R(i2, j);
-      if (std::abs(t) > ra + rb + margin) return false;
+      const Real gap = std::abs(t) - (ra + rb + margin);
+      if (gap > 0) return gap;
     }
   }
-  return true;
+  return 0;
 }
 
 /// Separating-axis test of two boxes (Gottschalk et al., OBB-Tree, 15 axes):
 /// box A with half extents ea in its own frame, box B with half extents eb,
 /// axes the columns of R and centre T, both in A's frame. `margin` widens
 /// every projected radius so that rounding never separates touching boxes.
+/// (For finite or infinite numbers x - y > 0 exactly when x > y, so testing
+/// the gap decides as comparing the two would; NaN separates nothing.)
 inline bool boxes_overlap(const Mat3& R, const Vec3& T, const Vec3& ea, const Vec3& eb,
                           Real margin) {
   Mat3 absR;
@@ -245,18 +326,19 @@ inline bool boxes_overlap(const Mat3& R, const Vec3& T, const Vec3& ea, const Ve
   // A's face axes.
   for (int i = 0; i < 3; ++i) {
     const Real rb = absR(i, 0) * eb[0] + absR(i, 1) * eb[1] + absR(i, 2) * eb[2];
-    if (std::abs(T[i]) > ea[i] + rb + margin) return false;
+    if (std::abs(T[i]) - (ea[i] + rb + margin) > 0) return false;
   }
-  return boxes_overlap_remaining_axes(R, absR, T, ea, eb, margin);
+  return !(boxes_gap_remaining_axes(R, absR, T, ea, eb, margin) > 0);
 }
 
-/// boxes_overlap for two boxes given by their axes (columns), centres and
-/// half extents, all in one frame. The relative rotation is built row by row
-/// while A's face axes are tested, so a rejection on one of those three axes
-/// (the common case) skips most of its cost.
-inline bool oriented_boxes_overlap(const Mat3& axes_a, const Vec3& centre_a, const Vec3& ea,
-                                   const Mat3& axes_b, const Vec3& centre_b, const Vec3& eb,
-                                   Real margin) {
+/// The gap between two boxes given by their axes (columns), centres and half
+/// extents, all in one frame, on the first separating axis found (> 0), or 0
+/// when they overlap (boxes_overlap's test and margin). The relative rotation
+/// is built row by row while A's face axes are tested, so a separation on one
+/// of those three axes (the common case) skips most of its cost.
+inline Real oriented_boxes_gap(const Mat3& axes_a, const Vec3& centre_a, const Vec3& ea,
+                               const Mat3& axes_b, const Vec3& centre_b, const Vec3& eb,
+                               Real margin) {
   const Vec3 d = centre_b - centre_a;
   Mat3 R, absR;
   Vec3 T;
@@ -268,9 +350,17 @@ inline bool oriented_boxes_overlap(const Mat3& axes_a, const Vec3& centre_a, con
     }
     T[i] = a.dot(d);
     const Real rb = absR(i, 0) * eb[0] + absR(i, 1) * eb[1] + absR(i, 2) * eb[2];
-    if (std::abs(T[i]) > ea[i] + rb + margin) return false;
+    const Real gap = std::abs(T[i]) - (ea[i] + rb + margin);
+    if (gap > 0) return gap;
   }
-  return boxes_overlap_remaining_axes(R, absR, T, ea, eb, margin);
+  return boxes_gap_remaining_axes(R, absR, T, ea, eb, margin);
+}
+
+/// Whether two boxes overlap: oriented_boxes_gap finds no separating axis.
+inline bool oriented_boxes_overlap(const Mat3& axes_a, const Vec3& centre_a, const Vec3& ea,
+                                   const Mat3& axes_b, const Vec3& centre_b, const Vec3& eb,
+                                   Real margin) {
+  return !(oriented_boxes_gap(axes_a, centre_a, ea, axes_b, centre_b, eb, margin) > 0);
 }
 
 }  // namespace dovetail::collision::detail

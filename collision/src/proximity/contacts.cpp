@@ -671,7 +671,7 @@ std::vector<ContactPatch> compute_contacts(const Mesh& a, const Mesh& b, const T
 
 std::vector<ContactPatch> compute_contacts(const CollisionModel& a, const CollisionModel& b,
                                            const Transform& X_AB, const ContactRequest& request) {
-  const CollideResult hits = a.collide(b, X_AB, {.all_pairs = true});
+  const CollideResult hits = a.collide(b, X_AB, {.all_pairs = true, .front = request.front});
   return compute_contacts(a.mesh(), b.mesh(), X_AB, hits.pairs, request);
 }
 

@@ -2,8 +2,11 @@
 /// \file collide.h
 /// Request and result of a collision query between two rigid meshes.
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
+
+#include "dovetail/collision/types.h"
 
 namespace dovetail::collision {
 
@@ -30,6 +33,52 @@ struct TraversalHint {
   bool valid = false;        ///< false until a first-hit query has found a hit
 };
 
+/// Where the last complete query of the same two OBB trees stopped: the cut
+/// through the pairs of their nodes that it visited. Every pair of triangles
+/// lies under exactly one entry, either a node pair whose boxes it found
+/// apart, with the gap between them, or a leaf pair whose triangles it tested.
+///
+/// Why: a part sliding in a hole is queried many times a frame at poses a few
+/// micrometres apart, and each query that finds it free descends to the same
+/// few thousand box pairs along the walls. Boxes that were apart by a gap g
+/// are still apart after B moves by less than g (any point of B, in A's
+/// frame), so the next query starts from the front, skips those entries
+/// without a test, and tests and descends only the rest. The entries are kept
+/// in depth-first order and a skipped entry holds no intersecting triangles,
+/// so the query finds the very pairs, and the very first hit, of a traversal
+/// from the roots; only the work differs. (With a TraversalHint as well, the
+/// hint is read and rewritten as usual, but a hit found below a front entry
+/// sets it no higher than that entry; the next first hit may then be another
+/// intersecting pair than with the hint alone.)
+///
+/// A query given a front reads it when it belongs to the same two trees and
+/// rewrites it when it visits the whole cut: a query that finds no hit, and
+/// every all-pairs query. A first-hit query that stops at a hit leaves it as
+/// it was. The trees must outlive the front (it is checked against them by
+/// address and node counts). Only the OBB tree (Method::kObb) uses fronts;
+/// other methods, split (parallel) and time-critical queries ignore them.
+struct SeparationFront {
+  /// A node pair found apart (gap > 0: no point of B's box within that
+  /// distance of A's box along the separating axis found), or a leaf pair
+  /// whose triangles were tested (gap < 0).
+  struct Entry {
+    std::uint32_t node_a = 0;
+    std::uint32_t node_b = 0;
+    Real gap = 0;
+  };
+  std::vector<Entry> entries;  ///< depth-first order
+  Transform X_AB{};            ///< the pose at which the gaps hold
+  const void* tree_a = nullptr;
+  const void* tree_b = nullptr;
+  std::size_t nodes_a = 0, nodes_b = 0;
+  /// Entries of the last front built from the roots. A front only deepens
+  /// (a pair found apart is never merged back into its parent), so once it
+  /// holds twice as many the next query starts from the roots again.
+  std::size_t root_entries = 0;
+  bool valid = false;
+  std::vector<Entry> scratch;  ///< the next front while a query builds it
+};
+
 /// What a query should find.
 struct CollideRequest {
   /// false: stop at the first intersecting pair (yes/no); true: report every
@@ -47,6 +96,9 @@ struct CollideRequest {
   /// collision, may report one that is not. Negative (the default): exact.
   /// Ignored by all-pairs queries and by the other methods.
   int max_depth = -1;
+  /// Coherence across queries of the same two models (see SeparationFront):
+  /// read where valid, rewritten by a query that visits all of it.
+  SeparationFront* front = nullptr;
 };
 
 /// Work a query did; the cost model is volume_tests * C_bv + triangle_tests * C_p.

@@ -42,6 +42,8 @@ struct ContactRequest {
   /// face gives one face patch. False: the patches are made of the
   /// intersecting pairs alone (cheaper when many pairs cross one plane).
   bool nearly_coplanar_pairs = true;
+  /// Passed to the all-pairs query of the models' overload (CollideRequest::front).
+  SeparationFront* front = nullptr;
 };
 
 /// How the surfaces meet in a patch.

@@ -186,6 +186,7 @@ class Grasping {
   bool sliding_ = false;
   std::string sliding_on_;
   SlideResult last_slide_{};
+  SlideFronts fronts_;                         ///< of the held part, against each obstacle
   std::vector<engine::PartId> contact_parts_;  ///< the parts of last_slide_'s obstacle ids
   InteractionStats stats_{};
 };

@@ -105,6 +105,36 @@ struct SlideProof {
   std::vector<SlideObstacle> obstacles;  ///< their models and poses (ids do not matter)
 };
 
+/// What the steps of one sliding part keep of each obstacle between their
+/// queries: the collision layer's SeparationFront of the last query against
+/// it that visited the whole front.
+///
+/// Why: a part pushed along a wall is queried many times a frame at poses
+/// micrometres apart, and each query that finds it free descends again to
+/// the same thousands of box pairs along the wall. From the front, box pairs
+/// still apart by more than the part moved are skipped without a test. The
+/// queries give the same answers with or without it.
+class SlideFronts {
+ public:
+  /// The front of queries of `obstacle` against `part`, empty the first time
+  /// (obstacles of one model share it: exact all the same, less to gain).
+  collision::SeparationFront& of(const std::shared_ptr<const collision::CollisionModel>& obstacle,
+                                 const std::shared_ptr<const collision::CollisionModel>& part);
+  /// Forgets the fronts of every obstacle not in `obstacles` or of another part.
+  void keep_only(std::span<const SlideObstacle> obstacles,
+                 const std::shared_ptr<const collision::CollisionModel>& part);
+  void clear() { fronts_.clear(); }
+  std::size_t size() const { return fronts_.size(); }
+
+ private:
+  struct Kept {
+    // Held, so that no other model can take their addresses while the front lives.
+    std::shared_ptr<const collision::CollisionModel> obstacle, part;
+    collision::SeparationFront front;
+  };
+  std::vector<Kept> fronts_;
+};
+
 /// What one step wants.
 struct SlideRequest {
   std::shared_ptr<const collision::CollisionModel> part;          ///< the sliding part (kObb)
@@ -122,6 +152,9 @@ struct SlideRequest {
   /// every obstacle, the step skips its first query (is the starting pose
   /// free?): a part resting in contact then costs no query at all.
   const SlideProof* start_proof = nullptr;
+  /// The part's fronts, read and rewritten by the step's queries (optional:
+  /// null costs more work, never another answer).
+  SlideFronts* fronts = nullptr;
 };
 
 /// How the step ended.
