@@ -358,16 +358,17 @@ SlidingRuns sliding_runs(int runs, const std::string& pictures,
   return out;
 }
 
-void sliding(int runs, const std::string& pictures, bool pair_guided, double slow_ms) {
+void sliding(int runs, const std::string& pictures, bool pair_guided, bool fronts, double slow_ms) {
   interaction::SlidingSettings settings;
   settings.pair_guided = pair_guided;
+  settings.separation_fronts = fronts;
   const SlidingRuns r = sliding_runs(runs, pictures, settings, slow_ms, false);
   const std::vector<double>& contact_ms = r.contact_ms;
   const std::vector<double>& run_medians = r.run_medians;
   std::printf(
-      "sliding (%s): %zu-triangle peg into a hole, %llu frames in contact per run, mated in "
+      "sliding (%s%s): %zu-triangle peg into a hole, %llu frames in contact per run, mated in "
       "%llu of %d runs\n",
-      pair_guided ? "pair-guided" : "plain", r.triangles,
+      pair_guided ? "pair-guided" : "plain", fronts ? "" : ", no fronts", r.triangles,
       static_cast<unsigned long long>(r.frames_in_contact),
       static_cast<unsigned long long>(r.mated), runs);
   std::printf(
@@ -499,8 +500,9 @@ int main(int argc, char** argv) {
     }
   }
   fk_only();
-  sliding(runs, "", false, slow_ms);
-  sliding(runs, pictures, true, slow_ms);
+  sliding(runs, "", false, true, slow_ms);
+  sliding(runs, "", true, false, slow_ms);
+  sliding(runs, pictures, true, true, slow_ms);
   if (!pictures.empty()) grasp_picture(pictures);
   return 0;
 }

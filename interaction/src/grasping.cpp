@@ -416,7 +416,7 @@ void Grasping::carry(engine::Simulation& simulation) {
   }
   request.previous_contacts = previous;
   request.start_proof = &last_slide_.proof;
-  request.fronts = &fronts_;
+  request.fronts = settings_.sliding.separation_fronts ? &fronts_ : nullptr;
   last_slide_ = slide(request, settings_.sliding);
   contact_parts_ = handles;
   stats_.slide_queries += static_cast<std::uint64_t>(last_slide_.collision_queries);

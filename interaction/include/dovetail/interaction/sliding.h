@@ -61,6 +61,9 @@ struct SlidingSettings {
   /// at the same resolution and accept only poses the whole-part query finds
   /// collision-free; false is the plain way, kept for comparison.
   bool pair_guided = true;
+  /// Keep each obstacle's separation front between the queries of a held
+  /// part (SlideFronts): the same answers for less work; false for comparison.
+  bool separation_fronts = true;
   int solver_sweeps = 64;    ///< passes over the contacts projecting the motion
   Real band_limit_m = 0.05;  ///< stretch (centre to centre) past which the band breaks
   Real band_limit_deg = 20;  ///< ... or angle between held and wanted orientation
