@@ -1,19 +1,22 @@
 // Object-level benchmark: every Dovetail broad phase and Bullet's
 // btDbvtBroadphase and btAxisSweep3 on the same box trajectories, in one run.
 //
-//   broadphase_bench [--objects N] [--frames F] [--runs R] [--seed S] [--size E]
-//                    [--speed V] [--no-brute] [--write-scene FILE]
+//   broadphase_bench [--scene sparse|crowded] [--objects N] [--frames F] [--runs R]
+//                    [--seed S] [--size E] [--speed V] [--no-brute] [--write-scene FILE]
 //
-// Scene: N boxes in a cube of edge 100, moving coherently (random velocities,
-// bouncing off the walls), each box's edges breathing by up to +-25% over time
-// as the box of a rotating part does. Prints the actual overlap (objects in at
-// least one pair, pairs per frame), then per contender the median over runs of
-// the median time per frame (frames after the first), the ratio to Bullet's
-// best, whether its pair sets equal brute force's on every frame, and its work
-// counters per frame (box tests, endpoint swaps, cells or nodes touched). Bullet
-// works in float and keeps pairs whose fattened boxes overlap: it is fed boxes
-// rounded outwards, and its pairs are filtered by the exact box test before the
-// comparison; any exact pair it misses is reported.
+// Scenes: `sparse` (the default), N boxes in a cube of edge 100, moving
+// coherently (random velocities, bouncing off the walls), each box's edges
+// breathing by up to +-25% over time as the box of a rotating part does.
+// `crowded`, the same N boxes packed into clusters of 27 (3 x 3 x 3, spaced a
+// little closer than their edges, as the parts of an assembly touch several
+// neighbours), each cluster moving as one, its boxes wobbling about their
+// places and breathing; about four overlapping pairs per box. Prints the actual overlap (objects in
+// at least one pair, pairs per frame), then per contender the median over runs of the median time
+// per frame (frames after the first), the ratio to Bullet's best, whether its pair sets equal brute
+// force's on every frame, and its work counters per frame (box tests, endpoint swaps, cells or
+// nodes touched). Bullet works in float and keeps pairs whose fattened boxes overlap: it is fed
+// boxes rounded outwards, and its pairs are filtered by the exact box test before the comparison;
+// any exact pair it misses is reported.
 
 #include <algorithm>
 #include <chrono>
@@ -69,6 +72,7 @@ class Rng {
 };
 
 struct Options {
+  bool crowded = false;
   int objects = 10000;
   int frames = 100;
   int runs = 5;
@@ -121,6 +125,78 @@ Frames make_scene(const Options& o) {
         if (m.c[k] < 0 || m.c[k] > kWorld) {
           m.v[k] = -m.v[k];
           m.c[k] = std::clamp(m.c[k], 0.0, kWorld);
+        }
+      }
+    }
+  }
+  return frames;
+}
+
+/// The crowded scene: clusters of 3 x 3 x 3 boxes spaced 0.9 of the mean
+/// edge apart, each cluster moving as one (random velocity, bouncing off the
+/// walls), each box wobbling by up to 5% of the edge about its place and its
+/// edges breathing by up to +-10%.
+Frames make_crowded_scene(const Options& o) {
+  Rng rng(o.seed);
+  struct Cluster {
+    double c[3], v[3];
+  };
+  struct Member {
+    std::size_t cluster;
+    double offset[3], half[3], phase[3], rate;
+  };
+  const std::size_t clusters = (static_cast<std::size_t>(o.objects) + 26) / 27;
+  std::vector<Cluster> cs(clusters);
+  for (Cluster& c : cs) {
+    double d[3], norm = 0;
+    do {
+      norm = 0;
+      for (double& x : d) {
+        x = rng.uniform(-1, 1);
+        norm += x * x;
+      }
+    } while (norm > 1 || norm < 1e-6);
+    const double speed = o.speed * rng.uniform(0.5, 1.5) / std::sqrt(norm);
+    for (int k = 0; k < 3; ++k) {
+      c.c[k] = rng.uniform(0, kWorld);
+      c.v[k] = d[k] * speed;
+    }
+  }
+  const double spacing = 0.9 * o.size;
+  std::vector<Member> members(static_cast<std::size_t>(o.objects));
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    Member& m = members[i];
+    m.cluster = i / 27;
+    const int slot[3] = {static_cast<int>(i % 3), static_cast<int>(i / 3 % 3),
+                         static_cast<int>(i / 9 % 3)};
+    for (int k = 0; k < 3; ++k) {
+      m.offset[k] = (slot[k] - 1) * spacing;
+      m.half[k] = o.size / 2 * rng.uniform(0.8, 1.2);
+      m.phase[k] = rng.uniform(0, 6.283185307179586);
+    }
+    m.rate = rng.uniform(0.02, 0.1);
+  }
+  Frames frames(static_cast<std::size_t>(o.frames));
+  for (int f = 0; f < o.frames; ++f) {
+    std::vector<Aabb>& boxes = frames[static_cast<std::size_t>(f)];
+    boxes.resize(members.size());
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      const Member& m = members[i];
+      const Cluster& c = cs[m.cluster];
+      for (int k = 0; k < 3; ++k) {
+        const double wave = std::sin(m.rate * f + m.phase[k]);
+        const double centre = c.c[k] + m.offset[k] + 0.05 * o.size * wave;
+        const double half = m.half[k] * (1 + 0.1 * std::cos(m.rate * f + m.phase[k]));
+        boxes[i].min[k] = centre - half;
+        boxes[i].max[k] = centre + half;
+      }
+    }
+    for (Cluster& c : cs) {
+      for (int k = 0; k < 3; ++k) {
+        c.c[k] += c.v[k];
+        if (c.c[k] < 0 || c.c[k] > kWorld) {
+          c.v[k] = -c.v[k];
+          c.c[k] = std::clamp(c.c[k], 0.0, kWorld);
         }
       }
     }
@@ -263,10 +339,12 @@ double frame_median(const std::vector<double>& ms) {
 }
 
 [[noreturn]] void usage(const char* message) {
-  std::fprintf(stderr,
-               "broadphase_bench: %s\nusage: broadphase_bench [--objects N] [--frames F] "
-               "[--runs R] [--seed S] [--size E] [--speed V] [--no-brute] [--write-scene FILE]\n",
-               message);
+  std::fprintf(
+      stderr,
+      "broadphase_bench: %s\nusage: broadphase_bench [--scene sparse|crowded] [--objects N] "
+      "[--frames F] "
+      "[--runs R] [--seed S] [--size E] [--speed V] [--no-brute] [--write-scene FILE]\n",
+      message);
   std::exit(2);
 }
 
@@ -280,7 +358,11 @@ Options parse(int argc, char** argv) {
     }
     if (i + 1 >= argc) usage(("missing value for " + arg).c_str());
     const char* value = argv[++i];
-    if (arg == "--objects") {
+    if (arg == "--scene") {
+      const std::string name = value;
+      if (name != "sparse" && name != "crowded") usage("--scene is sparse or crowded");
+      o.crowded = name == "crowded";
+    } else if (arg == "--objects") {
       o.objects = static_cast<int>(
           dovetail::bench::whole("broadphase_bench", "--objects", value, 2, 10000000));
     } else if (arg == "--frames") {
@@ -310,7 +392,7 @@ Options parse(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   const Options o = parse(argc, argv);
-  const Frames frames = make_scene(o);
+  const Frames frames = o.crowded ? make_crowded_scene(o) : make_scene(o);
   if (!o.write_scene.empty()) {
     if (!write_scene(frames, o.write_scene)) {
       std::fprintf(stderr, "broadphase_bench: cannot write %s\n", o.write_scene.c_str());
@@ -410,8 +492,9 @@ int main(int argc, char** argv) {
       bullet_best = median(r.run_medians);
     }
   }
-  std::printf("scene: %d boxes, %d frames, mean edge %.3g, speed %.3g per frame, seed %llu\n",
-              o.objects, o.frames, o.size, o.speed, static_cast<unsigned long long>(o.seed));
+  std::printf("scene: %s, %d boxes, %d frames, mean edge %.3g, speed %.3g per frame, seed %llu\n",
+              o.crowded ? "crowded" : "sparse", o.objects, o.frames, o.size, o.speed,
+              static_cast<unsigned long long>(o.seed));
   std::printf("overlap: %.2f%% of objects in at least one pair, %.1f pairs per frame\n",
               100 * overlapping_fraction, pairs_per_frame);
 #ifdef DOVETAIL_HAVE_BULLET

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "broadphase/octree.h"
+#include "broadphase/proxy_pairs.h"
 #include "broadphase/uniform_grid.h"
 
 namespace dovetail::collision {
@@ -513,4 +514,33 @@ TEST(BroadphaseAgreement, Clustered10000) {
 }
 
 }  // namespace
+TEST(Broadphase, PairSortingMatchesAComparisonSort) {
+  // Small lists, lists long enough for the radix sort, ids of every width
+  // up to 32 bits, repeats of one id: the same order as std::sort.
+  std::uint64_t state = 12345;
+  const auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<std::uint32_t>(state >> 32);
+  };
+  std::vector<std::uint64_t> keys;
+  for (const std::size_t n : {0, 1, 2, 100, 511, 512, 513, 5000, 70000}) {
+    for (const int width : {1, 5, 11, 14, 16, 17, 22, 31, 32}) {
+      const std::uint64_t range = std::uint64_t{1} << width;
+      std::vector<ProxyPair> pairs;
+      for (std::size_t i = 0; i < n; ++i) {
+        std::uint32_t a = static_cast<std::uint32_t>(next() % range);
+        std::uint32_t b = static_cast<std::uint32_t>(next() % range);
+        if (a == b) b = a == 0 ? 1 : a - 1;
+        pairs.push_back({std::min(a, b), std::max(a, b)});
+      }
+      std::vector<ProxyPair> expected = pairs;
+      std::sort(expected.begin(), expected.end(), [](const ProxyPair& x, const ProxyPair& y) {
+        return x.a < y.a || (x.a == y.a && x.b < y.b);
+      });
+      detail::sort_proxy_pairs(pairs, keys);
+      ASSERT_EQ(pairs, expected) << n << " pairs, ids of " << width << " bits";
+    }
+  }
+}
+
 }  // namespace dovetail::collision
