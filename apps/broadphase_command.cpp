@@ -1,12 +1,9 @@
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <span>
@@ -92,23 +89,8 @@ int broadphase_command(std::span<const std::string> argv) {
   }
   const std::optional<std::string> out_path = args.value("out");
 
-  // Open the output first: an unwritable destination should fail before any work.
-  std::ofstream out;
-  if (out_path) {
-    const std::string inputs[] = {boxes_path};
-    refuse_overwriting_input("broadphase", *out_path, inputs);
-    out.open(*out_path, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(*out_path + ": cannot be written: " + std::strerror(errno));
-  }
-  std::string text;
-  const auto flush = [&] {
-    if (out_path) {
-      out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    } else {
-      std::fwrite(text.data(), 1, text.size(), stdout);
-    }
-    text.clear();
-  };
+  const std::string inputs[] = {boxes_path};
+  FramePairsOutput output("broadphase", out_path, inputs);
 
   LineReader reader(boxes_path);
   std::unique_ptr<collision::Broadphase> broadphase = collision::make_broadphase(method);
@@ -116,18 +98,10 @@ int broadphase_command(std::span<const std::string> argv) {
   std::vector<double> frame_ms;
   std::optional<std::string> error;
   try {
-    // Header: `N F`.
-    const std::optional<std::vector<std::string_view>> header = reader.next();
-    if (!header) reader.fail("empty file, expected a first line `N F` (objects, frames)");
-    if (header->size() != 2) {
-      reader.fail("expected a first line `N F` (objects, frames), got " +
-                  fields_text(header->size()));
-    }
-    objects = reader.count((*header)[0], "the object count N");
-    frames = reader.count((*header)[1], "the frame count F");
+    const FrameCounts counts = read_frame_counts(reader, "object");
+    objects = counts.items;
+    frames = counts.frames;
     if (objects > kMaxObjects) reader.fail("more than 2^32 - 1 objects");
-    // Frames of no boxes take no lines, so nothing in the file would bound F.
-    if (objects == 0 && frames > 0) reader.fail("no objects (N = 0) but F > 0 frames");
 
     // Frame by frame: read every box, then update and query the broad phase.
     std::vector<collision::Aabb> boxes;
@@ -148,27 +122,14 @@ int broadphase_command(std::span<const std::string> argv) {
       frame_ms.push_back(ms_since(start));
       ++frames_done;
       pairs_total += pairs.size();
-      text += "frame " + std::to_string(f) + " count " + std::to_string(pairs.size()) + "\n";
-      for (const collision::ProxyPair& p : pairs) {
-        text += std::to_string(p.a);
-        text += ' ';
-        text += std::to_string(p.b);
-        text += '\n';
-      }
-      if (text.size() > (std::size_t{1} << 20)) flush();
+      output.frame(f, pairs.size());
+      for (const collision::ProxyPair& p : pairs) output.pair(p.a, p.b);
     }
-    if (reader.next()) {
-      reader.fail("more data than the first line declares (N F = " + std::to_string(objects) + " " +
-                  std::to_string(frames) + ")");
-    }
+    expect_end(reader, counts);
   } catch (const LineError& e) {
     error = e.message;
   }
-  flush();
-  if (out_path) {
-    out.close();
-    if (!out) throw InputError(*out_path + ": write failed: " + std::strerror(errno));
-  }
+  output.close();
 
   const std::vector<double> after_first(frame_ms.begin() + (frame_ms.empty() ? 0 : 1),
                                         frame_ms.end());

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 
@@ -77,6 +78,67 @@ double LineReader::number(std::string_view field) const {
   }
   if (!std::isfinite(v)) fail(quote(field) + " is not finite");
   return v;
+}
+
+FrameCounts read_frame_counts(LineReader& reader, const std::string& item) {
+  const std::string expected = "a first line `N F` (" + item + "s, frames)";
+  const std::optional<std::vector<std::string_view>> header = reader.next();
+  if (!header) reader.fail("empty file, expected " + expected);
+  if (header->size() != 2)
+    reader.fail("expected " + expected + ", got " + fields_text(header->size()));
+  const std::string n_name = "the " + item + " count N";
+  FrameCounts counts;
+  counts.items = reader.count((*header)[0], n_name.c_str());
+  counts.frames = reader.count((*header)[1], "the frame count F");
+  if (counts.items == 0 && counts.frames > 0) {
+    reader.fail("no " + item + "s (N = 0) but F > 0 frames");
+  }
+  return counts;
+}
+
+void expect_end(LineReader& reader, const FrameCounts& counts) {
+  if (reader.next()) {
+    reader.fail("more data than the first line declares (N F = " + std::to_string(counts.items) +
+                " " + std::to_string(counts.frames) + ")");
+  }
+}
+
+FramePairsOutput::FramePairsOutput(const std::string& command,
+                                   const std::optional<std::string>& path,
+                                   std::span<const std::string> inputs)
+    : path_(path) {
+  if (!path_) return;
+  refuse_overwriting_input(command, *path_, inputs);
+  out_.open(*path_, std::ios::binary | std::ios::trunc);
+  if (!out_) throw InputError(*path_ + ": cannot be written: " + std::strerror(errno));
+}
+
+void FramePairsOutput::frame(std::uint64_t k, std::size_t count) {
+  if (text_.size() > (std::size_t{1} << 20)) flush();
+  text_ += "frame " + std::to_string(k) + " count " + std::to_string(count) + "\n";
+}
+
+void FramePairsOutput::pair(std::uint64_t i, std::uint64_t j) {
+  text_ += std::to_string(i);
+  text_ += ' ';
+  text_ += std::to_string(j);
+  text_ += '\n';
+}
+
+void FramePairsOutput::flush() {
+  if (path_) {
+    out_.write(text_.data(), static_cast<std::streamsize>(text_.size()));
+  } else {
+    std::fwrite(text_.data(), 1, text_.size(), stdout);
+  }
+  text_.clear();
+}
+
+void FramePairsOutput::close() {
+  flush();
+  if (!path_) return;
+  out_.close();
+  if (!out_) throw InputError(*path_ + ": write failed: " + std::strerror(errno));
 }
 
 }  // namespace dovetail::cli

@@ -2,11 +2,13 @@
 /// \file line_reader.h
 /// Line-based text inputs of the command line (box files, pipeline scenes):
 /// blank and `#` lines skipped, fields split on blanks, and every error
-/// naming the file and the line.
+/// naming the file and the line; and the per-frame pair lists written for
+/// them.
 
 #include <cstdint>
 #include <fstream>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -48,6 +50,41 @@ class LineReader {
   std::string text_;
   std::vector<std::string_view> fields_;
   std::size_t line_ = 0;
+};
+
+/// The first line `N F` of a frame file: N items over F frames.
+struct FrameCounts {
+  std::uint64_t items = 0;
+  std::uint64_t frames = 0;
+};
+
+/// Reads the first line `N F`; `item` names what N counts ("object", "part").
+/// N = 0 with F > 0 is an error: frames of nothing take no lines, so nothing
+/// in the file would bound F.
+FrameCounts read_frame_counts(LineReader& reader, const std::string& item);
+
+/// After the last frame: an error when any data follows.
+void expect_end(LineReader& reader, const FrameCounts& counts);
+
+/// Where `broadphase` and `pipeline` write their pairs: the file `path`, or
+/// standard output when there is none. Per frame a line `frame K count C`,
+/// then the C pairs `i j`, buffered.
+class FramePairsOutput {
+ public:
+  /// Opens the file at once, so that an unwritable destination fails before
+  /// any work; refuses to overwrite one of `inputs` (usage error).
+  FramePairsOutput(const std::string& command, const std::optional<std::string>& path,
+                   std::span<const std::string> inputs);
+  void frame(std::uint64_t k, std::size_t count);
+  void pair(std::uint64_t i, std::uint64_t j);
+  /// Writes what is buffered; throws InputError when writing the file failed.
+  void close();
+
+ private:
+  void flush();
+  std::optional<std::string> path_;
+  std::ofstream out_;
+  std::string text_;
 };
 
 }  // namespace dovetail::cli

@@ -4,13 +4,10 @@
 /// files, frame by frame: which parts' meshes intersect.
 
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <memory>
 #include <optional>
@@ -110,22 +107,8 @@ int pipeline_command(std::span<const std::string> argv) {
   const int threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
   const std::optional<std::string> out_path = args.value("out");
 
-  std::ofstream out;
-  if (out_path) {
-    const std::string inputs[] = {scene_path};
-    refuse_overwriting_input("pipeline", *out_path, inputs);
-    out.open(*out_path, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(*out_path + ": cannot be written: " + std::strerror(errno));
-  }
-  std::string text;
-  const auto flush = [&] {
-    if (out_path) {
-      out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    } else {
-      std::fwrite(text.data(), 1, text.size(), stdout);
-    }
-    text.clear();
-  };
+  const std::string inputs[] = {scene_path};
+  FramePairsOutput output("pipeline", out_path, inputs);
 
   LineReader reader(scene_path);
   const std::filesystem::path folder = std::filesystem::path(scene_path).parent_path();
@@ -141,17 +124,10 @@ int pipeline_command(std::span<const std::string> argv) {
   std::vector<double> frame_ms;
   std::optional<std::string> error;
   try {
-    const std::optional<std::vector<std::string_view>> header = reader.next();
-    if (!header) reader.fail("empty file, expected a first line `N F` (parts, frames)");
-    if (header->size() != 2) {
-      reader.fail("expected a first line `N F` (parts, frames), got " +
-                  fields_text(header->size()));
-    }
-    parts = reader.count((*header)[0], "the part count N");
-    frames = reader.count((*header)[1], "the frame count F");
+    const FrameCounts counts = read_frame_counts(reader, "part");
+    parts = counts.items;
+    frames = counts.frames;
     if (parts > 1'000'000) reader.fail("more than 1,000,000 parts");
-    // Frames of no parts take no lines, so nothing in the file would bound F.
-    if (parts == 0 && frames > 0) reader.fail("no parts (N = 0) but F > 0 frames");
 
     // The meshes, each file read once however many parts use it.
     std::map<std::string, std::shared_ptr<const collision::Mesh>> meshes;
@@ -199,22 +175,14 @@ int pipeline_command(std::span<const std::string> argv) {
       std::sort(pairs.begin(), pairs.end());
       ++frames_done;
       pairs_total += pairs.size();
-      text += "frame " + std::to_string(f) + " count " + std::to_string(pairs.size()) + "\n";
-      for (const auto& [i, j] : pairs) text += std::to_string(i) + ' ' + std::to_string(j) + '\n';
-      if (text.size() > (std::size_t{1} << 20)) flush();
+      output.frame(f, pairs.size());
+      for (const auto& [i, j] : pairs) output.pair(i, j);
     }
-    if (reader.next()) {
-      reader.fail("more data than the first line declares (N F = " + std::to_string(parts) + " " +
-                  std::to_string(frames) + ")");
-    }
+    expect_end(reader, counts);
   } catch (const LineError& e) {
     error = e.message;
   }
-  flush();
-  if (out_path) {
-    out.close();
-    if (!out) throw InputError(*out_path + ": write failed: " + std::strerror(errno));
-  }
+  output.close();
 
   const std::vector<double> after_first(frame_ms.begin() + (frame_ms.empty() ? 0 : 1),
                                         frame_ms.end());

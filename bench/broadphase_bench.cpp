@@ -19,6 +19,7 @@
 // any exact pair it misses is reported.
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -83,6 +84,29 @@ struct Options {
   std::string write_scene;
 };
 
+/// A random direction times a speed 0.5 to 1.5 times `mean`.
+std::array<double, 3> random_velocity(Rng& rng, double mean) {
+  double d[3], norm = 0;
+  do {
+    norm = 0;
+    for (double& x : d) {
+      x = rng.uniform(-1, 1);
+      norm += x * x;
+    }
+  } while (norm > 1 || norm < 1e-6);
+  const double speed = mean * rng.uniform(0.5, 1.5) / std::sqrt(norm);
+  return {d[0] * speed, d[1] * speed, d[2] * speed};
+}
+
+/// One axis of a move, bouncing off the walls of the world.
+void move_bouncing(double& c, double& v) {
+  c += v;
+  if (c < 0 || c > kWorld) {
+    v = -v;
+    c = std::clamp(c, 0.0, kWorld);
+  }
+}
+
 /// The trajectories of every box, all frames.
 Frames make_scene(const Options& o) {
   Rng rng(o.seed);
@@ -92,19 +116,10 @@ Frames make_scene(const Options& o) {
   std::vector<Mover> movers(static_cast<std::size_t>(o.objects));
   for (Mover& m : movers) {
     const double edge = o.size * rng.uniform(0.5, 1.5);
-    // A random direction, speed 0.5 to 1.5 times the mean.
-    double d[3], norm = 0;
-    do {
-      norm = 0;
-      for (double& x : d) {
-        x = rng.uniform(-1, 1);
-        norm += x * x;
-      }
-    } while (norm > 1 || norm < 1e-6);
-    const double speed = o.speed * rng.uniform(0.5, 1.5) / std::sqrt(norm);
+    const std::array<double, 3> v = random_velocity(rng, o.speed);
     for (int k = 0; k < 3; ++k) {
       m.c[k] = rng.uniform(0, kWorld);
-      m.v[k] = d[k] * speed;
+      m.v[k] = v[k];
       m.half[k] = edge / 2 * rng.uniform(0.8, 1.2);
       m.phase[k] = rng.uniform(0, 6.283185307179586);
     }
@@ -120,12 +135,7 @@ Frames make_scene(const Options& o) {
         const double half = m.half[k] * (1 + 0.25 * std::sin(m.rate * f + m.phase[k]));
         boxes[i].min[k] = m.c[k] - half;
         boxes[i].max[k] = m.c[k] + half;
-        // Move on, bouncing off the walls.
-        m.c[k] += m.v[k];
-        if (m.c[k] < 0 || m.c[k] > kWorld) {
-          m.v[k] = -m.v[k];
-          m.c[k] = std::clamp(m.c[k], 0.0, kWorld);
-        }
+        move_bouncing(m.c[k], m.v[k]);
       }
     }
   }
@@ -148,18 +158,10 @@ Frames make_crowded_scene(const Options& o) {
   const std::size_t clusters = (static_cast<std::size_t>(o.objects) + 26) / 27;
   std::vector<Cluster> cs(clusters);
   for (Cluster& c : cs) {
-    double d[3], norm = 0;
-    do {
-      norm = 0;
-      for (double& x : d) {
-        x = rng.uniform(-1, 1);
-        norm += x * x;
-      }
-    } while (norm > 1 || norm < 1e-6);
-    const double speed = o.speed * rng.uniform(0.5, 1.5) / std::sqrt(norm);
+    const std::array<double, 3> v = random_velocity(rng, o.speed);
     for (int k = 0; k < 3; ++k) {
       c.c[k] = rng.uniform(0, kWorld);
-      c.v[k] = d[k] * speed;
+      c.v[k] = v[k];
     }
   }
   const double spacing = 0.9 * o.size;
@@ -192,13 +194,7 @@ Frames make_crowded_scene(const Options& o) {
       }
     }
     for (Cluster& c : cs) {
-      for (int k = 0; k < 3; ++k) {
-        c.c[k] += c.v[k];
-        if (c.c[k] < 0 || c.c[k] > kWorld) {
-          c.v[k] = -c.v[k];
-          c.c[k] = std::clamp(c.c[k], 0.0, kWorld);
-        }
-      }
+      for (int k = 0; k < 3; ++k) move_bouncing(c.c[k], c.v[k]);
     }
   }
   return frames;
