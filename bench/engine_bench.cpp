@@ -24,9 +24,12 @@
 #include "dovetail/collision/pose_sampling.h"
 #include "dovetail/engine/scene.h"
 #include "dovetail/engine/simulation.h"
+#include "engine_sweep.h"
 
 namespace {
 
+using dovetail::bench::EngineSweep;
+using dovetail::bench::load_engine_sweep;
 using dovetail::bench::median;
 
 using namespace dovetail;
@@ -34,9 +37,6 @@ using collision::Real;
 using collision::Transform;
 using collision::Vec3;
 using Clock = std::chrono::steady_clock;
-
-constexpr const char* kEngine =
-    "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
 
 struct RunResult {
   double polygon_pairs = 0, colliding_pairs = 0, volume_tests = 0;  ///< per frame
@@ -102,47 +102,11 @@ void engine_assembly(const std::string& path, double seconds, int runs) {
   std::vector<RunResult> results;
   std::size_t parts = 0;
   for (int r = 0; r < runs; ++r) {
-    engine::AssemblyOptions options;
-    options.movable = false;
-    engine::Scene scene = engine::load_assembly(path, options);
-    // The four largest parts move; the rest is fixed.
-    std::vector<engine::PartId> all = scene.parts();
-    std::vector<engine::PartId> with_mesh;
-    for (engine::PartId p : all) {
-      if (scene.collision_mesh(p)) with_mesh.push_back(p);
-    }
-    std::stable_sort(with_mesh.begin(), with_mesh.end(), [&](auto x, auto y) {
-      return scene.collision_mesh(x)->triangle_count() > scene.collision_mesh(y)->triangle_count();
-    });
-    // Size of the assembly: the spread of the parts' origins and meshes.
-    Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-    for (engine::PartId p : with_mesh) {
-      const collision::Bounds b = collision::mesh_bounds(*scene.collision_mesh(p));
-      const Transform X = scene.world_pose(p);
-      lo = lo.cwiseMin(X.apply(b.min)).cwiseMin(X.apply(b.max));
-      hi = hi.cwiseMax(X.apply(b.min)).cwiseMax(X.apply(b.max));
-    }
-    const Real size = (hi - lo).norm();
-    std::vector<engine::PartId> moving(
-        with_mesh.begin(), with_mesh.begin() + std::min<std::size_t>(4, with_mesh.size()));
-    std::vector<Transform> start;
-    for (engine::PartId p : moving) {
-      scene.set_movable(p, true);
-      start.push_back(scene.local_pose(p));
-    }
-    parts = with_mesh.size();
-    engine::Simulation sim(std::move(scene), {.collision_threads = 1});
-    results.push_back(run(sim, seconds, [&](std::uint64_t, double t) {
-      for (std::size_t i = 0; i < moving.size(); ++i) {
-        // Each part sweeps back and forth along a different axis through the assembly, turning
-        // slowly.
-        Transform X = start[i];
-        const Real phase = 2 * std::numbers::pi * (0.2 * t + 0.25 * static_cast<Real>(i));
-        X.t[i % 3] += 0.3 * size * std::sin(phase);
-        X.R = Eigen::AngleAxisd(0.5 * std::sin(phase), Vec3::UnitZ()).toRotationMatrix() * X.R;
-        sim.scene().set_local_pose(moving[i], X);
-      }
-    }));
+    EngineSweep sweep = load_engine_sweep(path);
+    parts = sweep.with_mesh.size();
+    engine::Simulation sim(std::move(sweep.scene), {.collision_threads = 1});
+    results.push_back(
+        run(sim, seconds, [&](std::uint64_t, double t) { sweep.pose_at(sim.scene(), t); }));
   }
   print("engine assembly, 4 moving", parts, seconds, results);
 }
@@ -206,7 +170,7 @@ void synthetic(std::size_t n, double seconds, int runs) {
 int main(int argc, char** argv) {
   double seconds = 10;
   int runs = 3;
-  std::string assembly = kEngine;
+  std::string assembly = dovetail::bench::kEngineAssembly;
   std::string only;  // "engine" or "synthetic": run one scene
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i];

@@ -11,15 +11,24 @@
 //       A scene dominated by polygon-level pairs, at 1, 2, 4 and 8 threads:
 //       throughput and speed-up, with a check that every thread count gives
 //       the same contacts.
+//   pipeline_bench scene engine|polytopes DIR [--frames F] [--n N] [--assembly FILE]
+//       Writes a scene for `dovetail pipeline` to DIR/scene.txt, its meshes
+//       as OBJ files beside it: the engine assembly with its four largest
+//       parts sweeping through it (engine_bench's scene, at 90 Hz), or the
+//       I-COLLIDE scene's N polytopes (their motion, bounces included).
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -28,6 +37,8 @@
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/pose_sampling.h"
 #include "dovetail/collision/primitives.h"
+#include "dovetail/engine/pose_list.h"
+#include "engine_sweep.h"
 
 namespace {
 
@@ -234,20 +245,118 @@ int threads(int frames, int runs) {
   return 0;
 }
 
+/// A `dovetail pipeline` scene being written: the meshes as OBJ files, then
+/// the frames of poses.
+class SceneWriter {
+ public:
+  SceneWriter(const std::filesystem::path& dir, std::size_t parts, std::size_t frames) : dir_(dir) {
+    std::filesystem::create_directories(dir);
+    scene_.open(dir / "scene.txt");
+    if (!scene_) throw std::runtime_error("cannot write " + (dir / "scene.txt").string());
+    scene_ << parts << ' ' << frames << '\n';
+  }
+
+  /// The mesh of the next part, written once per distinct mesh.
+  void part(const std::shared_ptr<const Mesh>& mesh) {
+    auto [it, added] =
+        files_.try_emplace(mesh.get(), "mesh_" + std::to_string(files_.size()) + ".obj");
+    if (added) write_obj(*mesh, dir_ / it->second);
+    scene_ << it->second << '\n';
+  }
+
+  void pose(const Transform& X_WP) { scene_ << dovetail::engine::format_pose(X_WP) << '\n'; }
+
+  void close() {
+    scene_.close();
+    if (!scene_) throw std::runtime_error("cannot write " + (dir_ / "scene.txt").string());
+  }
+
+ private:
+  static void write_obj(const Mesh& mesh, const std::filesystem::path& path) {
+    std::ofstream out(path);
+    char line[128];
+    for (const Vec3& v : mesh.vertices) {
+      std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", v.x(), v.y(), v.z());
+      out << line;
+    }
+    for (const auto& t : mesh.triangles)
+      out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    if (!out) throw std::runtime_error("cannot write " + path.string());
+  }
+
+  std::filesystem::path dir_;
+  std::ofstream scene_;
+  std::map<const Mesh*, std::string> files_;
+};
+
+/// The engine scene of engine_bench, `frames` frames at 90 Hz from t = 0.
+void engine_scene(const std::string& assembly, const std::filesystem::path& dir, int frames) {
+  dovetail::bench::EngineSweep sweep = dovetail::bench::load_engine_sweep(assembly);
+  SceneWriter writer(dir, sweep.with_mesh.size(), static_cast<std::size_t>(frames));
+  for (auto p : sweep.with_mesh) writer.part(sweep.scene.collision_mesh(p));
+  for (int f = 0; f < frames; ++f) {
+    sweep.pose_at(sweep.scene, f / 90.0);
+    for (auto p : sweep.with_mesh) writer.pose(sweep.scene.world_pose(p));
+  }
+  writer.close();
+  std::printf("%s: the engine assembly, %zu parts (4 moving), %d frames\n",
+              (dir / "scene.txt").c_str(), sweep.with_mesh.size(), frames);
+}
+
+/// The I-COLLIDE scene of icollide_scene: n polytopes, `frames` frames.
+void polytope_scene(std::size_t n, const std::filesystem::path& dir, int frames) {
+  std::mt19937_64 rng(42);
+  std::vector<std::shared_ptr<const Mesh>> shapes;
+  for (int s = 0; s < 20; ++s)
+    shapes.push_back(std::make_shared<const Mesh>(random_polytope(rng, 30, 1.0)));
+  const Real half = 0.5 * std::cbrt(n * (4.0 / 3.0 * std::numbers::pi) / 0.05);
+  Bodies bodies(n, half, 0.02, 0.05, 7, /*separated=*/true);
+  CollisionWorld world({.method = Method::kObb, .threads = 1});
+  SceneWriter writer(dir, n, static_cast<std::size_t>(frames));
+  std::vector<PartId> ids;
+  for (std::size_t i = 0; i < n; ++i) {
+    ids.push_back(world.add_part({.mesh = shapes[i % shapes.size()], .X_WP = bodies.pose[i]}));
+    writer.part(shapes[i % shapes.size()]);
+  }
+  for (int f = 0; f < frames; ++f) {
+    for (std::size_t i = 0; i < n; ++i) {
+      world.set_pose(ids[i], bodies.pose[i]);
+      writer.pose(bodies.pose[i]);
+    }
+    for (const PartPair& p : world.step().colliding) bodies.bounce(p.a.index, p.b.index);
+    bodies.advance();
+  }
+  writer.close();
+  std::printf("%s: %zu polytopes (about 56 faces), %d frames\n", (dir / "scene.txt").c_str(), n,
+              frames);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0) {
     std::printf(
         "usage: pipeline_bench icollide|scaling|threads [--n N] [--density D] [--frames F] [--runs "
-        "R]\n");
+        "R]\n"
+        "       pipeline_bench scene engine|polytopes DIR [--frames F] [--n N] [--assembly "
+        "FILE]\n");
     return argc < 2 ? 2 : 0;
   }
   const std::string mode = argv[1];
   std::size_t n = 1000;
   double density = 0.05;
   int frames = 100, runs = 3;
-  for (int i = 2; i + 1 < argc; i += 2) {
+  std::string assembly = dovetail::bench::kEngineAssembly;
+  const int first_option = mode == "scene" ? 4 : 2;  // scene KIND DIR
+  if (mode == "scene" && argc < 4) {
+    std::fprintf(stderr, "pipeline_bench: scene needs engine|polytopes and a folder\n");
+    return 2;
+  }
+  if ((argc - first_option) % 2 != 0) {
+    std::fprintf(stderr, "pipeline_bench: %s needs a value\n", argv[argc - 1]);
+    return 2;
+  }
+  for (int i = first_option; i + 1 < argc; i += 2) {
     const std::string arg = argv[i];
     if (arg == "--n")
       n = static_cast<std::size_t>(
@@ -260,6 +369,8 @@ int main(int argc, char** argv) {
     else if (arg == "--runs")
       runs = static_cast<int>(
           dovetail::bench::whole("pipeline_bench", "--runs", argv[i + 1], 1, 1000));
+    else if (arg == "--assembly")
+      assembly = argv[i + 1];
     else {
       std::fprintf(stderr, "pipeline_bench: unknown option %s\n", arg.c_str());
       return 2;
@@ -269,6 +380,10 @@ int main(int argc, char** argv) {
     if (mode == "icollide") return icollide(n, density, frames, runs);
     if (mode == "scaling") return scaling(frames, runs);
     if (mode == "threads") return threads(frames, runs);
+    if (mode == "scene" && std::strcmp(argv[2], "engine") == 0)
+      return engine_scene(assembly, argv[3], frames), 0;
+    if (mode == "scene" && std::strcmp(argv[2], "polytopes") == 0)
+      return polytope_scene(n, argv[3], frames), 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pipeline_bench: %s\n", e.what());
     return 1;

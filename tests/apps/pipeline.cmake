@@ -41,3 +41,24 @@ dovetail_cli_test(pipeline_unknown_method EXIT 2
                   STDERR "unknown --method 'fcl'; valid: boxtree, dop6")
 dovetail_cli_test(pipeline_missing_scene EXIT 1 ARGS pipeline --scene ${pl_data}/nothing.txt
                   STDERR "nothing.txt: file not found")
+
+# ---- pair for pair with brute force, at 1, 2 and 8 threads, on generated scenes
+if(DOVETAIL_BUILD_BENCH)
+  set(engine_glb
+      /usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb)
+  foreach(scene "polytopes;100" "engine;20")
+    list(GET scene 0 kind)
+    list(GET scene 1 frames)
+    if(kind STREQUAL "engine" AND NOT EXISTS ${engine_glb})
+      message(STATUS "Dovetail: ${engine_glb} (assimp-testmodels) missing, "
+                     "cli.pipeline_agrees_with_brute_force_engine not added")
+      continue()
+    endif()
+    add_test(NAME cli.pipeline_agrees_with_brute_force_${kind}
+             COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:dovetail>
+                     -DBENCH=$<TARGET_FILE:pipeline_bench> -DKIND=${kind} -DFRAMES=${frames}
+                     -DOUT=${out}/pipeline_${kind}
+                     -P ${CMAKE_CURRENT_SOURCE_DIR}/pipeline_agreement.cmake)
+    set_tests_properties(cli.pipeline_agrees_with_brute_force_${kind} PROPERTIES TIMEOUT 900)
+  endforeach()
+endif()
