@@ -274,16 +274,27 @@ void Octree::visit(std::uint32_t index, std::size_t candidates_begin, std::vecto
   const Node& node = nodes_[index];
   const std::size_t candidates_end = candidates_.size();
   std::uint64_t tests = 0;
-  const auto test = [&](ProxyId a, ProxyId b) {
+  // Branch-free: every tested pair is written past the found ones, and
+  // counted as found only when the boxes overlap (a test that mostly fails
+  // would otherwise mispredict its branch often).
+  std::size_t& found = found_;
+  const auto test = [&](ProxyId a, const Aabb& box_a, ProxyId b, const Aabb& box_b) {
     ++tests;
-    if (boxes_[a].overlaps(boxes_[b])) out.push_back(a < b ? ProxyPair{a, b} : ProxyPair{b, a});
+    const bool hit = (box_a.min.x() <= box_b.max.x()) & (box_b.min.x() <= box_a.max.x()) &
+                     (box_a.min.y() <= box_b.max.y()) & (box_b.min.y() <= box_a.max.y()) &
+                     (box_a.min.z() <= box_b.max.z()) & (box_b.min.z() <= box_a.max.z());
+    if (found == out.size()) out.resize(2 * found + 64);
+    out[found] = a < b ? ProxyPair{a, b} : ProxyPair{b, a};
+    found += hit;
   };
   // The node's boxes with each other, then with the ancestors' boxes reaching in.
   const std::size_t m = node.ids.size();
   for (std::size_t i = 0; i < m; ++i) {
-    for (std::size_t j = i + 1; j < m; ++j) test(node.ids[i], node.ids[j]);
+    const ProxyId a = node.ids[i];
+    const Aabb box_a = boxes_[a];
+    for (std::size_t j = i + 1; j < m; ++j) test(a, box_a, node.ids[j], boxes_[node.ids[j]]);
     for (std::size_t c = candidates_begin; c < candidates_end; ++c)
-      test(node.ids[i], candidates_[c]);
+      test(a, box_a, candidates_[c].id, candidates_[c].box);
   }
   stats_.box_tests += tests;
   if (node.first_child == kNone) return;
@@ -293,10 +304,11 @@ void Octree::visit(std::uint32_t index, std::size_t candidates_begin, std::vecto
     if (child.subtree == 0) continue;
     const std::size_t start = candidates_.size();
     for (std::size_t i = candidates_begin; i < candidates_end; ++i) {
-      if (reaches(boxes_[candidates_[i]], child)) candidates_.push_back(candidates_[i]);
+      const Candidate k = candidates_[i];
+      if (reaches(k.box, child)) candidates_.push_back(k);
     }
     for (ProxyId id : node.ids) {
-      if (reaches(boxes_[id], child)) candidates_.push_back(id);
+      if (reaches(boxes_[id], child)) candidates_.push_back({boxes_[id], id});
     }
     visit(c, start, out);
     candidates_.resize(start);
@@ -311,7 +323,9 @@ void Octree::pairs(std::vector<ProxyPair>& out) {
     rebuild();
   }
   candidates_.clear();
+  found_ = 0;
   visit(0, 0, out);
+  out.resize(found_);
   detail::sort_proxy_pairs(out, sort_keys_);
   last_stats_ = stats_;
   stats_ = {};

@@ -87,7 +87,14 @@ class Octree final : public Broadphase {
   std::vector<Aabb> boxes_;  ///< by id
   std::vector<Entry> entries_;
   std::vector<ProxyId> present_;
-  std::vector<ProxyId> candidates_;  ///< scratch of the query
+  /// A box of an ancestor reaching into the cell being visited, copied so
+  /// that the query's inner loop reads boxes in order, not through ids.
+  struct Candidate {
+    Aabb box;
+    ProxyId id;
+  };
+  std::vector<Candidate> candidates_;  ///< scratch of the query
+  std::size_t found_ = 0;              ///< pairs found so far by the query
   std::vector<Real> scratch_;
   BroadphaseStats stats_, last_stats_;
 };
