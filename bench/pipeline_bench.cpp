@@ -348,7 +348,8 @@ int main(int argc, char** argv) {
   int frames = 100, runs = 3;
   std::string assembly = dovetail::bench::kEngineAssembly;
   const int first_option = mode == "scene" ? 4 : 2;  // scene KIND DIR
-  if (mode == "scene" && argc < 4) {
+  if (mode == "scene" && (argc < 4 || (std::strcmp(argv[2], "engine") != 0 &&
+                                       std::strcmp(argv[2], "polytopes") != 0))) {
     std::fprintf(stderr, "pipeline_bench: scene needs engine|polytopes and a folder\n");
     return 2;
   }
