@@ -280,9 +280,7 @@ void Octree::visit(std::uint32_t index, std::size_t candidates_begin, std::vecto
   std::size_t& found = found_;
   const auto test = [&](ProxyId a, const Aabb& box_a, ProxyId b, const Aabb& box_b) {
     ++tests;
-    const bool hit = (box_a.min.x() <= box_b.max.x()) & (box_b.min.x() <= box_a.max.x()) &
-                     (box_a.min.y() <= box_b.max.y()) & (box_b.min.y() <= box_a.max.y()) &
-                     (box_a.min.z() <= box_b.max.z()) & (box_b.min.z() <= box_a.max.z());
+    const bool hit = box_a.overlaps(box_b);
     if (found == out.size()) out.resize(2 * found + 64);
     out[found] = a < b ? ProxyPair{a, b} : ProxyPair{b, a};
     found += hit;
