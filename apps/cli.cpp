@@ -186,22 +186,25 @@ void refuse_overwriting_input(const std::string& command, const std::string& out
   }
 }
 
-std::string method_list() {
+namespace {
+
+/// The names of `all` joined by ", ".
+template <typename All, typename Name>
+std::string join_names(const All& all, Name name) {
   std::string list;
-  for (collision::Method m : collision::all_methods()) {
+  for (const auto m : all) {
     if (!list.empty()) list += ", ";
-    list += collision::method_name(m);
+    list += name(m);
   }
   return list;
 }
 
+}  // namespace
+
+std::string method_list() { return join_names(collision::all_methods(), collision::method_name); }
+
 std::string broadphase_list() {
-  std::string names;
-  for (collision::BroadphaseMethod m : collision::all_broadphases()) {
-    if (!names.empty()) names += ", ";
-    names += collision::broadphase_name(m);
-  }
-  return names;
+  return join_names(collision::all_broadphases(), collision::broadphase_name);
 }
 
 double ms_since(std::chrono::steady_clock::time_point start) {
