@@ -125,20 +125,33 @@ struct SceneResult {
   double box_pairs = 0, colliding = 0, polygon_pairs = 0, cached = 0;
 };
 
-/// Runs the I-COLLIDE scene: `n` polytopes of radius 1 in a cube sized for
-/// `density` (fraction of the cube's volume the polytopes' spheres fill),
-/// bouncing off the walls and off each other (velocities exchanged along the
-/// line of centres when a pair is in contact and approaching).
-SceneResult icollide_scene(std::size_t n, double density, int frames, int runs) {
+/// The I-COLLIDE scene's 20 polytope shapes (radius 1, about 56 faces), body
+/// i taking shape i mod 20.
+std::vector<std::shared_ptr<const Mesh>> icollide_shapes() {
   std::mt19937_64 rng(42);
   std::vector<std::shared_ptr<const Mesh>> shapes;
   for (int s = 0; s < 20; ++s)
     shapes.push_back(std::make_shared<const Mesh>(random_polytope(rng, 30, 1.0)));
+  return shapes;
+}
+
+/// Half the edge of the cube that n bodies' unit spheres fill to `density`.
+Real icollide_half_size(std::size_t n, double density) {
   const Real sphere_volume = 4.0 / 3.0 * std::numbers::pi;
   const Real half = 0.5 * std::cbrt(n * sphere_volume / density);
   if (2 * half / std::ceil(std::cbrt(static_cast<double>(n))) < 2.0) {
     throw std::invalid_argument("density too high to start the bodies apart");
   }
+  return half;
+}
+
+/// Runs the I-COLLIDE scene: `n` polytopes of radius 1 in a cube sized for
+/// `density` (fraction of the cube's volume the polytopes' spheres fill),
+/// bouncing off the walls and off each other (velocities exchanged along the
+/// line of centres when a pair is in contact and approaching).
+SceneResult icollide_scene(std::size_t n, double density, int frames, int runs) {
+  const std::vector<std::shared_ptr<const Mesh>> shapes = icollide_shapes();
+  const Real half = icollide_half_size(n, density);
   std::vector<double> run_ms;
   SceneResult out;
   for (int r = 0; r < runs; ++r) {
@@ -305,12 +318,8 @@ void engine_scene(const std::string& assembly, const std::filesystem::path& dir,
 
 /// The I-COLLIDE scene of icollide_scene: n polytopes, `frames` frames.
 void polytope_scene(std::size_t n, const std::filesystem::path& dir, int frames) {
-  std::mt19937_64 rng(42);
-  std::vector<std::shared_ptr<const Mesh>> shapes;
-  for (int s = 0; s < 20; ++s)
-    shapes.push_back(std::make_shared<const Mesh>(random_polytope(rng, 30, 1.0)));
-  const Real half = 0.5 * std::cbrt(n * (4.0 / 3.0 * std::numbers::pi) / 0.05);
-  Bodies bodies(n, half, 0.02, 0.05, 7, /*separated=*/true);
+  const std::vector<std::shared_ptr<const Mesh>> shapes = icollide_shapes();
+  Bodies bodies(n, icollide_half_size(n, 0.05), 0.02, 0.05, 7, /*separated=*/true);
   CollisionWorld world({.method = Method::kObb, .threads = 1});
   SceneWriter writer(dir, n, static_cast<std::size_t>(frames));
   std::vector<PartId> ids;
