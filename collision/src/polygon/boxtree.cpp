@@ -259,9 +259,9 @@ class BoxtreeTraversal {
   /// One tree's current node: its box in its own frame and the enclosure of
   /// that box in the other tree's frame.
   struct Side {
-    std::uint32_t node;
     Box box;
     Box enc;
+    std::uint32_t node;
   };
   /// A pair of overlapping nodes.
   struct Entry {
@@ -356,32 +356,39 @@ class BoxtreeTraversal {
     }
   };
 
-  /// Moves the upper face on `axis` of s's box down to `split`: the enclosure's
-  /// upper bounds drop where the axis maps positively, its lower bounds where negatively.
-  static void move_upper(Side& s, int axis, double split, const SplitRotation& M) {
+  /// The child of `s` whose upper face on `axis` moved down to `split`: the
+  /// enclosure's upper bounds drop where the axis maps positively, its lower
+  /// bounds where negatively. Every value is computed from the parent's, none
+  /// read back from the child being written (a partial store followed by a
+  /// wide load of the same bytes would stall).
+  static void move_upper(Side& child, const Side& s, int axis, double split,
+                         const SplitRotation& M) {
     const double d = s.box.hi[axis] - split;
-    s.box.hi[axis] = split;
+    child.box = s.box;
+    child.box.hi[axis] = split;
     for (int i = 0; i < 3; ++i) {
-      s.enc.hi[i] -= M.pos[axis][i] * d;
-      s.enc.lo[i] -= M.neg[axis][i] * d;
+      child.enc.hi[i] = s.enc.hi[i] - M.pos[axis][i] * d;
+      child.enc.lo[i] = s.enc.lo[i] - M.neg[axis][i] * d;
     }
   }
 
-  static void move_lower(Side& s, int axis, double split, const SplitRotation& M) {
+  static void move_lower(Side& child, const Side& s, int axis, double split,
+                         const SplitRotation& M) {
     const double d = split - s.box.lo[axis];
-    s.box.lo[axis] = split;
+    child.box = s.box;
+    child.box.lo[axis] = split;
     for (int i = 0; i < 3; ++i) {
-      s.enc.lo[i] += M.pos[axis][i] * d;
-      s.enc.hi[i] += M.neg[axis][i] * d;
+      child.enc.lo[i] = s.enc.lo[i] + M.pos[axis][i] * d;
+      child.enc.hi[i] = s.enc.hi[i] + M.neg[axis][i] * d;
     }
   }
 
   /// After `child` moved one face on `axis`: its own box needs only that face
   /// compared with the other's enclosure; its enclosure moved on all axes.
-  bool child_overlaps(const Side& child, bool upper, int axis, const Side& other) const {
+  bool child_overlaps(const Side& child, bool upper, double split, int axis,
+                      const Side& other) const {
     tester_.count_volume_test();
-    if (upper ? child.box.hi[axis] < other.enc.lo[axis] - margin_
-              : child.box.lo[axis] > other.enc.hi[axis] + margin_) {
+    if (upper ? split < other.enc.lo[axis] - margin_ : split > other.enc.hi[axis] + margin_) {
       return false;
     }
     return overlap(other.box, child.enc, 0) && overlap(other.box, child.enc, 1) &&
@@ -414,17 +421,19 @@ class BoxtreeTraversal {
     const std::uint32_t kind = n.kind();
     std::uint32_t child = n.index();
     if (kind != BoxtreeNode::kRightOnly) {
-      Side left = s;
+      Side left;
       left.node = child++;
-      move_upper(left, axis, n.split_left, M);
-      if (child_overlaps(left, true, axis, other)) next(left);
+      const double split = n.split_left;
+      move_upper(left, s, axis, split, M);
+      if (child_overlaps(left, true, split, axis, other)) next(left);
       if (tester_.done()) return;
     }
     if (kind != BoxtreeNode::kLeftOnly) {
-      Side right = s;
+      Side right;
       right.node = child;
-      move_lower(right, axis, n.split_right, M);
-      if (child_overlaps(right, false, axis, other)) next(right);
+      const double split = n.split_right;
+      move_lower(right, s, axis, split, M);
+      if (child_overlaps(right, false, split, axis, other)) next(right);
     }
   }
 

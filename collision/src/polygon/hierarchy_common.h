@@ -80,17 +80,29 @@ class LeafTester {
   bool done() const { return done_; }
 
   /// Tests every triangle of one leaf against every triangle of another; B's
-  /// triangles are transformed once per leaf pair.
+  /// triangles are transformed, and every triangle's bounding box computed,
+  /// once per leaf pair.
   void test_leaves(const std::uint32_t* tris_a, int count_a, const std::uint32_t* tris_b,
                    int count_b) {
     constexpr int kMaxLeaf = 8;
     std::array<std::array<Vec3, 3>, kMaxLeaf> b;
+    std::array<Vec3, kMaxLeaf> b_lo, b_hi;
     for (int j = 0; j < count_b; ++j) {
       const TriangleIndices& tb = b_.triangles[tris_b[j]];
       for (int k = 0; k < 3; ++k) b[j][k] = X_AB_.apply(b_.vertices[tb[k]]);
+      b_lo[j] = b[j][0].cwiseMin(b[j][1]).cwiseMin(b[j][2]);
+      b_hi[j] = b[j][0].cwiseMax(b[j][1]).cwiseMax(b[j][2]);
     }
     for (int i = 0; i < count_a && !done_; ++i) {
-      for (int j = 0; j < count_b && !done_; ++j) test_transformed(tris_a[i], tris_b[j], b[j]);
+      const TriangleIndices& ta = a_.triangles[tris_a[i]];
+      const Vec3& p = a_.vertices[ta[0]];
+      const Vec3& q = a_.vertices[ta[1]];
+      const Vec3& r = a_.vertices[ta[2]];
+      const Vec3 a_lo = p.cwiseMin(q).cwiseMin(r), a_hi = p.cwiseMax(q).cwiseMax(r);
+      for (int j = 0; j < count_b && !done_; ++j) {
+        if (boxes_overlap(a_lo, a_hi, b_lo[j], b_hi[j]))
+          test_exact(tris_a[i], p, q, r, tris_b[j], b[j]);
+      }
     }
   }
 
@@ -99,20 +111,12 @@ class LeafTester {
   /// the comparison only saves work and never changes a verdict.
   void test_transformed(std::uint32_t ia, std::uint32_t ib, const std::array<Vec3, 3>& b) {
     const TriangleIndices& ta = a_.triangles[ia];
-    const Vec3& p1 = a_.vertices[ta[0]];
-    const Vec3& q1 = a_.vertices[ta[1]];
-    const Vec3& r1 = a_.vertices[ta[2]];
-    for (int k = 0; k < 3; ++k) {
-      const Real lo_a = std::min({p1[k], q1[k], r1[k]}), hi_a = std::max({p1[k], q1[k], r1[k]});
-      const Real lo_b = std::min({b[0][k], b[1][k], b[2][k]});
-      const Real hi_b = std::max({b[0][k], b[1][k], b[2][k]});
-      if (lo_a > hi_b || lo_b > hi_a) return;
-    }
-    ++result_.stats.triangle_tests;
-    if (triangles_intersect(p1, q1, r1, b[0], b[1], b[2])) {
-      result_.colliding = true;
-      result_.pairs.push_back({ia, ib});
-      done_ = !all_pairs_;
+    const Vec3& p = a_.vertices[ta[0]];
+    const Vec3& q = a_.vertices[ta[1]];
+    const Vec3& r = a_.vertices[ta[2]];
+    if (boxes_overlap(p.cwiseMin(q).cwiseMin(r), p.cwiseMax(q).cwiseMax(r),
+                      b[0].cwiseMin(b[1]).cwiseMin(b[2]), b[0].cwiseMax(b[1]).cwiseMax(b[2]))) {
+      test_exact(ia, p, q, r, ib, b);
     }
   }
 
@@ -130,6 +134,21 @@ class LeafTester {
   }
 
  private:
+  static bool boxes_overlap(const Vec3& a_lo, const Vec3& a_hi, const Vec3& b_lo,
+                            const Vec3& b_hi) {
+    return !((a_lo.array() > b_hi.array()).any() || (b_lo.array() > a_hi.array()).any());
+  }
+
+  void test_exact(std::uint32_t ia, const Vec3& p, const Vec3& q, const Vec3& r, std::uint32_t ib,
+                  const std::array<Vec3, 3>& b) {
+    ++result_.stats.triangle_tests;
+    if (triangles_intersect(p, q, r, b[0], b[1], b[2])) {
+      result_.colliding = true;
+      result_.pairs.push_back({ia, ib});
+      done_ = !all_pairs_;
+    }
+  }
+
   const Mesh& a_;
   const Mesh& b_;
   const Transform& X_AB_;
