@@ -1,5 +1,6 @@
-// Object-level benchmark: every Dovetail broad phase and Bullet's
-// btDbvtBroadphase and btAxisSweep3 on the same box trajectories, in one run.
+// Object-level benchmark: every Dovetail broad phase, Bullet's
+// btDbvtBroadphase and btAxisSweep3 and FCL's DynamicAABBTreeCollisionManager
+// (and its array variant) on the same box trajectories, in one run.
 //
 //   broadphase_bench [--scene sparse|crowded] [--objects N] [--frames F] [--runs R]
 //                    [--seed S] [--size E] [--speed V] [--no-brute] [--write-scene FILE]
@@ -12,11 +13,12 @@
 // neighbours), each cluster moving as one, its boxes wobbling about their
 // places and breathing; about four overlapping pairs per box. Prints the actual overlap (objects in
 // at least one pair, pairs per frame), then per contender the median over runs of the median time
-// per frame (frames after the first), the ratio to Bullet's best, whether its pair sets equal brute
-// force's on every frame, and its work counters per frame (box tests, endpoint swaps, cells or
-// nodes touched). Bullet works in float and keeps pairs whose fattened boxes overlap: it is fed
+// per frame (frames after the first), the ratio to the best peer's, whether its pair sets equal
+// brute force's on every frame, and its work counters per frame (box tests, endpoint swaps, cells
+// or nodes touched). Bullet works in float and keeps pairs whose fattened boxes overlap: it is fed
 // boxes rounded outwards, and its pairs are filtered by the exact box test before the comparison;
-// any exact pair it misses is reported.
+// any exact pair it misses is reported. FCL is given the very double boxes (its objects' world
+// boxes are set directly); its pairs go through the same filter.
 
 #include <algorithm>
 #include <array>
@@ -39,6 +41,13 @@
 #include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
 #include <BulletCollision/CollisionDispatch/btCollisionDispatcher.h>
 #include <BulletCollision/CollisionDispatch/btDefaultCollisionConfiguration.h>
+#endif
+
+#ifdef DOVETAIL_HAVE_FCL
+#include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
+#include <fcl/broadphase/broadphase_dynamic_AABB_tree_array.h>
+#include <fcl/geometry/shape/box.h>
+#include <fcl/narrowphase/collision_object.h>
 #endif
 
 namespace {
@@ -217,10 +226,10 @@ bool write_scene(const Frames& frames, const std::string& path) {
 /// One contender's results over all runs.
 struct Result {
   std::string name;
-  bool bullet = false;
+  bool peer = false;  ///< Bullet or FCL: timed against, filtered by the exact box test
   std::vector<double> run_medians;  ///< median ms per frame (after the first), per run
   std::size_t frames_differing = 0;
-  std::size_t raw_pairs = 0;     ///< Bullet: pairs before the exact filter, all frames
+  std::size_t raw_pairs = 0;     ///< peers: pairs before the exact filter, all frames
   std::size_t missed_pairs = 0;  ///< exact pairs the contender did not report
   std::size_t extra_pairs = 0;   ///< pairs reported that are not exact pairs
   BroadphaseStats work;          ///< Dovetail: work counters, summed over frames after the first
@@ -326,6 +335,71 @@ std::vector<double> run_bullet(const std::function<std::unique_ptr<btBroadphaseI
     std::sort(out.begin(), out.end());
   }
   for (btBroadphaseProxy* proxy : proxies) bp->destroyProxy(proxy, &dispatcher);
+  return ms;
+}
+#endif
+
+#ifdef DOVETAIL_HAVE_FCL
+/// An FCL object whose world box is set directly, so that FCL's broad phase
+/// sees exactly the boxes the others see (its own box of a shape would be
+/// rounded differently).
+class FclBox : public fcl::CollisionObjectd {
+ public:
+  explicit FclBox(const std::shared_ptr<fcl::CollisionGeometryd>& shape, std::size_t index)
+      : fcl::CollisionObjectd(shape) {
+    setUserData(reinterpret_cast<void*>(static_cast<std::uintptr_t>(index + 1)));
+  }
+  void set_box(const Aabb& b) {
+    aabb = fcl::AABBd(fcl::Vector3d(b.min[0], b.min[1], b.min[2]),
+                      fcl::Vector3d(b.max[0], b.max[1], b.max[2]));
+  }
+};
+
+/// Runs an FCL broad-phase manager over all frames once; the pairs it reports
+/// are filtered by the exact box test, as Bullet's.
+std::vector<double> run_fcl(
+    const std::function<std::unique_ptr<fcl::BroadPhaseCollisionManagerd>()>& make,
+    const Frames& frames, PairLists& pairs, std::size_t& raw_pairs) {
+  const auto shape = std::make_shared<fcl::Boxd>(1, 1, 1);
+  std::unique_ptr<fcl::BroadPhaseCollisionManagerd> manager = make();
+  std::vector<std::unique_ptr<FclBox>> objects;
+  std::vector<ProxyPair> found;
+  const auto collect = [](fcl::CollisionObjectd* a, fcl::CollisionObjectd* b, void* data) {
+    auto* out = static_cast<std::vector<ProxyPair>*>(data);
+    const auto i = static_cast<ProxyId>(reinterpret_cast<std::uintptr_t>(a->getUserData()) - 1);
+    const auto j = static_cast<ProxyId>(reinterpret_cast<std::uintptr_t>(b->getUserData()) - 1);
+    out->push_back(i < j ? ProxyPair{i, j} : ProxyPair{j, i});
+    return false;  // go on: every pair
+  };
+  std::vector<double> ms;
+  raw_pairs = 0;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    const std::vector<Aabb>& boxes = frames[f];
+    found.clear();
+    const Clock::time_point start = Clock::now();
+    if (f == 0) {
+      std::vector<fcl::CollisionObjectd*> all;
+      for (std::size_t i = 0; i < boxes.size(); ++i) {
+        objects.push_back(std::make_unique<FclBox>(shape, i));
+        objects.back()->set_box(boxes[i]);
+        all.push_back(objects.back().get());
+      }
+      manager->registerObjects(all);
+      manager->setup();
+    } else {
+      for (std::size_t i = 0; i < boxes.size(); ++i) objects[i]->set_box(boxes[i]);
+      manager->update();
+    }
+    manager->collide(&found, collect);
+    ms.push_back(ms_since(start));
+    raw_pairs += found.size();
+    std::vector<ProxyPair>& out = pairs[f];
+    out.clear();
+    for (const ProxyPair& p : found) {
+      if (boxes[p.a].overlaps(boxes[p.b])) out.push_back(p);
+    }
+    std::sort(out.begin(), out.end());
+  }
   return ms;
 }
 #endif
@@ -454,7 +528,23 @@ int main(int argc, char** argv) {
   for (const auto& b : bullets) {
     Result r;
     r.name = b.first;
-    r.bullet = true;
+    r.peer = true;
+    results.push_back(r);
+  }
+#endif
+#ifdef DOVETAIL_HAVE_FCL
+  const std::vector<
+      std::pair<std::string, std::function<std::unique_ptr<fcl::BroadPhaseCollisionManagerd>()>>>
+      fcls = {
+          {"fcl DynamicAABBTree",
+           [] { return std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>(); }},
+          {"fcl DynamicAABBTree_Array",
+           [] { return std::make_unique<fcl::DynamicAABBTreeCollisionManager_Arrayd>(); }},
+      };
+  for (const auto& m : fcls) {
+    Result r;
+    r.name = m.first;
+    r.peer = true;
     results.push_back(r);
   }
 #endif
@@ -480,12 +570,23 @@ int main(int argc, char** argv) {
       }
     }
 #endif
+#ifdef DOVETAIL_HAVE_FCL
+    for (const auto& m : fcls) {
+      Result& r = results[index++];
+      std::size_t raw = 0;
+      r.run_medians.push_back(frame_median(run_fcl(m.second, frames, got, raw)));
+      if (run == 0) {
+        r.raw_pairs = raw;
+        for (std::size_t f = 0; f < nf; ++f) compare(got[f], reference[f], r);
+      }
+    }
+#endif
   }
 
-  double bullet_best = 0;
+  double peer_best = 0;
   for (const Result& r : results) {
-    if (r.bullet && (bullet_best == 0 || median(r.run_medians) < bullet_best)) {
-      bullet_best = median(r.run_medians);
+    if (r.peer && (peer_best == 0 || median(r.run_medians) < peer_best)) {
+      peer_best = median(r.run_medians);
     }
   }
   std::printf("scene: %s, %d boxes, %d frames, mean edge %.3g, speed %.3g per frame, seed %llu\n",
@@ -499,15 +600,15 @@ int main(int argc, char** argv) {
 #endif
   std::printf("times: median over %d runs of the median ms per frame (frames 2..%d)\n\n", o.runs,
               o.frames);
-  std::printf("| %-26s | %10s | %11s | %-34s | %30s |\n", "broad phase", "ms/frame", "vs Bullet",
+  std::printf("| %-26s | %10s | %12s | %-34s | %30s |\n", "broad phase", "ms/frame", "vs best peer",
               "pairs vs brute force, all frames", "box tests / swaps / cells");
   std::printf("|%s|%s|%s|%s|%s|\n", std::string(28, '-').c_str(), std::string(12, '-').c_str(),
-              std::string(13, '-').c_str(), std::string(36, '-').c_str(),
+              std::string(14, '-').c_str(), std::string(36, '-').c_str(),
               std::string(32, '-').c_str());
   for (const Result& r : results) {
     const double ms = median(r.run_medians);
     char ratio[32] = "-";
-    if (bullet_best > 0) std::snprintf(ratio, sizeof ratio, "%.3fx", ms / bullet_best);
+    if (peer_best > 0) std::snprintf(ratio, sizeof ratio, "%.3fx", ms / peer_best);
     std::string verdict;
     if (r.name.rfind(std::string(broadphase_name(reference_method)), 0) == 0 &&
         &r == &results.front()) {
@@ -519,17 +620,17 @@ int main(int argc, char** argv) {
                 " frames differ: " + std::to_string(r.missed_pairs) + " missed, " +
                 std::to_string(r.extra_pairs) + " extra";
     }
-    if (r.bullet) {
+    if (r.peer) {
       verdict += " (raw " + std::to_string(r.raw_pairs / nf) + "/frame)";
     }
     char work[64] = "-";
-    if (!r.bullet) {
+    if (!r.peer) {
       const double per = static_cast<double>(nf > 1 ? nf - 1 : 1);
       std::snprintf(
           work, sizeof work, "%.0f / %.0f / %.0f", static_cast<double>(r.work.box_tests) / per,
           static_cast<double>(r.work.swaps) / per, static_cast<double>(r.work.cells) / per);
     }
-    std::printf("| %-26s | %10.3f | %11s | %-34s | %30s |\n", r.name.c_str(), ms, ratio,
+    std::printf("| %-26s | %10.3f | %12s | %-34s | %30s |\n", r.name.c_str(), ms, ratio,
                 verdict.c_str(), work);
   }
   return 0;
