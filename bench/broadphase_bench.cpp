@@ -279,6 +279,33 @@ std::vector<double> run_dovetail(BroadphaseMethod method, const Frames& frames, 
   return ms;
 }
 
+#if defined(DOVETAIL_HAVE_BULLET) || defined(DOVETAIL_HAVE_FCL)
+/// A peer's handle on box i (never null), and back.
+void* client_of(std::size_t i) {
+  return reinterpret_cast<void*>(static_cast<std::uintptr_t>(i + 1));
+}
+ProxyId index_of(const void* client) {
+  return static_cast<ProxyId>(reinterpret_cast<std::uintptr_t>(client) - 1);
+}
+
+/// A peer's pairs (a < b), exact ones only, sorted: `out`.
+void keep_exact(const std::vector<ProxyPair>& found, const std::vector<Aabb>& boxes,
+                std::vector<ProxyPair>& out) {
+  out.clear();
+  for (const ProxyPair& p : found) {
+    if (boxes[p.a].overlaps(boxes[p.b])) out.push_back(p);
+  }
+  std::sort(out.begin(), out.end());
+}
+#endif
+
+/// A peer broad phase: runs over all frames once, returns per-frame ms, its
+/// exact pairs per frame and the pairs it reported before the exact filter.
+struct Peer {
+  std::string name;
+  std::function<std::vector<double>(const Frames&, PairLists&, std::size_t&)> run;
+};
+
 #ifdef DOVETAIL_HAVE_BULLET
 /// Bullet's float box around a double box: rounded outwards, so it contains it.
 void float_box(const Aabb& b, btVector3& lo, btVector3& hi) {
@@ -301,6 +328,7 @@ std::vector<double> run_bullet(const std::function<std::unique_ptr<btBroadphaseI
   btCollisionDispatcher dispatcher(&configuration);
   std::unique_ptr<btBroadphaseInterface> bp = make();
   std::vector<btBroadphaseProxy*> proxies;
+  std::vector<ProxyPair> found;
   std::vector<double> ms;
   raw_pairs = 0;
   btVector3 lo, hi;
@@ -311,7 +339,7 @@ std::vector<double> run_bullet(const std::function<std::unique_ptr<btBroadphaseI
       float_box(boxes[i], lo, hi);
       if (f == 0) {
         // The client object carries the box index.
-        void* client = reinterpret_cast<void*>(static_cast<std::uintptr_t>(i + 1));
+        void* client = client_of(i);
         proxies.push_back(bp->createProxy(lo, hi, 0, client, btBroadphaseProxy::DefaultFilter,
                                           btBroadphaseProxy::AllFilter, &dispatcher));
       } else {
@@ -321,18 +349,15 @@ std::vector<double> run_bullet(const std::function<std::unique_ptr<btBroadphaseI
     bp->calculateOverlappingPairs(&dispatcher);
     ms.push_back(ms_since(start));
     // Bullet's pairs, by index, exact ones only.
-    std::vector<ProxyPair>& out = pairs[f];
-    out.clear();
     const btBroadphasePairArray& array = bp->getOverlappingPairCache()->getOverlappingPairArray();
     raw_pairs += static_cast<std::size_t>(array.size());
+    found.clear();
     for (int p = 0; p < array.size(); ++p) {
-      const auto a = static_cast<ProxyId>(
-          reinterpret_cast<std::uintptr_t>(array[p].m_pProxy0->m_clientObject) - 1);
-      const auto b = static_cast<ProxyId>(
-          reinterpret_cast<std::uintptr_t>(array[p].m_pProxy1->m_clientObject) - 1);
-      if (boxes[a].overlaps(boxes[b])) out.push_back(a < b ? ProxyPair{a, b} : ProxyPair{b, a});
+      const ProxyId a = index_of(array[p].m_pProxy0->m_clientObject);
+      const ProxyId b = index_of(array[p].m_pProxy1->m_clientObject);
+      found.push_back(a < b ? ProxyPair{a, b} : ProxyPair{b, a});
     }
-    std::sort(out.begin(), out.end());
+    keep_exact(found, boxes, pairs[f]);
   }
   for (btBroadphaseProxy* proxy : proxies) bp->destroyProxy(proxy, &dispatcher);
   return ms;
@@ -347,7 +372,7 @@ class FclBox : public fcl::CollisionObjectd {
  public:
   explicit FclBox(const std::shared_ptr<fcl::CollisionGeometryd>& shape, std::size_t index)
       : fcl::CollisionObjectd(shape) {
-    setUserData(reinterpret_cast<void*>(static_cast<std::uintptr_t>(index + 1)));
+    setUserData(client_of(index));
   }
   void set_box(const Aabb& b) {
     aabb = fcl::AABBd(fcl::Vector3d(b.min[0], b.min[1], b.min[2]),
@@ -366,8 +391,8 @@ std::vector<double> run_fcl(
   std::vector<ProxyPair> found;
   const auto collect = [](fcl::CollisionObjectd* a, fcl::CollisionObjectd* b, void* data) {
     auto* out = static_cast<std::vector<ProxyPair>*>(data);
-    const auto i = static_cast<ProxyId>(reinterpret_cast<std::uintptr_t>(a->getUserData()) - 1);
-    const auto j = static_cast<ProxyId>(reinterpret_cast<std::uintptr_t>(b->getUserData()) - 1);
+    const ProxyId i = index_of(a->getUserData());
+    const ProxyId j = index_of(b->getUserData());
     out->push_back(i < j ? ProxyPair{i, j} : ProxyPair{j, i});
     return false;  // go on: every pair
   };
@@ -393,12 +418,7 @@ std::vector<double> run_fcl(
     manager->collide(&found, collect);
     ms.push_back(ms_since(start));
     raw_pairs += found.size();
-    std::vector<ProxyPair>& out = pairs[f];
-    out.clear();
-    for (const ProxyPair& p : found) {
-      if (boxes[p.a].overlaps(boxes[p.b])) out.push_back(p);
-    }
-    std::sort(out.begin(), out.end());
+    keep_exact(found, boxes, pairs[f]);
   }
   return ms;
 }
@@ -508,46 +528,45 @@ int main(int argc, char** argv) {
     r.name = broadphase_name(m);
     results.push_back(r);
   }
+  std::vector<Peer> peers;
 #ifdef DOVETAIL_HAVE_BULLET
   const btVector3 world_lo(-10, -10, -10), world_hi(kWorld + 10, kWorld + 10, kWorld + 10);
-  const std::vector<std::pair<std::string, std::function<std::unique_ptr<btBroadphaseInterface>()>>>
-      bullets = {
-          {"bullet btDbvtBroadphase", [] { return std::make_unique<btDbvtBroadphase>(); }},
-          {"bullet btAxisSweep3",
-           [&] {
-             // 16-bit quantised endpoints; the ray-cast accelerator (a second
-             // tree updated on every move) is switched off: only pairs are timed.
-             return std::make_unique<btAxisSweep3>(
-                 world_lo, world_hi, static_cast<unsigned short>(16384), nullptr, true);
-           }},
-          {"bullet bt32BitAxisSweep3",
-           [&] {
-             return std::make_unique<bt32BitAxisSweep3>(world_lo, world_hi, 16384u, nullptr, true);
-           }},
-      };
-  for (const auto& b : bullets) {
-    Result r;
-    r.name = b.first;
-    r.peer = true;
-    results.push_back(r);
-  }
+  const auto bullet = [&](std::string name,
+                          std::function<std::unique_ptr<btBroadphaseInterface>()> make) {
+    peers.push_back({std::move(name), [make](const Frames& f, PairLists& p, std::size_t& raw) {
+                       return run_bullet(make, f, p, raw);
+                     }});
+  };
+  bullet("bullet btDbvtBroadphase", [] { return std::make_unique<btDbvtBroadphase>(); });
+  bullet("bullet btAxisSweep3", [&] {
+    // 16-bit quantised endpoints; the ray-cast accelerator (a second
+    // tree updated on every move) is switched off: only pairs are timed.
+    return std::make_unique<btAxisSweep3>(world_lo, world_hi, static_cast<unsigned short>(16384),
+                                          nullptr, true);
+  });
+  bullet("bullet bt32BitAxisSweep3", [&] {
+    return std::make_unique<bt32BitAxisSweep3>(world_lo, world_hi, 16384u, nullptr, true);
+  });
 #endif
 #ifdef DOVETAIL_HAVE_FCL
-  const std::vector<
-      std::pair<std::string, std::function<std::unique_ptr<fcl::BroadPhaseCollisionManagerd>()>>>
-      fcls = {
-          {"fcl DynamicAABBTree",
-           [] { return std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>(); }},
-          {"fcl DynamicAABBTree_Array",
-           [] { return std::make_unique<fcl::DynamicAABBTreeCollisionManager_Arrayd>(); }},
+  const auto fcl_peer =
+      [&](std::string name,
+          std::function<std::unique_ptr<fcl::BroadPhaseCollisionManagerd>()> make) {
+        peers.push_back({std::move(name), [make](const Frames& f, PairLists& p, std::size_t& raw) {
+                           return run_fcl(make, f, p, raw);
+                         }});
       };
-  for (const auto& m : fcls) {
+  fcl_peer("fcl DynamicAABBTree",
+           [] { return std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>(); });
+  fcl_peer("fcl DynamicAABBTree_Array",
+           [] { return std::make_unique<fcl::DynamicAABBTreeCollisionManager_Arrayd>(); });
+#endif
+  for (const Peer& peer : peers) {
     Result r;
-    r.name = m.first;
+    r.name = peer.name;
     r.peer = true;
     results.push_back(r);
   }
-#endif
   PairLists got(nf);
   for (int run = 0; run < o.runs; ++run) {
     std::size_t index = first;
@@ -559,28 +578,15 @@ int main(int argc, char** argv) {
         for (std::size_t f = 0; f < nf; ++f) compare(got[f], reference[f], r);
       }
     }
-#ifdef DOVETAIL_HAVE_BULLET
-    for (const auto& b : bullets) {
+    for (const Peer& peer : peers) {
       Result& r = results[index++];
       std::size_t raw = 0;
-      r.run_medians.push_back(frame_median(run_bullet(b.second, frames, got, raw)));
+      r.run_medians.push_back(frame_median(peer.run(frames, got, raw)));
       if (run == 0) {
         r.raw_pairs = raw;
         for (std::size_t f = 0; f < nf; ++f) compare(got[f], reference[f], r);
       }
     }
-#endif
-#ifdef DOVETAIL_HAVE_FCL
-    for (const auto& m : fcls) {
-      Result& r = results[index++];
-      std::size_t raw = 0;
-      r.run_medians.push_back(frame_median(run_fcl(m.second, frames, got, raw)));
-      if (run == 0) {
-        r.raw_pairs = raw;
-        for (std::size_t f = 0; f < nf; ++f) compare(got[f], reference[f], r);
-      }
-    }
-#endif
   }
 
   double peer_best = 0;
