@@ -191,7 +191,6 @@ class ObbPolicy {
 
   Real gap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
     const ObbTree::Node& node = a_.nodes_[n];
-    prefetch_children(a_, node);
     return detail::oriented_boxes_gap(node.axes, node.centre, node.half, e.axes, e.centre, e.half,
                                       margin_);
   }
@@ -204,17 +203,20 @@ class ObbPolicy {
   const std::uint32_t* slots_b() const { return b_.order_.data(); }
 
  private:
-  /// Starts loading a node's two children (adjacent, two cache lines each)
+  /// Starts loading a node's two children (adjacent, 128 bytes each)
   /// while its own box is tested: where the test passes, they are the next
   /// nodes the traversal reads. On the bunny, whose tree (10 MB) does not fit
   /// in the cache, this takes 4% off a query; on trees that fit it changes
   /// nothing measurable.
   static void prefetch_children(const ObbTree& tree, const ObbTree::Node& node) {
     if (node.link.is_leaf()) return;
+    constexpr std::size_t kCacheLine = 64;
     const char* first = reinterpret_cast<const char*>(&tree.nodes_[node.link.first_child()]);
-    for (std::size_t offset = 0; offset < 2 * sizeof(ObbTree::Node); offset += 64) {
+    constexpr std::size_t kBytes = 2 * sizeof(ObbTree::Node);
+    for (std::size_t offset = 0; offset < kBytes; offset += kCacheLine) {
       __builtin_prefetch(first + offset);
     }
+    __builtin_prefetch(first + kBytes - 1);  // the last line, when the nodes start mid-line
   }
 
   const ObbTree& a_;
