@@ -4,10 +4,10 @@
 //              [--sweep TABLE]
 // --slow MS lists the sliding frames slower than MS milliseconds, with their
 // sub-steps, collision queries and contacts. --sweep TABLE runs only the
-// sliding scene, with the contact search's resolution and sub-step budget
-// varied, measuring the deepest overlap of peg and block every frame and their
-// distance in the frames in contact, and writes the table behind the sliding
-// chart (scripts/charts.sh).
+// sliding scene along the wall (below), with the contact search's resolution
+// and sub-step budget varied, measuring the deepest overlap of peg and block
+// every frame and their distance in the frames in contact, and writes the
+// table behind the sliding chart (scripts/charts.sh).
 //
 // One collision thread. Each scene is a 10,000-triangle part and the hand,
 // driven by the simulated glove through a plan that approaches, closes
@@ -30,10 +30,13 @@
 // axis and tilted 2 degrees into a hole of 20.5 mm in a block, down to the
 // bottom and 20 mm past it (the peg resting there, the band stretched), then
 // opens: median, 95th percentile and worst frame while the peg is held and
-// in contact. Twice, side by side: the plain search (a whole-part collision
-// query per halving toward each contact pose, the contact patches analysed at
-// every hit) and the one guided by the colliding triangle pair
-// (SlidingSettings::pair_guided, the default).
+// in contact. The same peg also slides down the hole's wall: upright, 5 mm
+// into the hole, the hand moves 0.5 mm sideways (the hole leaves 0.25 mm) and
+// then down past the bottom, with no mate to draw the peg off the wall, so it
+// slides 35 mm in contact. Each scene three times, side by side: the plain
+// search (a whole-part collision query per halving toward each contact pose,
+// the contact patches analysed at every hit), the one guided by the colliding
+// triangle pair without separation fronts, and the default (guided, fronts).
 
 #include <algorithm>
 #include <chrono>
@@ -259,10 +262,14 @@ void grasp_picture(const std::string& pictures) {
 /// What the sliding scene gave over all runs.
 struct SlidingRuns {
   std::vector<double> contact_ms;       ///< interaction step per frame in contact, all runs
+  std::vector<double> querying_ms;      ///< ... of those frames that made collision queries
   std::vector<double> run_medians;      ///< median of each run
   std::uint64_t frames_in_contact = 0;  ///< of the first run
   std::uint64_t mated = 0;
   std::size_t triangles = 0;
+  /// Height of the peg's tip over the hole's bottom at the end, the highest of all runs.
+  Real tip_over_bottom_m = -1;
+  std::uint64_t at_bottom = 0;  ///< runs that ended with the tip within 0.01 mm of the bottom
   /// Deepest overlap of peg and block over every frame of every run (the
   /// collision layer's contact depth), when measured.
   Real max_penetration = 0;
@@ -271,10 +278,21 @@ struct SlidingRuns {
   std::vector<double> contact_gap_m;
 };
 
+/// How the hand carries the peg.
+enum class Carry {
+  /// 1.5 mm off the hole's axis and tilted 2 degrees, straight down to 20 mm past the
+  /// bottom; the mate draws the peg onto the axis (Mate::position_tolerance).
+  kIntoHole,
+  /// Upright on the axis until its tip is 5 mm into the hole, 0.5 mm sideways (twice the
+  /// 0.25 mm the hole leaves), then down to 10 mm past the bottom: the peg slides 35 mm down
+  /// pressed against the wall. No mate, so nothing draws it off the wall.
+  kAlongWall,
+};
+
 /// The peg carried into the hole `runs` times with these sliding settings.
 SlidingRuns sliding_runs(int runs, const std::string& pictures,
                          const interaction::SlidingSettings& sliding_settings, double slow_ms,
-                         bool measure_penetration) {
+                         bool measure_penetration, Carry carry = Carry::kIntoHole) {
   constexpr Real kTop = 0.03, kDepth = 0.04, kLength = 0.06;
   const auto block = std::make_shared<const collision::Mesh>(
       collision::make_block_with_hole(Vec3(0.04, kTop, 0.04), 0.01025, kDepth, 64));
@@ -291,31 +309,43 @@ SlidingRuns sliding_runs(int runs, const std::string& pictures,
     peg_distance = collision::build_distance_model(peg);
   }
   for (int run = 0; run < runs; ++run) {
+    const bool wall = carry == Carry::kAlongWall;
+    const Real tilt_deg = wall ? 0 : -2;
     Transform X_WPeg;
-    X_WPeg.R = interaction::rotation_z_deg(-2) * interaction::rotation_x_deg(90);
-    X_WPeg.t = Vec3(0.0015, kTop + 0.01 + kLength, 0);
+    X_WPeg.R = interaction::rotation_z_deg(tilt_deg) * interaction::rotation_x_deg(90);
+    X_WPeg.t = Vec3(wall ? 0 : 0.0015, kTop + 0.01 + kLength, 0);
     engine::Scene scene;
     scene.add_part({.name = "block", .movable = false, .render_mesh = block});
     scene.add_part({.name = "peg", .X_PC = X_WPeg, .render_mesh = peg});
     engine::Simulation sim(std::move(scene), {.collision_threads = 1});
     GlovePlan p;
     p.start.p_WH = X_WPeg.t + Vec3(0, 0.05, 0.09);
-    p.start.q_WH = engine::quaternion_from_rotation(interaction::rotation_z_deg(-2));
+    p.start.q_WH = engine::quaternion_from_rotation(interaction::rotation_z_deg(tilt_deg));
     p.start_posture = *interaction::named_posture("power");
-    PlanStep down = reach(2.0, p.start.p_WH - Vec3(0, 0.09, 0));
-    down.poses[0].q_WH = p.start.q_WH;
-    p.steps = {down, close(0.3, "power"), close(0.3, "open")};
+    if (wall) {
+      PlanStep enter = reach(0.5, p.start.p_WH - Vec3(0, 0.015, 0));
+      PlanStep aside = reach(0.2, p.start.p_WH - Vec3(-0.0005, 0.015, 0));
+      PlanStep down = reach(1.5, p.start.p_WH - Vec3(-0.0005, 0.065, 0));
+      enter.poses[0].q_WH = aside.poses[0].q_WH = down.poses[0].q_WH = p.start.q_WH;
+      p.steps = {enter, aside, down, close(0.3, "power"), close(0.3, "open")};
+    } else {
+      PlanStep down = reach(2.0, p.start.p_WH - Vec3(0, 0.09, 0));
+      down.poses[0].q_WH = p.start.q_WH;
+      p.steps = {down, close(0.3, "power"), close(0.3, "open")};
+    }
     interaction::Hand hand(sim, std::make_shared<interaction::SimulatedGlove>(p));
     interaction::InteractionSettings interaction_settings;
     interaction_settings.sliding = sliding_settings;
     interaction::Grasping grasping(sim, hand, interaction_settings);
-    grasping.add_mate({.name = "peg_in_hole",
-                       .part = "peg",
-                       .p_PF = Vec3(0, 0, kLength),
-                       .axis_P = Vec3::UnitZ(),
-                       .other = "block",
-                       .p_OF = Vec3(0, kTop - kDepth, 0),
-                       .axis_O = -Vec3::UnitY()});
+    if (!wall) {
+      grasping.add_mate({.name = "peg_in_hole",
+                         .part = "peg",
+                         .p_PF = Vec3(0, 0, kLength),
+                         .axis_P = Vec3::UnitZ(),
+                         .other = "block",
+                         .p_OF = Vec3(0, kTop - kDepth, 0),
+                         .axis_O = -Vec3::UnitY()});
+    }
     grasping.hold("peg", interaction::GraspType::kPower);
     sim.prepare();
     std::vector<double> in_contact;
@@ -323,6 +353,9 @@ SlidingRuns sliding_runs(int runs, const std::string& pictures,
       const engine::FrameResult& r = sim.step();
       if (grasping.held() && grasping.last_slide().status != interaction::SlideStatus::kReached) {
         in_contact.push_back(grasping.stats().frame_ms);
+        if (grasping.last_slide().collision_queries > 0) {
+          out.querying_ms.push_back(grasping.stats().frame_ms);
+        }
         if (slow_ms > 0 && grasping.stats().frame_ms > slow_ms) {
           const interaction::SlideResult& s = grasping.last_slide();
           std::printf(
@@ -352,31 +385,39 @@ SlidingRuns sliding_runs(int runs, const std::string& pictures,
       }
     }
     if (run == 0) out.frames_in_contact = in_contact.size();
+    const Real tip_y = sim.scene().world_pose("peg").apply(Vec3(0, 0, kLength)).y();
+    out.tip_over_bottom_m = std::max(out.tip_over_bottom_m, tip_y - (kTop - kDepth));
+    out.at_bottom += tip_y - (kTop - kDepth) < 1e-5;
     out.contact_ms.insert(out.contact_ms.end(), in_contact.begin(), in_contact.end());
     out.run_medians.push_back(percentile(in_contact, 0.5));
   }
   return out;
 }
 
-void sliding(int runs, const std::string& pictures, bool pair_guided, bool fronts, double slow_ms) {
+void sliding(int runs, const std::string& pictures, bool pair_guided, bool fronts, double slow_ms,
+             Carry carry) {
   interaction::SlidingSettings settings;
   settings.pair_guided = pair_guided;
   settings.separation_fronts = fronts;
-  const SlidingRuns r = sliding_runs(runs, pictures, settings, slow_ms, false);
+  const SlidingRuns r = sliding_runs(runs, pictures, settings, slow_ms, false, carry);
   const std::vector<double>& contact_ms = r.contact_ms;
   const std::vector<double>& run_medians = r.run_medians;
   std::printf(
-      "sliding (%s%s): %zu-triangle peg into a hole, %llu frames in contact per run, mated in "
-      "%llu of %d runs\n",
-      pair_guided ? "pair-guided" : "plain", fronts ? "" : ", no fronts", r.triangles,
+      "sliding (%s%s%s): %zu-triangle peg into a hole, %llu frames in contact per run, mated in "
+      "%llu of %d runs, tip %.4f mm over the bottom at the end (highest run)\n",
+      pair_guided ? "pair-guided" : "plain", fronts ? "" : ", no fronts",
+      carry == Carry::kAlongWall ? ", along the wall" : "", r.triangles,
       static_cast<unsigned long long>(r.frames_in_contact),
-      static_cast<unsigned long long>(r.mated), runs);
+      static_cast<unsigned long long>(r.mated), runs, 1000 * r.tip_over_bottom_m);
   std::printf(
       "  interaction step ms per frame in contact: median %.4f  p95 %.4f  worst %.4f  "
       "run medians %.4f (%.4f..%.4f)\n",
       percentile(contact_ms, 0.5), percentile(contact_ms, 0.95), percentile(contact_ms, 1.0),
       percentile(run_medians, 0.5), *std::min_element(run_medians.begin(), run_medians.end()),
       *std::max_element(run_medians.begin(), run_medians.end()));
+  std::printf("  of them the %.0f a run that made collision queries: median %.4f  p95 %.4f\n",
+              static_cast<double>(r.querying_ms.size()) / runs, percentile(r.querying_ms, 0.5),
+              percentile(r.querying_ms, 0.95));
 }
 
 /// Sliding accuracy against its cost: the peg scene with the contact search's
@@ -409,26 +450,26 @@ void sliding_sweep(int runs, const std::string& table_path) {
   if (table) {
     std::fprintf(table,
                  "# setting median_ms p95_ms worst_ms max_penetration_mm median_gap_um "
-                 "p95_gap_um mated_runs runs\n");
+                 "p95_gap_um bottom_runs runs\n");
   }
   std::printf(
       "sliding sweep: %d runs each; ms per frame in contact; deepest overlap over all frames\n",
       runs);
-  std::printf("%-18s %9s %9s %9s %15s %14s %11s %6s\n", "setting", "median", "p95", "worst",
-              "penetration mm", "gap median um", "gap p95 um", "mated");
+  std::printf("%-18s %9s %9s %9s %15s %14s %11s %6s %10s\n", "setting", "median", "p95", "worst",
+              "penetration mm", "gap median um", "gap p95 um", "bottom", "tip mm");
   for (const Variant& v : variants) {
-    const SlidingRuns r = sliding_runs(runs, "", v.settings, 0, true);
+    const SlidingRuns r = sliding_runs(runs, "", v.settings, 0, true, Carry::kAlongWall);
     const double median = percentile(r.contact_ms, 0.5), p95 = percentile(r.contact_ms, 0.95),
                  worst = percentile(r.contact_ms, 1.0);
     const double gap_median = 1e6 * percentile(r.contact_gap_m, 0.5);
     const double gap_p95 = 1e6 * percentile(r.contact_gap_m, 0.95);
-    std::printf("%-18s %9.4f %9.4f %9.4f %15.6f %14.3f %11.3f %3llu/%d\n", v.name.c_str(), median,
-                p95, worst, 1000 * r.max_penetration, gap_median, gap_p95,
-                static_cast<unsigned long long>(r.mated), runs);
+    std::printf("%-18s %9.4f %9.4f %9.4f %15.6f %14.3f %11.3f %3llu/%d %10.4f\n", v.name.c_str(),
+                median, p95, worst, 1000 * r.max_penetration, gap_median, gap_p95,
+                static_cast<unsigned long long>(r.at_bottom), runs, 1000 * r.tip_over_bottom_m);
     if (table) {
       std::fprintf(table, "%s %.5f %.5f %.5f %.7f %.4f %.4f %llu %d\n", v.name.c_str(), median, p95,
                    worst, 1000 * r.max_penetration, gap_median, gap_p95,
-                   static_cast<unsigned long long>(r.mated), runs);
+                   static_cast<unsigned long long>(r.at_bottom), runs);
     }
   }
   if (table) std::fclose(table);
@@ -500,9 +541,12 @@ int main(int argc, char** argv) {
     }
   }
   fk_only();
-  sliding(runs, "", false, true, slow_ms);
-  sliding(runs, "", true, false, slow_ms);
-  sliding(runs, pictures, true, true, slow_ms);
+  for (const Carry carry : {Carry::kIntoHole, Carry::kAlongWall}) {
+    const std::string& shots = carry == Carry::kIntoHole ? pictures : std::string();
+    sliding(runs, "", false, true, slow_ms, carry);
+    sliding(runs, "", true, false, slow_ms, carry);
+    sliding(runs, shots, true, true, slow_ms, carry);
+  }
   if (!pictures.empty()) grasp_picture(pictures);
   return 0;
 }

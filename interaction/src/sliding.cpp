@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 
@@ -12,7 +13,7 @@ namespace dovetail::interaction {
 
 namespace {
 
-using Vec6 = Eigen::Matrix<Real, 6, 1>;
+using Vec6 = Motion;
 
 constexpr Real kDegree = std::numbers::pi / 180;
 
@@ -100,29 +101,6 @@ std::optional<SlideContact> pair_contact(const SlideRequest& request, const Hit&
   if (!(d.distance > 0)) return std::nullopt;
   return SlideContact{o.id, (d.p + d.q) / 2, (d.q - d.p) / d.distance,
                       collision::ContactKind::kPoint, 0};
-}
-
-/// The motion x = (v, w) closest to x_d in the metric diag(1, 1, 1, L^2, L^2, L^2) with
-/// a_i . x >= b_i for every contact: Hildreth's dual coordinate ascent, a fixed number of
-/// sweeps in a fixed order.
-Vec6 project(const Vec6& x_d, const std::vector<Vec6>& a, const std::vector<Real>& b, Real size,
-             int sweeps) {
-  Vec6 m_inv;
-  const Real l2 = size * size;
-  m_inv << 1, 1, 1, 1 / l2, 1 / l2, 1 / l2;
-  std::vector<Real> lambda(a.size(), 0);
-  std::vector<Real> norm(a.size());
-  for (std::size_t i = 0; i < a.size(); ++i) norm[i] = a[i].dot(m_inv.cwiseProduct(a[i]));
-  Vec6 x = x_d;
-  for (int sweep = 0; sweep < sweeps; ++sweep) {
-    for (std::size_t i = 0; i < a.size(); ++i) {
-      if (!(norm[i] > 0)) continue;
-      const Real step = std::max(-lambda[i], (b[i] - a[i].dot(x)) / norm[i]);
-      lambda[i] += step;
-      x += step * m_inv.cwiseProduct(a[i]);
-    }
-  }
-  return x;
 }
 
 /// The part at X_WP against every obstacle, exact first-hit queries: the
@@ -256,6 +234,79 @@ bool proves_free(const SlideProof* proof, const SlideRequest& request) {
 
 }  // namespace
 
+// Goldfarb and Idnani's dual method: from the unconstrained minimum it adds the most
+// violated constraint, walking along the M-shortest step (M = diag(1, 1, 1, L^2, L^2, L^2))
+// that keeps the active constraints tight and dropping an active one whose multiplier would
+// turn negative, until none is violated. Six unknowns: at most six active constraints, each
+// step a solve of their Gram matrix at most 6 x 6.
+std::optional<Motion> project_motion(const Motion& x_d, std::span<const Motion> a,
+                                     std::span<const Real> b, Real length) {
+  // Sized up to six on the stack: at most six constraints are active.
+  using Active = Eigen::Matrix<Real, 6, Eigen::Dynamic, 0, 6, 6>;
+  using Gram = Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+  using Multipliers = Eigen::Matrix<Real, Eigen::Dynamic, 1, 0, 6, 1>;
+  constexpr Real kInfinity = std::numeric_limits<Real>::infinity();
+  // A constraint counts as met within this (metres), far below what sliding resolves.
+  constexpr Real kSlack = 1e-15;
+  Motion m_inv;  // the metric's inverse, diagonal
+  m_inv << 1, 1, 1, 1 / (length * length), 1 / (length * length), 1 / (length * length);
+  Motion x = x_d;
+  std::vector<std::size_t> active;  // linearly independent, so at most six
+  std::vector<Real> u;              // their multipliers, never negative
+  const std::size_t budget = 8 * a.size() + 16;
+  std::size_t steps = 0;
+  while (true) {
+    // The most violated constraint, the first of equals; none left: x is the projection.
+    std::size_t p = a.size();
+    Real worst = -kSlack;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const Real s = a[i].dot(x) - b[i];
+      if (s < worst) worst = s, p = i;
+    }
+    if (p == a.size()) return x;
+    Real u_p = 0;
+    while (true) {
+      if (++steps > budget) return std::nullopt;  // not settled: not expected, but bounded
+      // z: the M-shortest step raising a_p . x with the active constraints held tight;
+      // r: how the active multipliers change along it.
+      const auto k = static_cast<Eigen::Index>(active.size());
+      Active N(6, k);
+      for (Eigen::Index j = 0; j < k; ++j) N.col(j) = a[active[static_cast<std::size_t>(j)]];
+      const Motion m_a = m_inv.cwiseProduct(a[p]);
+      Multipliers r(k);
+      Motion z = m_a;
+      if (k > 0) {
+        const Gram G = N.transpose() * m_inv.asDiagonal() * N;
+        r = G.ldlt().solve(N.transpose() * m_a);
+        z -= m_inv.asDiagonal() * (N * r);
+      }
+      // Full step: a_p's constraint becomes tight; none when a_p lies in the active span.
+      const Real rise = a[p].dot(z);
+      const bool dependent = !(rise > 1e-12 * a[p].dot(m_a));
+      const Real full = dependent ? kInfinity : (b[p] - a[p].dot(x)) / rise;
+      // Partial step: an active multiplier reaches zero first and that constraint is dropped.
+      Real partial = kInfinity;
+      std::size_t drop = active.size();
+      for (Eigen::Index j = 0; j < k; ++j) {
+        const auto i = static_cast<std::size_t>(j);
+        if (r[j] > 0 && u[i] / r[j] < partial) partial = u[i] / r[j], drop = i;
+      }
+      const Real t = std::min(full, partial);
+      if (t == kInfinity) return std::nullopt;  // a_p cannot be met with the others
+      if (!dependent) x += t * z;
+      for (Eigen::Index j = 0; j < k; ++j) u[static_cast<std::size_t>(j)] -= t * r[j];
+      u_p += t;
+      if (t == full) {
+        active.push_back(p);
+        u.push_back(u_p);
+        break;
+      }
+      active.erase(active.begin() + static_cast<std::ptrdiff_t>(drop));
+      u.erase(u.begin() + static_cast<std::ptrdiff_t>(drop));
+    }
+  }
+}
+
 Vec3 rotation_vector(const Mat3& R) {
   // Angle from the trace, axis from the skew part; near pi from the diagonal.
   const Real cos_angle = std::clamp((R.trace() - 1) / 2, Real{-1}, Real{1});
@@ -351,8 +402,15 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
       constraints.push_back(a);
       clearance.push_back(std::max<Real>(0, settings.skin_m - k.separation));
     }
-    const Vec6 allowed = project(wanted, constraints, clearance,
-                                 settings.turn_stiffness * request.size, settings.solver_sweeps);
+    // Contacts that ask to back out further than their common room allows (the part
+    // wedged between them) still forbid moving into them.
+    const Real metric = settings.turn_stiffness * request.size;
+    std::optional<Vec6> projected = project_motion(wanted, constraints, clearance, metric);
+    if (!projected) {
+      std::fill(clearance.begin(), clearance.end(), Real{0});
+      projected = project_motion(wanted, constraints, clearance, metric);
+    }
+    const Vec6 allowed = projected.value_or(Vec6::Zero());
     // 5. At rest: nothing left that the contacts allow.
     if (allowed.head<3>().norm() + allowed.tail<3>().norm() * request.size < settings.rest_m) {
       result.status = SlideStatus::kAtRest;

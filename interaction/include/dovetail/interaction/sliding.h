@@ -35,6 +35,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -64,7 +65,6 @@ struct SlidingSettings {
   /// Keep each obstacle's separation front between the queries of a held
   /// part (SlideFronts): the same answers for less work; false for comparison.
   bool separation_fronts = true;
-  int solver_sweeps = 64;    ///< passes over the contacts projecting the motion
   Real band_limit_m = 0.05;  ///< stretch (centre to centre) past which the band breaks
   Real band_limit_deg = 20;  ///< ... or angle between held and wanted orientation
   Real rest_m = 5e-6;        ///< a sub-step moving less than this ends the frame: at rest
@@ -196,6 +196,17 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings =
 /// Whether the part at X_WP collides with any obstacle (exact first-hit tests).
 bool collides(const collision::CollisionModel& part, const Transform& X_WP,
               std::span<const SlideObstacle> obstacles, int* queries = nullptr);
+
+/// A motion of a part: translation v of its centre (metres) over the turn w about it
+/// (rotation vector, radians).
+using Motion = Eigen::Matrix<Real, 6, 1>;
+
+/// The motion closest to `wanted` in the metric |v|^2 + length^2 |w|^2 with
+/// a_i . x >= b_i for every i, exactly (up to rounding): Goldfarb and Idnani's
+/// dual active-set method, deterministic. Nothing when no motion meets them all
+/// (or, not expected, when it does not settle within 8 steps a constraint).
+std::optional<Motion> project_motion(const Motion& wanted, std::span<const Motion> a,
+                                     std::span<const Real> b, Real length);
 
 /// The rotation vector (axis times angle, radians) of R, and its inverse.
 Vec3 rotation_vector(const Mat3& R);
