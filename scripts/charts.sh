@@ -63,7 +63,7 @@ GNUPLOT
   done
 }
 
-# Sliding: accuracy against cost, the peg carried into its hole.
+# Sliding: accuracy against cost, the peg slid down its hole's wall.
 echo "charts: sliding ($runs runs per setting)" >&2
 "$build/bench/hand_bench" --runs "$runs" --sweep docs/results/sliding_sweep.dat >docs/results/sliding_sweep.txt
 for format in png svg; do
@@ -72,12 +72,13 @@ for format in png svg; do
 set terminal $term
 set termoption noenhanced
 set output "docs/images/sliding_sweep.$format"
-set title "Sliding a 10,240-triangle peg into its hole: gap left at contact against cost"
+set title "Sliding a 10,240-triangle peg down its hole's wall: gap left at contact against cost"
 set xlabel "interaction step, 95th percentile over the frames in contact (ms)"
 set ylabel "gap between peg and block in contact, median (µm, log)"
 set logscale y
 set grid
 set key off
+set offsets graph 0.05, graph 0.25, 0, 0
 file = "docs/results/sliding_sweep.dat"
 plot file using 3:6 with points pt 7 ps 1.5, file using 3:6:(strcol(1)) with labels offset 1,0.6 left font ",9"
 GNUPLOT
