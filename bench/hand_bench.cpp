@@ -308,9 +308,10 @@ SlidingRuns sliding_runs(int runs, const std::string& pictures,
     block_distance = collision::build_distance_model(block);
     peg_distance = collision::build_distance_model(peg);
   }
+  const bool wall = carry == Carry::kAlongWall;
+  const Real tilt_deg = wall ? 0 : -2;
+  constexpr Real kBottom = kTop - kDepth;  // the hole's bottom, y in the world
   for (int run = 0; run < runs; ++run) {
-    const bool wall = carry == Carry::kAlongWall;
-    const Real tilt_deg = wall ? 0 : -2;
     Transform X_WPeg;
     X_WPeg.R = interaction::rotation_z_deg(tilt_deg) * interaction::rotation_x_deg(90);
     X_WPeg.t = Vec3(wall ? 0 : 0.0015, kTop + 0.01 + kLength, 0);
@@ -343,7 +344,7 @@ SlidingRuns sliding_runs(int runs, const std::string& pictures,
                          .p_PF = Vec3(0, 0, kLength),
                          .axis_P = Vec3::UnitZ(),
                          .other = "block",
-                         .p_OF = Vec3(0, kTop - kDepth, 0),
+                         .p_OF = Vec3(0, kBottom, 0),
                          .axis_O = -Vec3::UnitY()});
     }
     grasping.hold("peg", interaction::GraspType::kPower);
@@ -385,9 +386,10 @@ SlidingRuns sliding_runs(int runs, const std::string& pictures,
       }
     }
     if (run == 0) out.frames_in_contact = in_contact.size();
-    const Real tip_y = sim.scene().world_pose("peg").apply(Vec3(0, 0, kLength)).y();
-    out.tip_over_bottom_m = std::max(out.tip_over_bottom_m, tip_y - (kTop - kDepth));
-    out.at_bottom += tip_y - (kTop - kDepth) < 1e-5;
+    const Real tip_over_bottom =
+        sim.scene().world_pose("peg").apply(Vec3(0, 0, kLength)).y() - kBottom;
+    out.tip_over_bottom_m = std::max(out.tip_over_bottom_m, tip_over_bottom);
+    out.at_bottom += tip_over_bottom < 1e-5;
     out.contact_ms.insert(out.contact_ms.end(), in_contact.begin(), in_contact.end());
     out.run_medians.push_back(percentile(in_contact, 0.5));
   }
@@ -420,8 +422,8 @@ void sliding(int runs, const std::string& pictures, bool pair_guided, bool front
               percentile(r.querying_ms, 0.95));
 }
 
-/// Sliding accuracy against its cost: the peg scene with the contact search's
-/// resolution and sub-step budget varied, the deepest overlap of peg and block
+/// Sliding accuracy against its cost: the peg slid down the hole's wall with the contact
+/// search's resolution and sub-step budget varied, the deepest overlap of peg and block
 /// measured every frame. One line per setting on stdout and in `table`.
 void sliding_sweep(int runs, const std::string& table_path) {
   struct Variant {
@@ -542,7 +544,7 @@ int main(int argc, char** argv) {
   }
   fk_only();
   for (const Carry carry : {Carry::kIntoHole, Carry::kAlongWall}) {
-    const std::string& shots = carry == Carry::kIntoHole ? pictures : std::string();
+    const std::string shots = carry == Carry::kIntoHole ? pictures : std::string();
     sliding(runs, "", false, true, slow_ms, carry);
     sliding(runs, "", true, false, slow_ms, carry);
     sliding(runs, shots, true, true, slow_ms, carry);

@@ -13,8 +13,6 @@ namespace dovetail::interaction {
 
 namespace {
 
-using Vec6 = Motion;
-
 constexpr Real kDegree = std::numbers::pi / 180;
 
 /// X rotated by w about the point c (world) and moved by v.
@@ -388,16 +386,16 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
     ++result.substeps;
     // 4. The rest of the wanted motion, projected onto what the contacts allow.
     const Vec3 c = centre(result.X_WP);
-    Vec6 wanted;
+    Motion wanted;
     wanted << centre(request.X_WP_target) - c,
         rotation_vector(request.X_WP_target.R * result.X_WP.R.transpose());
     if (wanted.head<3>().norm() + wanted.tail<3>().norm() * request.size < settings.rest_m) break;
     // Each contact: not into it, and back out to the skin where closer (so that sliding
     // along a curved or faceted surface has room for what the first order misses).
-    std::vector<Vec6> constraints;
+    std::vector<Motion> constraints;
     std::vector<Real> clearance;
     for (const SlideContact& k : result.contacts) {
-      Vec6 a;
+      Motion a;
       a << k.n_W, (k.p_W - c).cross(k.n_W);
       constraints.push_back(a);
       clearance.push_back(std::max<Real>(0, settings.skin_m - k.separation));
@@ -405,12 +403,12 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
     // Contacts that ask to back out further than their common room allows (the part
     // wedged between them) still forbid moving into them.
     const Real metric = settings.turn_stiffness * request.size;
-    std::optional<Vec6> projected = project_motion(wanted, constraints, clearance, metric);
+    std::optional<Motion> projected = project_motion(wanted, constraints, clearance, metric);
     if (!projected) {
       std::fill(clearance.begin(), clearance.end(), Real{0});
       projected = project_motion(wanted, constraints, clearance, metric);
     }
-    const Vec6 allowed = projected.value_or(Vec6::Zero());
+    const Motion allowed = projected.value_or(Motion::Zero());
     // 5. At rest: nothing left that the contacts allow.
     if (allowed.head<3>().norm() + allowed.tail<3>().norm() * request.size < settings.rest_m) {
       result.status = SlideStatus::kAtRest;
