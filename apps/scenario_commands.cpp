@@ -20,7 +20,7 @@ namespace {
 constexpr const char* kRunHelp =
     R"(usage: dovetail run [SCENARIO] [--trace T] [--record T] [--report R.json]
                     [--render DIR [--every N]] [--threads N] [--quiet]
-                    [--capture DIR [--cross-check METHOD]]
+                    [--method METHOD] [--capture DIR [--cross-check METHOD]]
 
 Runs a Lua assembly scenario headless: the scene, the hand driven by the
 scenario's glove (or --trace), the rules and steps frame by frame, then checks
@@ -35,6 +35,9 @@ or its script fails. Without SCENARIO, runs the first shipped scenario
   --render DIR    write DIR/final.png, and with --every N every N-th frame
   --threads N     collision worker threads (default 1; the report is the same)
   --quiet         no progress meter and no summary on stdout
+  --method METHOD every exact pair on this hierarchy (boxtree, dop6, dop14, dop18,
+                  dop26, aabb, obb, brute) instead of the plan the pipeline makes
+                  per pair (the report's collision_plans say which and why)
   --capture DIR   failure capture: write every suspect collision query (a search
                   stopped at its iteration cap, a pose that is not finite, a
                   cross-check disagreement) with its inputs to DIR, to be
@@ -47,7 +50,7 @@ or its script fails. Without SCENARIO, runs the first shipped scenario
 constexpr const char* kReplayHelp =
     R"(usage: dovetail replay SCENARIO TRACE [--record T] [--report R.json]
                        [--render DIR [--every N]] [--threads N] [--quiet]
-                       [--capture DIR [--cross-check METHOD]]
+                       [--method METHOD] [--capture DIR [--cross-check METHOD]]
 
 `dovetail run SCENARIO --trace TRACE`: replays a recorded glove trace in the
 scenario. A trace recorded by `run --record` gives the identical report.
@@ -94,6 +97,11 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
     throw UsageError("run: --every needs --render DIR");
   options.threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
   options.progress = !args.flag("quiet") && stderr_is_terminal();
+  if (auto v = args.value("method")) {
+    options.method = collision::parse_method(*v);
+    if (!options.method)
+      throw UsageError("run: unknown --method '" + *v + "' (" + method_list() + ")");
+  }
   if (auto v = args.value("capture")) {
     options.capture_dir = *v;
     make_folder(*v);
@@ -178,10 +186,10 @@ int run_scenario_command(const Args& args, const std::filesystem::path& scenario
 }  // namespace
 
 int run_command(std::span<const std::string> argv) {
-  const Args args(
-      "run", argv,
-      {"trace", "record", "report", "render", "every", "threads", "capture", "cross-check"},
-      {"quiet"});
+  const Args args("run", argv,
+                  {"trace", "record", "report", "render", "every", "threads", "method", "capture",
+                   "cross-check"},
+                  {"quiet"});
   if (args.help()) {
     std::fputs(kRunHelp, stdout);
     return kExitOk;
@@ -196,9 +204,10 @@ int run_command(std::span<const std::string> argv) {
 }
 
 int replay_command(std::span<const std::string> argv) {
-  const Args args("replay", argv,
-                  {"record", "report", "render", "every", "threads", "capture", "cross-check"},
-                  {"quiet"});
+  const Args args(
+      "replay", argv,
+      {"record", "report", "render", "every", "threads", "method", "capture", "cross-check"},
+      {"quiet"});
   if (args.help()) {
     std::fputs(kReplayHelp, stdout);
     return kExitOk;

@@ -116,6 +116,19 @@ std::string Report::to_json(bool with_timings) const {
            ", \"max_contacts\": " + std::to_string(c.max_contacts) + "}";
   }
   out += contacts.empty() ? "]" : "\n  ]";
+  out += ",\n  \"collision_plans\": [";
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    const PairPlanReport& p = plans[i];
+    out += i == 0 ? "\n    " : ",\n    ";
+    out += "{\"a\": " + json_string(p.a) + ", \"b\": " + json_string(p.b) +
+           ", \"level\": " + json_string(p.level);
+    if (!p.method.empty()) out += ", \"method\": " + json_string(p.method);
+    out += std::string(", \"convex_level\": ") + (p.convex_level ? "true" : "false") +
+           ", \"front\": " + (p.front ? "true" : "false");
+    if (p.max_size > 0) out += ", \"max_size\": " + number(p.max_size);
+    out += ", \"reason\": " + json_string(p.reason) + "}";
+  }
+  out += plans.empty() ? "]" : "\n  ]";
   if (!notes.empty()) {
     out += ",\n  \"notes\": [";
     for (std::size_t i = 0; i < notes.size(); ++i) {

@@ -50,6 +50,7 @@ Simulation::Simulation(Scene scene, const SimulationSettings& settings)
   }
   world_ = std::make_unique<collision::CollisionWorld>(
       collision::WorldSettings{.method = settings_.method,
+                               .tolerance = settings_.tolerance,
                                .broadphase = settings_.broadphase,
                                .convex_level = settings_.convex_level,
                                .threads = settings_.collision_threads,
@@ -246,6 +247,7 @@ const FrameResult& Simulation::step() {
   const auto collision_start = std::chrono::steady_clock::now();
   const collision::StepResult& result = world_->step();
   const double collision_ms = ms_since(collision_start);
+  if (world_->plans_version() != plans_version_) update_plans();
 
   // 6. Events: differences from the last frame.
   contact_events(result, events, now);
@@ -279,6 +281,26 @@ const FrameResult& Simulation::step() {
   report_.state_hash = state_hash_;
   report_.timings.push_back({collision_ms, ms_since(frame_start)});
   return last_;
+}
+
+void Simulation::update_plans() {
+  plans_version_ = world_->plans_version();
+  for (const collision::PairPlan& plan : world_->plans()) {
+    std::string a = collision_names_.at(plan.pair.a);
+    std::string b = collision_names_.at(plan.pair.b);
+    if (b < a) std::swap(a, b);
+    plans_[{a, b}] = PairPlanReport{
+        .a = a,
+        .b = b,
+        .level = std::string(collision::level_name(plan.level)),
+        .method = plan.method ? std::string(collision::method_name(*plan.method)) : std::string(),
+        .convex_level = plan.convex_level,
+        .front = plan.front,
+        .max_size = plan.max_size,
+        .reason = plan.reason};
+  }
+  report_.plans.clear();
+  for (const auto& [key, plan] : plans_) report_.plans.push_back(plan);
 }
 
 std::uint64_t Simulation::run(std::uint64_t frames, bool progress) {

@@ -603,6 +603,25 @@ void Loader::read_scenario_fields(int table, const SourceLocation& where) {
       fail(where, "scenario: time_step must be in [0.0001, 1] s");
     scenario_.time_step = a.number;
   }
+  // "exact" or a length: not one of the argument types, so read here.
+  raw_getfield(table, "accuracy");
+  if (lua_type(L_, -1) == LUA_TNUMBER) {
+    const double tolerance = lua_tonumber(L_, -1);
+    if (!(tolerance > 0) || !std::isfinite(tolerance)) {
+      fail(where, "scenario: accuracy must be \"exact\" or a length > 0 (a tolerance), not " +
+                      format_number(tolerance));
+    }
+    scenario_.tolerance_m = tolerance * scenario_.metres_per_unit;
+  } else if (lua_type(L_, -1) != LUA_TNIL && !(lua_type(L_, -1) == LUA_TSTRING &&
+                                               std::string_view(lua_tostring(L_, -1)) == "exact")) {
+    fail(where,
+         std::string("scenario: accuracy must be \"exact\" or a length > 0 (a tolerance), "
+                     "not a ") +
+             luaL_typename(L_, -1) +
+             (lua_type(L_, -1) == LUA_TSTRING ? " \"" + std::string(lua_tostring(L_, -1)) + "\""
+                                              : std::string()));
+  }
+  lua_pop(L_, 1);
   auto with_field = [&](const char* name, auto read) {
     raw_getfield(table, name);
     if (lua_type(L_, -1) != LUA_TNIL) read(lua_gettop(L_));

@@ -325,6 +325,8 @@ void Runner::build() {
   engine::SimulationSettings settings;
   settings.time_step = scenario_.time_step;
   settings.collision_threads = options_.threads;
+  settings.method = options_.method;
+  settings.tolerance = options_.tolerance_m.value_or(scenario_.tolerance_m);
   if (options_.capture_dir) {
     capture_ = std::make_unique<collision::CaptureSink>(*options_.capture_dir);
     settings.capture = capture_.get();

@@ -23,6 +23,10 @@ std::vector<Word> make_vocabulary() {
         {"duration", kSeconds, kOptional,
          "simulated seconds to run (default: the glove's plan or trace, plus 1 s)"},
         {"time_step", kSeconds, kOptional, "seconds per frame (default 1/90)"},
+        {"accuracy", kText, kOptional,
+         "\"exact\" (default): parts touch exactly when their triangles meet; or a length, a "
+         "tolerance: parts that far apart may count as touching, and the pipeline picks "
+         "cheaper levels where they keep it (never a missed contact)"},
         {"parts", kMap, kRequired, "the parts by name: `peg = part { ... }`"},
         {"mates", kMap, kOptional, "the mates by name: `peg_in_hole = mate { ... }`"},
         {"regions", kMap, kOptional, "named boxes in the world: `tray = region { ... }`"},

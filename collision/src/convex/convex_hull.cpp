@@ -8,10 +8,12 @@
 #include <libqhull_r/qhull_ra.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -648,6 +650,48 @@ bool is_exact_hull(std::span<const Vec3> points, const std::vector<TriangleIndic
 }
 
 }  // namespace detail
+
+bool surface_on_hull(const ConvexHull& hull, std::span<const Vec3> points,
+                     std::span<const TriangleIndices> triangles) {
+  // The hull vertex at each point's exact position, if any.
+  std::map<std::array<Real, 3>, std::uint32_t> at;
+  for (std::uint32_t i = 0; i < hull.vertices.size(); ++i) {
+    const Vec3& v = hull.vertices[i];
+    at.emplace(std::array<Real, 3>{v.x(), v.y(), v.z()}, i);
+  }
+  // Signs of orient3d(a, b, c, .) over some hull vertices: supporting when
+  // they never take both signs; a plane no vertex leaves is degenerate.
+  const auto supports = [&](const Vec3& a, const Vec3& b, const Vec3& c, auto&& vertices) {
+    bool above = false, below = false;
+    for (const std::uint32_t v : vertices) {
+      const Real o = orient3d(a, b, c, hull.vertices[v]);
+      above = above || o > 0;
+      below = below || o < 0;
+      if (above && below) return false;
+    }
+    return above || below;
+  };
+  std::vector<std::uint32_t> every(hull.vertices.size());
+  for (std::uint32_t i = 0; i < every.size(); ++i) every[i] = i;
+  for (const TriangleIndices& t : triangles) {
+    const Vec3& a = points[t[0]];
+    const Vec3& b = points[t[1]];
+    const Vec3& c = points[t[2]];
+    std::span<const std::uint32_t> check = every;
+    for (const std::uint32_t corner : t) {
+      const Vec3& p = points[corner];
+      const auto it = at.find({p.x(), p.y(), p.z()});
+      if (it == at.end()) continue;
+      const std::uint32_t h = it->second;
+      check =
+          std::span<const std::uint32_t>(hull.neighbors.data() + hull.neighbor_offsets[h],
+                                         hull.neighbor_offsets[h + 1] - hull.neighbor_offsets[h]);
+      break;
+    }
+    if (!supports(a, b, c, check)) return false;
+  }
+  return true;
+}
 
 ConvexHull compute_convex_hull(std::span<const Vec3> points, const std::string& source) {
   return detail::build_convex_hull(points, source, nullptr, false);

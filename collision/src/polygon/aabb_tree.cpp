@@ -78,12 +78,17 @@ class AabbPolicy {
   detail::NodeLink link_b(std::uint32_t n) const { return b_.nodes_[n].link; }
   Real size_a(std::uint32_t n) const { return size(a_.nodes_[n]); }
   Real size_b(std::uint32_t n) const { return size(b_.nodes_[n]); }
+  Real diameter_a(std::uint32_t n) const { return diameter(a_.nodes_[n]); }
+  Real diameter_b(std::uint32_t n) const { return diameter(b_.nodes_[n]); }
   const std::uint32_t* slots_a() const { return a_.order_.data(); }
   const std::uint32_t* slots_b() const { return b_.order_.data(); }
 
  private:
   static Real size(const AabbTree::Node& n) {
     return (n.hi[0] - n.lo[0]) + (n.hi[1] - n.lo[1]) + (n.hi[2] - n.lo[2]);
+  }
+  static Real diameter(const AabbTree::Node& n) {
+    return Vec3(n.hi[0] - n.lo[0], n.hi[1] - n.lo[1], n.hi[2] - n.lo[2]).norm();
   }
   const AabbTree& a_;
   const AabbTree& b_;
@@ -199,6 +204,8 @@ class ObbPolicy {
   detail::NodeLink link_b(std::uint32_t n) const { return b_.nodes_[n].link; }
   Real size_a(std::uint32_t n) const { return a_.nodes_[n].half.sum(); }
   Real size_b(std::uint32_t n) const { return b_.nodes_[n].half.sum(); }
+  Real diameter_a(std::uint32_t n) const { return 2 * a_.nodes_[n].half.norm(); }
+  Real diameter_b(std::uint32_t n) const { return 2 * b_.nodes_[n].half.norm(); }
   const std::uint32_t* slots_a() const { return a_.order_.data(); }
   const std::uint32_t* slots_b() const { return b_.order_.data(); }
 

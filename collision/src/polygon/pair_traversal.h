@@ -30,6 +30,15 @@ concept HasGap = requires(const Policy& p, const typename Policy::EncA& ea,
   { p.gap(0u, ea, 0u, eb) } -> std::same_as<Real>;
 };
 
+/// Policies whose volumes bound the distance between their contents
+/// (CollideRequest::max_size): diameter_a(n) and diameter_b(n) at least the
+/// largest distance between two points of node n's volume.
+template <typename Policy>
+concept HasDiameter = requires(const Policy& p) {
+  { p.diameter_a(0u) } -> std::same_as<Real>;
+  { p.diameter_b(0u) } -> std::same_as<Real>;
+};
+
 template <typename Policy>
 class PairTraversal {
  public:
@@ -54,6 +63,10 @@ class PairTraversal {
   /// Time-critical detection (CollideRequest::max_depth): a pair of
   /// overlapping volumes this many levels below the roots is a hit.
   void cut_at_depth(int max_depth) { max_depth_ = max_depth; }
+
+  /// Detection within a tolerance (CollideRequest::max_size): a pair of
+  /// overlapping volumes whose diameters sum to at most `max_size` is a hit.
+  void cut_at_size(Real max_size) { max_size_ = max_size; }
 
   /// Overlapping node pairs breadth-first from the roots, until there are at
   /// least `target` or only leaf pairs remain.
@@ -170,6 +183,12 @@ class PairTraversal {
       tester_.volumes_hit();
       return;
     }
+    if constexpr (HasDiameter<Policy>) {
+      if (max_size_ > 0 && p_.diameter_a(a) + p_.diameter_b(b) <= max_size_) {
+        tester_.volumes_hit();
+        return;
+      }
+    }
     if (la.is_leaf() && lb.is_leaf()) {
       tester_.test_leaves(p_.slots_a() + la.first_slot(), la.count(),
                           p_.slots_b() + lb.first_slot(), lb.count());
@@ -211,6 +230,7 @@ class PairTraversal {
   int hint_levels_ = 0;
   int hint_countdown_ = 0;
   int max_depth_ = -1;  ///< negative: exact
+  Real max_size_ = 0;   ///< 0: exact
 };
 
 /// Levels above the intersecting leaf pair a TraversalHint records.
@@ -240,8 +260,9 @@ CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh
   const Policy policy(a, b, X_AB);
   PairTraversal<Policy> traversal(policy, tester);
   SeparationFront* front = nullptr;
+  const bool cut = request.max_depth >= 0 || (HasDiameter<Policy> && request.max_size > 0);
   if constexpr (HasGap<Policy>) {
-    if (request.max_depth < 0) front = request.front;
+    if (!cut) front = request.front;
   }
   const bool from_front = front && front->valid && front->tree_a == &a && front->tree_b == &b &&
                           front->nodes_a == a.node_count() && front->nodes_b == b.node_count() &&
@@ -256,8 +277,9 @@ CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh
     }
     traversal.run();
   };
-  if (request.max_depth >= 0 && !request.all_pairs) {
+  if (cut && !request.all_pairs) {
     traversal.cut_at_depth(request.max_depth);
+    traversal.cut_at_size(request.max_size);
     traversal.run();
   } else if (request.hint && !request.all_pairs) {
     traversal.record_hint(request.hint, kHintLevels);

@@ -2,12 +2,16 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <map>
+#include <optional>
 #include <stdexcept>
+#include <string>
 #include <unordered_map>
 #include <utility>
 
 #include "core/vertex_triangles.h"
+#include "dovetail/collision/containment.h"
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/distance.h"
 #include "dovetail/collision/task_system.h"
@@ -26,9 +30,14 @@ struct Shape {
   std::shared_ptr<const CollisionModel> check_model;
   /// Distance hierarchy, built for the first exact distance query.
   std::shared_ptr<const DistanceModel> distance_model;
-  std::shared_ptr<const ConvexHull> hull;  ///< convex level and tight world boxes
-  bool hull_failed = false;                ///< flat part: no hull, conservative boxes
-  Vec3 local_min, local_max;               ///< bounds in the part's frame
+  /// Convex level and tight world boxes of moving parts: built when a pair
+  /// of the part is first tested, not before.
+  std::shared_ptr<const ConvexHull> hull;
+  bool hull_failed = false;  ///< flat part: no hull, conservative boxes
+  /// Closed and on its hull (surface_on_hull): the hull is the part. Decided
+  /// with the hull, when a tolerance asks for it.
+  std::optional<bool> convex;
+  Vec3 local_min, local_max;  ///< bounds in the part's frame
   Real max_abs = 0;
   /// Triangles around each vertex. Built with the model in pairs mode; used
   /// to follow a moving contact from one triangle to the next.
@@ -60,6 +69,10 @@ struct PairState {
   /// First-hit mode: the subtree pair around the last hit, searched next
   /// when the witness and its neighbours no longer intersect.
   TraversalHint hint;
+  /// The box pairs the last query found apart (PairPlan::front).
+  SeparationFront front;
+  PairPlan plan;
+  bool planned = false;
 };
 
 std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
@@ -79,7 +92,7 @@ Transform relative(const Transform& X_WA, const Transform& X_WB) {
 struct PairWork {
   std::uint32_t a = 0, b = 0;
   LevelOfDetail level = LevelOfDetail::kExact;
-  PairState* state = nullptr;
+  PairState* state = nullptr;  ///< with its plan (not for a pair at the box level)
   // Outputs.
   bool colliding = false;
   bool convex_tested = false;
@@ -106,6 +119,7 @@ struct CollisionWorld::Impl {
   std::vector<PairWork> work;
   StepResult result;
   std::uint64_t steps = 0;  ///< step() calls so far, for the captures' context
+  std::uint64_t plans_version = 0;
 
   Part& part(PartId id) {
     if (id.index >= parts.size() || !parts[id.index].alive || parts[id.index].id != id) {
@@ -143,20 +157,32 @@ struct CollisionWorld::Impl {
 
   void ensure_model(Shape& shape) {
     if (shape.model) return;
-    shape.model = build_model(settings.method, shape.mesh);
+    shape.model = build_model(polygon_method(), shape.mesh);
     if (settings.contacts == ContactDetail::kPairs)
       shape.around = detail::VertexTriangles(*shape.mesh);
   }
 
+  Method polygon_method() const { return settings.method.value_or(Method::kObb); }
+
   /// The part's world box: extremal hull vertices found by walking from last
-  /// step's, or the transformed local box for a part without a hull; widened
+  /// step's; without a hull (none built yet, or a flat part), the box of the
+  /// transformed vertices for a fixed part (it moves seldom; the same box the
+  /// hull would give) and the transformed local box for a moving one; widened
   /// by a margin far above rounding so the box holds the part as every later
   /// stage computes it.
   Aabb world_box(Part& p) {
     const Shape& shape = *p.shape;
     const Transform& X = p.X_WP;
     Aabb box;
-    if (shape.hull) {
+    if (!shape.hull && !p.movable) {
+      box.min = Vec3::Constant(std::numeric_limits<Real>::infinity());
+      box.max = -box.min;
+      for (const Vec3& v : shape.mesh->vertices) {
+        const Vec3 v_W = X.apply(v);
+        box.min = box.min.cwiseMin(v_W);
+        box.max = box.max.cwiseMax(v_W);
+      }
+    } else if (shape.hull) {
       for (int k = 0; k < 3; ++k) {
         const Vec3 d_P = X.R.row(k).transpose();  // world axis k in the part's frame
         p.extremal[2 * k] = shape.hull->support(d_P, p.extremal[2 * k]);
@@ -188,36 +214,101 @@ struct CollisionWorld::Impl {
     return std::min(a.level, b.level);
   }
 
-  /// Decides one pair up to the polygon level; returns whether the polygon
-  /// level must still decide it.
+  /// Whether the shape is convex (surface_on_hull and closed); needs its hull.
+  static bool convex(Shape& shape) {
+    if (!shape.convex) {
+      shape.convex = shape.hull && is_closed(*shape.mesh) &&
+                     surface_on_hull(*shape.hull, shape.mesh->vertices, shape.mesh->triangles);
+    }
+    return *shape.convex;
+  }
+
+  /// Plans a pair on its first test (serially: it may build the two hulls).
+  void make_plan(const Part& a, const Part& b, PairState& state) {
+    PairPlan& plan = state.plan;
+    plan = PairPlan{.pair = {a.id, b.id}};
+    state.planned = true;
+    ++plans_version;
+    const LevelOfDetail asked = level_of(a, b);
+    if (asked == LevelOfDetail::kBox) {
+      plan.level = LevelOfDetail::kBox;
+      plan.reason = "the scene asks for the box level: boxes that overlap are in contact";
+      return;
+    }
+    ensure_hull(*a.shape);
+    ensure_hull(*b.shape);
+    const bool hulls = a.shape->hull && b.shape->hull;
+    if (asked == LevelOfDetail::kHull && hulls) {
+      plan.level = LevelOfDetail::kHull;
+      plan.convex_level = true;
+      plan.reason = "the scene asks for the hull level: GJK on the convex hulls";
+      return;
+    }
+    // GJK's touching band is kGjkContactTolerance of the pair's scale; a
+    // tolerance far above it is kept by the hull level of convex parts.
+    const Real scale = hulls ? a.shape->hull->extent + b.shape->hull->extent : 0;
+    if (settings.tolerance > 0 && hulls && settings.tolerance >= 1e-6 * scale && convex(*a.shape) &&
+        convex(*b.shape)) {
+      plan.level = LevelOfDetail::kHull;
+      plan.convex_level = true;
+      plan.reason =
+          "both parts are convex (closed, every triangle on the hull): the hulls are the parts, "
+          "and GJK on them decides contact far within the tolerance";
+      return;
+    }
+    plan.level = LevelOfDetail::kExact;
+    plan.convex_level = hulls && settings.convex_level;
+    plan.method = polygon_method();
+    plan.front = !settings.method;
+    const bool cuts = *plan.method == Method::kObb || *plan.method == Method::kAabb;
+    plan.max_size = cuts ? settings.tolerance : 0;
+    std::string why;
+    if (asked == LevelOfDetail::kHull)
+      why = "the scene asks for the hull level, but a part is flat (no hull): ";
+    else if (!hulls)
+      why = "a part is flat (no hull), so no convex level: ";
+    why += settings.method ? "the polygon level on the hierarchy the world was given (" +
+                                 std::string(method_name(*plan.method)) + ")"
+                           : std::string(
+                                 "the polygon level on OBB trees, the fastest exact hierarchy "
+                                 "measured, keeping the box pairs found apart from step to step");
+    if (plan.convex_level) why += ", after the separating-plane test";
+    if (settings.tolerance > 0) {
+      why += cuts ? "; a part is not convex, so its hull would not keep the tolerance: box pairs "
+                    "smaller than the tolerance count as contact"
+                  : "; a part is not convex, and this hierarchy has no tolerance cut: exact";
+    }
+    plan.reason = std::move(why);
+  }
+
+  /// Decides one pair up to the polygon level by its plan; returns whether
+  /// the polygon level must still decide it.
   bool evaluate_coarse(PairWork& w) {
     const Part& a = parts[w.a];
     const Part& b = parts[w.b];
-    if (w.level == LevelOfDetail::kBox) {
+    const PairPlan& plan = w.state->plan;
+    if (plan.level == LevelOfDetail::kBox) {
       w.colliding = true;
       return false;
     }
     const Transform X_AB = relative(a.X_WP, b.X_WP);
-    const bool have_hulls = a.shape->hull && b.shape->hull;
-    if (have_hulls && (settings.convex_level || w.level == LevelOfDetail::kHull)) {
-      const SeparatingPlaneResult plane =
+    if (plan.convex_level) {
+      const SeparatingPlaneResult separation =
           separating_plane_test(*a.shape->hull, *b.shape->hull, X_AB, w.state->plane);
       w.convex_tested = true;
-      w.cached_plane = plane.cache_hit;
-      w.search_capped = plane.gave_up && !plane.overlap &&
-                        plane.iterations >= SeparatingPlaneSettings{}.max_iterations;
-      if (plane.separated) {
+      w.cached_plane = separation.cache_hit;
+      w.search_capped = separation.gave_up && !separation.overlap &&
+                        separation.iterations >= SeparatingPlaneSettings{}.max_iterations;
+      if (separation.separated) {
         w.convex_separated = true;
         return false;
       }
-      if (w.level == LevelOfDetail::kHull) {
+      if (plan.level == LevelOfDetail::kHull) {
         const GjkResult g = gjk(*a.shape->hull, *b.shape->hull, X_AB, &w.state->gjk);
         w.colliding = g.intersecting;
         w.search_capped = w.search_capped || g.hit_iteration_cap;
         return false;
       }
-    } else if (w.level == LevelOfDetail::kHull) {
-      w.level = LevelOfDetail::kExact;  // a flat part has no hull: decide exactly
     }
     w.polygon = true;
     return true;
@@ -233,7 +324,8 @@ struct CollisionWorld::Impl {
     const Part& a = parts[w.a];
     const Part& b = parts[w.b];
     const Transform X_AB = relative(a.X_WP, b.X_WP);
-    const CollideRequest request = polygon_request();
+    CollideRequest request = polygon_request();
+    request.max_size = w.state->plan.max_size;
     if (!request.all_pairs && w.state->has_witness) {
       std::uint64_t tests = 0;
       if (follow_witness(*a.shape, *b.shape, X_AB, w.state->witness, tests)) {
@@ -247,10 +339,12 @@ struct CollisionWorld::Impl {
     const std::uint64_t witness_tests = w.result.stats.triangle_tests;
     CollideRequest hinted = request;
     if (!request.all_pairs) hinted.hint = &w.state->hint;
+    if (w.state->plan.front) hinted.front = &w.state->front;
     w.result = a.shape->model->collide(*b.shape->model, X_AB, hinted);
     w.result.stats.triangle_tests += witness_tests;
     w.colliding = w.result.colliding;
-    w.state->has_witness = !request.all_pairs && w.colliding;
+    // A hit of the tolerance cut has no triangle pair to follow.
+    w.state->has_witness = !request.all_pairs && w.colliding && !w.result.pairs.empty();
     if (w.state->has_witness) w.state->witness = w.result.pairs.front();
   }
 
@@ -483,10 +577,26 @@ struct CollisionWorld::Impl {
       const std::string verdict = w.colliding ? "intersecting" : "separate";
       const std::string other = check ? "intersecting" : "separate";
       record(CaptureKind::kMethodsDisagree,
-             (w.polygon ? std::string(method_name(settings.method)) + " says " + verdict
+             (w.polygon ? std::string(method_name(polygon_method())) + " says " + verdict
                         : std::string("the convex level separated the hulls")) +
                  ", " + std::string(method_name(*settings.cross_check)) + " says " + other);
     }
+  }
+
+  /// The polygon-level hierarchies of the pairs that reached that level,
+  /// built once per mesh, the meshes spread over the threads.
+  void build_models_for_polygon_pairs() {
+    std::vector<Shape*> todo;
+    for (const PairWork& w : work) {
+      if (!w.polygon) continue;
+      for (Shape* shape : {parts[w.a].shape.get(), parts[w.b].shape.get()}) {
+        if (!shape->model && std::find(todo.begin(), todo.end(), shape) == todo.end())
+          todo.push_back(shape);
+      }
+    }
+    tasks->parallel_for(todo.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) ensure_model(*todo[i]);
+    });
   }
 
   const StepResult& step() {
@@ -495,7 +605,6 @@ struct CollisionWorld::Impl {
     for (Part& p : parts) {
       if (!p.alive) continue;
       if (p.dirty || !p.in_broadphase) {
-        ensure_hull(*p.shape);
         const Aabb box = world_box(p);
         if (p.in_broadphase)
           broadphase->move(p.id.index, box);
@@ -509,7 +618,8 @@ struct CollisionWorld::Impl {
     broadphase->pairs(candidates);
     next.stats.box_pairs = candidates.size();
 
-    // 2. Pairs of interest, their levels, and what they need built (serially).
+    // 2. Pairs of interest and their plans (serially: planning a pair may
+    //    build its hulls).
     work.clear();
     for (const ProxyPair& c : candidates) {
       const Part& a = parts[c.a];
@@ -518,39 +628,34 @@ struct CollisionWorld::Impl {
       PairWork w;
       w.a = c.a;
       w.b = c.b;
-      w.level = level_of(a, b);
-      if (w.level != LevelOfDetail::kBox) {
-        w.state = &pair_states[pair_key(c.a, c.b)];
-        if (w.level == LevelOfDetail::kExact || a.shape->hull_failed || b.shape->hull_failed) {
-          ensure_model(*a.shape);
-          ensure_model(*b.shape);
-        }
-      }
+      w.state = &pair_states[pair_key(c.a, c.b)];
+      if (!w.state->planned) make_plan(a, b, *w.state);
+      w.level = w.state->plan.level;
       work.push_back(std::move(w));
     }
     next.stats.tested_pairs = work.size();
 
-    // 3. Decide the pairs in parallel over pairs (coarse grain); the polygon
-    //    level of heavy pairs is deferred and then split over the threads one
-    //    pair at a time (fine grain). Either way each pair's result is the same.
+    // 3. The box and convex levels in parallel over pairs; then the
+    //    hierarchies the polygon level needs and has not built yet (one task
+    //    per mesh); then the polygon level in parallel over pairs (coarse
+    //    grain), with heavy pairs each split over the threads (fine grain).
+    //    Either way each pair's result is the same.
+    tasks->parallel_for(work.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) evaluate_coarse(work[i]);
+    });
+    build_models_for_polygon_pairs();
     // First-hit queries are not split: a divided query may do different work
     // than an undivided one, and the counters must not depend on the threads.
     const bool split_heavy =
         tasks->thread_count() > 1 && settings.contacts == ContactDetail::kTriangles;
-    std::vector<char> deferred(work.size(), 0);
-    tasks->parallel_for(work.size(), 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        if (!evaluate_coarse(work[i])) continue;
-        if (split_heavy && heavy(work[i]))
-          deferred[i] = 1;
-        else
-          evaluate_polygon(work[i]);
-      }
-    });
-    std::vector<std::size_t> heavy_pairs;
+    std::vector<std::size_t> polygon_pairs, heavy_pairs;
     for (std::size_t i = 0; i < work.size(); ++i) {
-      if (deferred[i]) heavy_pairs.push_back(i);
+      if (!work[i].polygon) continue;
+      (split_heavy && heavy(work[i]) ? heavy_pairs : polygon_pairs).push_back(i);
     }
+    tasks->parallel_for(polygon_pairs.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) evaluate_polygon(work[polygon_pairs[i]]);
+    });
     if (!heavy_pairs.empty()) evaluate_split(heavy_pairs);
 
     if (settings.capture) capture_suspects();
@@ -634,6 +739,7 @@ void CollisionWorld::remove_part(PartId id) {
     return (key >> 32) == id.index || (key & 0xffffffffu) == id.index;
   };
   std::erase_if(w.pair_states, [&](const auto& kv) { return involves(kv.first); });
+  ++w.plans_version;
   std::erase_if(w.interest, [&](const auto& kv) { return involves(kv.first); });
   std::erase_if(w.levels, [&](const auto& kv) { return involves(kv.first); });
 }
@@ -662,6 +768,36 @@ void CollisionWorld::set_pair_level(PartId a, PartId b, LevelOfDetail level) {
   impl_->part(a);
   impl_->part(b);
   impl_->levels[pair_key(a.index, b.index)] = level;
+  // Planned again at the next test, with the new level.
+  const auto it = impl_->pair_states.find(pair_key(a.index, b.index));
+  if (it != impl_->pair_states.end() && it->second.planned) {
+    it->second.planned = false;
+    ++impl_->plans_version;
+  }
+}
+
+std::vector<PairPlan> CollisionWorld::plans() const {
+  std::vector<PairPlan> out;
+  for (const auto& [key, state] : impl_->pair_states) {
+    if (state.planned) out.push_back(state.plan);
+  }
+  std::sort(out.begin(), out.end(),
+            [](const PairPlan& x, const PairPlan& y) { return x.pair < y.pair; });
+  return out;
+}
+
+std::uint64_t CollisionWorld::plans_version() const { return impl_->plans_version; }
+
+std::string_view level_name(LevelOfDetail level) {
+  switch (level) {
+    case LevelOfDetail::kBox:
+      return "box";
+    case LevelOfDetail::kHull:
+      return "hull";
+    case LevelOfDetail::kExact:
+      return "exact";
+  }
+  return "exact";
 }
 
 PartDistance CollisionWorld::distance(PartId a, PartId b, const PartDistanceRequest& request) {

@@ -96,6 +96,14 @@ struct CollideRequest {
   /// collision, may report one that is not. Negative (the default): exact.
   /// Ignored by all-pairs queries and by the other methods.
   int max_depth = -1;
+  /// Detection within a tolerance: a first-hit query on the AABB and OBB
+  /// trees that meets two overlapping volumes whose diameters sum to at most
+  /// this stops there and reports colliding, with no triangle pair. A point
+  /// lies in both volumes, and every triangle under each is within that
+  /// volume's diameter of it, so the parts are then at most `max_size` apart.
+  /// Conservative: never misses a collision. 0 (the default): exact. Ignored
+  /// by all-pairs queries and by the other methods.
+  Real max_size = 0;
   /// Coherence across queries of the same two models (see SeparationFront):
   /// read where valid, rewritten by a query that visits all of it.
   SeparationFront* front = nullptr;

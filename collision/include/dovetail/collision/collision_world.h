@@ -18,6 +18,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "dovetail/collision/broadphase.h"
@@ -70,7 +71,18 @@ enum class ContactDetail : std::uint8_t {
 
 /// Pipeline settings.
 struct WorldSettings {
-  Method method = Method::kObb;  ///< polygon-level hierarchy
+  /// The polygon-level hierarchy of every pair. Unset (the default): the
+  /// world plans each pair itself (PairPlan): the OBB tree, the fastest exact
+  /// hierarchy measured, with a SeparationFront kept per pair across steps.
+  std::optional<Method> method{};
+  /// The accuracy the world must keep, in the meshes' units. 0 (the default):
+  /// exact, a pair is in contact exactly when its triangles intersect. A
+  /// tolerance > 0: a pair may also be reported in contact when its parts are
+  /// at most this far apart (solids: a part inside another is in contact);
+  /// no contact is ever missed. Each pair then takes the cheapest level that
+  /// keeps it (PairPlan): the hull level for two convex parts, a cut
+  /// hierarchy (CollideRequest::max_size) for others.
+  Real tolerance = 0;
   BroadphaseMethod broadphase = BroadphaseMethod::kSweepAndPrune;
   bool convex_level = true;  ///< separating-plane test before the polygon level
   int threads = 1;           ///< 1 = fully serial; 0 = one per hardware thread
@@ -109,6 +121,30 @@ struct PartPair {
   friend bool operator==(const PartPair&, const PartPair&) = default;
   friend auto operator<=>(const PartPair&, const PartPair&) = default;
 };
+
+/// How the world decides one pair, and why: made when the pair is first
+/// tested (its boxes overlap and it is of interest), from the parts' levels
+/// of detail, WorldSettings::tolerance and ::method, and the parts' shapes.
+///
+/// Why: a scene should be modelled no more precisely than it needs. A
+/// large fixed part nobody comes near never gets a hull or a hierarchy; two
+/// convex parts under a tolerance are decided on their hulls; everything
+/// else at the polygon level, which keeps, per pair, what the last step
+/// learned (the separating plane, the triangle pair in contact, the box
+/// pairs found apart).
+struct PairPlan {
+  PartPair pair;
+  LevelOfDetail level = LevelOfDetail::kExact;  ///< the level that decides the pair
+  bool convex_level = false;                    ///< the separating-plane test runs first
+  std::optional<Method> method{};  ///< the polygon level's hierarchy (exact level only)
+  bool front = false;              ///< a SeparationFront kept across steps
+  Real max_size = 0;               ///< the polygon level's tolerance cut (0: exact)
+  std::string reason{};            ///< one sentence: why this plan
+  friend bool operator==(const PairPlan&, const PairPlan&) = default;
+};
+
+/// Command-line and report name of a level: box, hull, exact.
+std::string_view level_name(LevelOfDetail level);
 
 /// What one step did at each level.
 struct StepStats {
@@ -194,6 +230,12 @@ class CollisionWorld {
   void set_interest(PartId a, PartId b, bool interested);
   /// Level of detail for one pair, overriding the parts' levels.
   void set_pair_level(PartId a, PartId b, LevelOfDetail level);
+
+  /// The plan of every pair tested so far and not removed, sorted by pair.
+  std::vector<PairPlan> plans() const;
+  /// Changes whenever plans() would give something new (a pair planned or
+  /// forgotten): cheap to poll every step.
+  std::uint64_t plans_version() const;
 
   /// Builds now, over the task system's threads, the hulls of all parts and
   /// the polygon-level hierarchies of all parts that can reach an exact pair

@@ -57,6 +57,17 @@ struct ConvexHull {
 /// pipeline then skips the convex level for it) or a qhull error.
 ConvexHull compute_convex_hull(std::span<const Vec3> points, const std::string& source);
 
+/// Whether every triangle lies in a supporting plane of `hull` (the hull of
+/// `points`), decided exactly: then the triangles lie on the hull's boundary,
+/// and a closed mesh of them (is_closed, containment.h) is that boundary, so
+/// the part is convex and its hull is the part itself. A triangle with a hull
+/// vertex is checked against that vertex's hull neighbours (on an exactly
+/// convex hull a plane through a vertex that no neighbour crosses supports
+/// the whole hull), any other against every hull vertex. A triangle whose
+/// three corners are collinear makes the answer false.
+bool surface_on_hull(const ConvexHull& hull, std::span<const Vec3> points,
+                     std::span<const TriangleIndices> triangles);
+
 /// Per-pair state of the separating-plane test, kept by the caller across frames.
 struct SeparatingPlaneCache {
   Vec3 normal = Vec3::UnitX();  ///< plane normal in A's frame, pointing from A to B

@@ -33,6 +33,20 @@ struct PairContactStats {
   friend bool operator==(const PairContactStats&, const PairContactStats&) = default;
 };
 
+/// How the collision pipeline decided one pair of parts, and why
+/// (collision::PairPlan), as the report states it.
+struct PairPlanReport {
+  std::string a{};  ///< first part, a < b by name
+  std::string b{};
+  std::string level{};        ///< box, hull or exact
+  std::string method{};       ///< the polygon level's hierarchy (exact level), else empty
+  bool convex_level = false;  ///< the separating-plane test runs first
+  bool front = false;         ///< box pairs found apart kept from step to step
+  double max_size = 0;        ///< the polygon level's tolerance cut, metres (0: exact)
+  std::string reason{};
+  friend bool operator==(const PairPlanReport&, const PairPlanReport&) = default;
+};
+
 /// Wall-clock cost of one frame; not deterministic, never part of the report proper.
 struct FrameTiming {
   double collision_ms = 0;  ///< the collision pipeline
@@ -47,6 +61,8 @@ struct Report {
   std::uint64_t state_hash = 0;
   std::vector<Event> events;               ///< the timeline, in delivery order
   std::vector<PairContactStats> contacts;  ///< sorted by (a, b)
+  /// The plan of every pair the collision pipeline tested, sorted by (a, b).
+  std::vector<PairPlanReport> plans;
   /// Things a reader should know (a joint angle clamped to its limit, ...),
   /// in the order noticed.
   std::vector<std::string> notes;

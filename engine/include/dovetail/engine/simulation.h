@@ -13,6 +13,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -28,7 +29,13 @@ namespace dovetail::engine {
 struct SimulationSettings {
   double time_step = 1.0 / 90.0;  ///< seconds per frame (90 Hz)
   int collision_threads = 1;      ///< worker threads of the pipeline; 0 = all cores
-  collision::Method method = collision::Method::kObb;
+  /// The polygon-level hierarchy of every pair; unset (the default): planned
+  /// per pair by the collision world (collision::PairPlan).
+  std::optional<collision::Method> method{};
+  /// The accuracy the collision world keeps, in metres: 0 (the default),
+  /// exact; > 0, contact may be reported up to this far apart
+  /// (collision::WorldSettings::tolerance).
+  double tolerance = 0;
   collision::BroadphaseMethod broadphase = collision::BroadphaseMethod::kSweepAndPrune;
   bool convex_level = true;
   /// Pairs (default): the pipeline only decides whether parts touch, enough
@@ -156,6 +163,7 @@ class Simulation {
   void contact_events(const collision::StepResult& step, std::vector<Event>& events, double now);
   void timer_events(std::vector<Event>& events, double now);
   void region_events(std::vector<Event>& events, double now);
+  void update_plans();
 
   Scene scene_;
   SimulationSettings settings_;
@@ -183,6 +191,9 @@ class Simulation {
   std::vector<collision::PartId> removed_;  ///< removed since the last collision step
   /// Contact statistics by (a, b) names.
   std::map<std::pair<std::string, std::string>, PairContactStats> contact_stats_;
+  /// Pair plans by (a, b) names, kept after a part is removed.
+  std::map<std::pair<std::string, std::string>, PairPlanReport> plans_;
+  std::uint64_t plans_version_ = 0;
   std::uint64_t frame_ = 0;
   bool paused_ = false;
   std::uint64_t state_hash_ = 0;

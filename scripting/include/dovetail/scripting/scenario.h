@@ -123,6 +123,9 @@ struct Scenario {
   std::uint64_t seed = 1;
   std::optional<double> duration{};
   double time_step = 1.0 / 90.0;
+  /// The collision accuracy the scenario asks for, in metres: 0, exact (the
+  /// default); > 0, a tolerance (collision::WorldSettings::tolerance).
+  double tolerance_m = 0;
   std::vector<PartSpec> parts{};  ///< in name order
   std::vector<MateSpec> mates{};  ///< in name order
   std::vector<RegionSpec> regions{};

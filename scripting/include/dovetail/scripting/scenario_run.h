@@ -43,6 +43,11 @@ struct RunOptions {
   std::optional<std::filesystem::path> capture_dir{};
   std::optional<collision::Method> cross_check{};
   SandboxLimits limits{};
+  /// Every pair on this polygon-level hierarchy instead of the planned one
+  /// (collision::PairPlan); for comparisons.
+  std::optional<collision::Method> method{};
+  /// Overrides the scenario's accuracy: metres, 0 exact.
+  std::optional<double> tolerance_m{};
 };
 
 /// One expectation's verdict.
