@@ -1,6 +1,7 @@
 #include "polygon/aabb_tree.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "polygon/pair_traversal.h"
@@ -78,8 +79,12 @@ class AabbPolicy {
   detail::NodeLink link_b(std::uint32_t n) const { return b_.nodes_[n].link; }
   Real size_a(std::uint32_t n) const { return size(a_.nodes_[n]); }
   Real size_b(std::uint32_t n) const { return size(b_.nodes_[n]); }
-  Real diameter_a(std::uint32_t n) const { return diameter(a_.nodes_[n]); }
-  Real diameter_b(std::uint32_t n) const { return diameter(b_.nodes_[n]); }
+  bool small_pair(std::uint32_t a, std::uint32_t b, Real max) const {
+    // The edge sums bound the diagonals from above by at most sqrt(3): most
+    // pairs are rejected without a square root.
+    if (size(a_.nodes_[a]) + size(b_.nodes_[b]) > std::sqrt(Real{3}) * max) return false;
+    return diameter(a_.nodes_[a]) + diameter(b_.nodes_[b]) <= max;
+  }
   const std::uint32_t* slots_a() const { return a_.order_.data(); }
   const std::uint32_t* slots_b() const { return b_.order_.data(); }
 
@@ -204,8 +209,14 @@ class ObbPolicy {
   detail::NodeLink link_b(std::uint32_t n) const { return b_.nodes_[n].link; }
   Real size_a(std::uint32_t n) const { return a_.nodes_[n].half.sum(); }
   Real size_b(std::uint32_t n) const { return b_.nodes_[n].half.sum(); }
-  Real diameter_a(std::uint32_t n) const { return 2 * a_.nodes_[n].half.norm(); }
-  Real diameter_b(std::uint32_t n) const { return 2 * b_.nodes_[n].half.norm(); }
+  bool small_pair(std::uint32_t a, std::uint32_t b, Real max) const {
+    // A box's diagonal 2|half| is at least 2 half.sum() / sqrt(3): most pairs
+    // are rejected without a square root.
+    const Vec3& ha = a_.nodes_[a].half;
+    const Vec3& hb = b_.nodes_[b].half;
+    if (2 * (ha.sum() + hb.sum()) > std::sqrt(Real{3}) * max) return false;
+    return 2 * (ha.norm() + hb.norm()) <= max;
+  }
   const std::uint32_t* slots_a() const { return a_.order_.data(); }
   const std::uint32_t* slots_b() const { return b_.order_.data(); }
 

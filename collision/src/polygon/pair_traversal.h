@@ -31,12 +31,11 @@ concept HasGap = requires(const Policy& p, const typename Policy::EncA& ea,
 };
 
 /// Policies whose volumes bound the distance between their contents
-/// (CollideRequest::max_size): diameter_a(n) and diameter_b(n) at least the
-/// largest distance between two points of node n's volume.
+/// (CollideRequest::max_size): small_pair(a, b, s) is true only when the
+/// diameters of node a's and node b's volumes sum to at most s.
 template <typename Policy>
 concept HasDiameter = requires(const Policy& p) {
-  { p.diameter_a(0u) } -> std::same_as<Real>;
-  { p.diameter_b(0u) } -> std::same_as<Real>;
+  { p.small_pair(0u, 0u, Real{0}) } -> std::same_as<bool>;
 };
 
 template <typename Policy>
@@ -184,7 +183,7 @@ class PairTraversal {
       return;
     }
     if constexpr (HasDiameter<Policy>) {
-      if (max_size_ > 0 && p_.diameter_a(a) + p_.diameter_b(b) <= max_size_) {
+      if (max_size_ > 0 && p_.small_pair(a, b, max_size_)) {
         tester_.volumes_hit();
         return;
       }
@@ -260,9 +259,10 @@ CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh
   const Policy policy(a, b, X_AB);
   PairTraversal<Policy> traversal(policy, tester);
   SeparationFront* front = nullptr;
-  const bool cut = request.max_depth >= 0 || (HasDiameter<Policy> && request.max_size > 0);
+  // A size cut stops a query at a hit, like a triangle pair does, and a
+  // query that finds none is an exact one: hint and front work as usual.
   if constexpr (HasGap<Policy>) {
-    if (!cut) front = request.front;
+    if (request.max_depth < 0) front = request.front;
   }
   const bool from_front = front && front->valid && front->tree_a == &a && front->tree_b == &b &&
                           front->nodes_a == a.node_count() && front->nodes_b == b.node_count() &&
@@ -277,9 +277,9 @@ CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh
     }
     traversal.run();
   };
-  if (cut && !request.all_pairs) {
+  if (!request.all_pairs) traversal.cut_at_size(request.max_size);
+  if (request.max_depth >= 0 && !request.all_pairs) {
     traversal.cut_at_depth(request.max_depth);
-    traversal.cut_at_size(request.max_size);
     traversal.run();
   } else if (request.hint && !request.all_pairs) {
     traversal.record_hint(request.hint, kHintLevels);

@@ -217,8 +217,10 @@ struct CollisionWorld::Impl {
   /// Whether the shape is convex (surface_on_hull and closed); needs its hull.
   static bool convex(Shape& shape) {
     if (!shape.convex) {
-      shape.convex = shape.hull && is_closed(*shape.mesh) &&
-                     surface_on_hull(*shape.hull, shape.mesh->vertices, shape.mesh->triangles);
+      // The surface test first: it stops at the first triangle off the hull.
+      shape.convex = shape.hull &&
+                     surface_on_hull(*shape.hull, shape.mesh->vertices, shape.mesh->triangles) &&
+                     is_closed(*shape.mesh);
     }
     return *shape.convex;
   }

@@ -98,9 +98,10 @@ struct CollideRequest {
   int max_depth = -1;
   /// Detection within a tolerance: a first-hit query on the AABB and OBB
   /// trees that meets two overlapping volumes whose diameters sum to at most
-  /// this stops there and reports colliding, with no triangle pair. A point
-  /// lies in both volumes, and every triangle under each is within that
-  /// volume's diameter of it, so the parts are then at most `max_size` apart.
+  /// this stops there and reports colliding, with no triangle pair. A point lies in both
+  /// volumes, and every triangle under each is within that volume's diameter
+  /// of it, so the parts are then at most `max_size` apart. Hint and front
+  /// work as in an exact query.
   /// Conservative: never misses a collision. 0 (the default): exact. Ignored
   /// by all-pairs queries and by the other methods.
   Real max_size = 0;
