@@ -321,7 +321,10 @@ TEST(Report, JsonFieldsAndTimingsApart) {
   for (const char* field :
        {"\"format\": \"dovetail-report\"", "\"time_step\": 0.011111111111111112", "\"frames\": 12",
         "\"parts\": 4", "\"state_hash\": \"0x", "\"events\": [", "\"contacts\": [",
-        "\"frames_in_contact\": 5", "\"kind\": \"timer\", \"a\": \"later\""}) {
+        "\"frames_in_contact\": 5", "\"kind\": \"timer\", \"a\": \"later\"",
+        "\"collision_plans\": [\n    {\"a\": \"block\", \"b\": \"slider\", \"level\": \"exact\", "
+        "\"method\": \"obb\", \"convex_level\": true, \"front\": true, \"reason\": \"the polygon "
+        "level on OBB trees"}) {
     EXPECT_NE(json.find(field), std::string::npos) << field << "\n" << json;
   }
   EXPECT_EQ(report.timings.size(), 12u);
