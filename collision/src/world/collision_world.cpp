@@ -92,7 +92,7 @@ Transform relative(const Transform& X_WA, const Transform& X_WB) {
 struct PairWork {
   std::uint32_t a = 0, b = 0;
   LevelOfDetail level = LevelOfDetail::kExact;
-  PairState* state = nullptr;  ///< with its plan (not for a pair at the box level)
+  PairState* state = nullptr;  ///< the pair's caches and its plan
   // Outputs.
   bool colliding = false;
   bool convex_tested = false;
