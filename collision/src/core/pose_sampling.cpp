@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 
 namespace dovetail::collision {
 
@@ -59,6 +60,46 @@ std::vector<Transform> random_poses(std::size_t count, Real extent, std::uint64_
   for (Transform& X : poses) {
     X.R = random_rotation(u);
     X.t = Vec3(u.in(-extent, extent), u.in(-extent, extent), u.in(-extent, extent));
+  }
+  return poses;
+}
+
+std::vector<Real> tumble_distances(const TumbleSettings& settings) {
+  const Real span = settings.last_distance - settings.first_distance;
+  if (!(settings.distance_step > 0) || !(span >= 0) || !std::isfinite(span) ||
+      span / settings.distance_step > 1e6) {
+    throw std::invalid_argument(
+        "tumble distances need a step > 0, last >= first and at most a million distances");
+  }
+  const auto count = static_cast<std::size_t>(std::floor(span / settings.distance_step + 1e-6)) + 1;
+  std::vector<Real> distances(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    distances[k] = settings.first_distance + static_cast<Real>(k) * settings.distance_step;
+  }
+  return distances;
+}
+
+std::vector<TumblePose> tumble_poses(const TumbleSettings& settings) {
+  if (settings.turns < 1) throw std::invalid_argument("a tumble needs at least one turn");
+  const std::vector<Real> distances = tumble_distances(settings);
+  const Vec3 axis = Vec3(1, 2, 3).normalized();
+  std::vector<Mat3> turns(static_cast<std::size_t>(settings.turns));
+  for (int k = 0; k < settings.turns; ++k) {
+    const Real angle = 2 * std::numbers::pi * k / settings.turns;
+    turns[static_cast<std::size_t>(k)] =
+        Eigen::AngleAxis<Real>(angle, axis).toRotationMatrix() *
+        Eigen::AngleAxis<Real>(2 * angle, Vec3::UnitZ()).toRotationMatrix();
+  }
+  std::vector<TumblePose> poses;
+  poses.reserve(distances.size() * turns.size());
+  for (std::size_t d = 0; d < distances.size(); ++d) {
+    for (const Mat3& R : turns) {
+      TumblePose pose;
+      pose.X_AB.R = R;
+      pose.X_AB.t = Vec3(distances[d], 0, 0);
+      pose.distance_index = d;
+      poses.push_back(pose);
+    }
   }
   return poses;
 }

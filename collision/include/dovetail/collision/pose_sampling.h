@@ -9,6 +9,7 @@
 /// object size (the larger bounding-box diagonal) from that contact distance,
 /// negative gaps pushing B into A.
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -35,6 +36,34 @@ struct SampledPose {
 /// the bisection. Order: for each direction, one pose per gap.
 std::vector<SampledPose> contact_distance_poses(const CollisionModel& a, const CollisionModel& b,
                                                 const ContactPoseSettings& settings);
+
+/// Zachmann's tumbling protocol: B's centre at distances along A's x axis
+/// from A's centre, and at each distance B turned through a full rotation in
+/// `turns` steps, about the oblique axis (1, 2, 3) and, twice as fast, about
+/// z. Meant for objects scaled into [-1, 1]^3, where distances 0 to 3 go
+/// from deep overlap to free.
+struct TumbleSettings {
+  Real first_distance = 0;
+  Real last_distance = 3;
+  Real distance_step = 0.1;
+  int turns = 360;
+};
+
+/// One pose of a tumble and the index of its distance in tumble_distances().
+struct TumblePose {
+  Transform X_AB;
+  std::size_t distance_index = 0;
+};
+
+/// first_distance + k * distance_step for k = 0, 1, ... up to last_distance
+/// (within a millionth of a step). Throws std::invalid_argument unless the
+/// step is > 0, last >= first and there are at most a million distances.
+std::vector<Real> tumble_distances(const TumbleSettings& settings);
+
+/// Every pose of the tumble, distance-major: for each distance, `turns`
+/// rotations. Throws std::invalid_argument as tumble_distances() does, or
+/// when turns < 1.
+std::vector<TumblePose> tumble_poses(const TumbleSettings& settings);
 
 /// `count` uniformly random rotations with translations uniform in the box
 /// [-extent, extent]^3, from a seeded generator (identical on every platform).
