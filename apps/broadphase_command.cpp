@@ -68,6 +68,50 @@ collision::Aabb read_box(LineReader& reader, std::uint64_t frame, std::uint64_t 
   return box;
 }
 
+/// What a run of the boxes file measured, kept when an input error stops it.
+struct BoxesRun {
+  std::uint64_t objects = 0, frames_done = 0, pairs_total = 0;
+  std::vector<double> frame_ms;
+};
+
+/// Frame by frame: reads every box, then updates and queries the broad phase
+/// and writes the pairs; the first input error, if any.
+std::optional<std::string> run_boxes(LineReader& reader, collision::Broadphase& broadphase,
+                                     BoxesRun& run, FramePairsOutput& output) {
+  try {
+    const FrameCounts counts = read_frame_counts(reader, "object");
+    run.objects = counts.items;
+    if (run.objects > kMaxObjects) reader.fail("more than 2^32 - 1 objects");
+    std::vector<collision::Aabb> boxes;
+    std::vector<collision::ProxyPair> pairs;
+    for (std::uint64_t f = 0; f < counts.frames; ++f) {
+      boxes.clear();
+      for (std::uint64_t i = 0; i < run.objects; ++i) {
+        boxes.push_back(read_box(reader, f, i, run.objects));
+      }
+      const auto start = std::chrono::steady_clock::now();
+      for (std::size_t i = 0; i < boxes.size(); ++i) {
+        const auto id = static_cast<collision::ProxyId>(i);
+        if (f == 0) {
+          broadphase.add(id, boxes[i]);
+        } else {
+          broadphase.move(id, boxes[i]);
+        }
+      }
+      broadphase.pairs(pairs);
+      run.frame_ms.push_back(ms_since(start));
+      ++run.frames_done;
+      run.pairs_total += pairs.size();
+      output.frame(f, pairs.size());
+      for (const collision::ProxyPair& p : pairs) output.pair(p.a, p.b);
+    }
+    expect_end(reader, counts);
+  } catch (const LineError& e) {
+    return e.message;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 int broadphase_command(std::span<const std::string> argv) {
@@ -93,54 +137,21 @@ int broadphase_command(std::span<const std::string> argv) {
   FramePairsOutput output("broadphase", out_path, inputs);
 
   LineReader reader(boxes_path);
-  std::unique_ptr<collision::Broadphase> broadphase = collision::make_broadphase(method);
-  std::uint64_t objects = 0, frames = 0, frames_done = 0, pairs_total = 0;
-  std::vector<double> frame_ms;
-  std::optional<std::string> error;
-  try {
-    const FrameCounts counts = read_frame_counts(reader, "object");
-    objects = counts.items;
-    frames = counts.frames;
-    if (objects > kMaxObjects) reader.fail("more than 2^32 - 1 objects");
-
-    // Frame by frame: read every box, then update and query the broad phase.
-    std::vector<collision::Aabb> boxes;
-    std::vector<collision::ProxyPair> pairs;
-    for (std::uint64_t f = 0; f < frames; ++f) {
-      boxes.clear();
-      for (std::uint64_t i = 0; i < objects; ++i) boxes.push_back(read_box(reader, f, i, objects));
-      const auto start = std::chrono::steady_clock::now();
-      for (std::size_t i = 0; i < boxes.size(); ++i) {
-        const auto id = static_cast<collision::ProxyId>(i);
-        if (f == 0) {
-          broadphase->add(id, boxes[i]);
-        } else {
-          broadphase->move(id, boxes[i]);
-        }
-      }
-      broadphase->pairs(pairs);
-      frame_ms.push_back(ms_since(start));
-      ++frames_done;
-      pairs_total += pairs.size();
-      output.frame(f, pairs.size());
-      for (const collision::ProxyPair& p : pairs) output.pair(p.a, p.b);
-    }
-    expect_end(reader, counts);
-  } catch (const LineError& e) {
-    error = e.message;
-  }
+  const std::unique_ptr<collision::Broadphase> broadphase = collision::make_broadphase(method);
+  BoxesRun run;
+  const std::optional<std::string> error = run_boxes(reader, *broadphase, run, output);
   output.close();
 
-  const std::vector<double> after_first(frame_ms.begin() + (frame_ms.empty() ? 0 : 1),
-                                        frame_ms.end());
+  const std::vector<double>& ms = run.frame_ms;
+  const std::vector<double> after_first(ms.begin() + (ms.empty() ? 0 : 1), ms.end());
   JsonLine json;
   json.add("method", collision::broadphase_name(method))
       .add("boxes", boxes_path)
-      .add("objects", objects)
-      .add("frames", frames_done)
+      .add("objects", run.objects)
+      .add("frames", run.frames_done)
       .add("ms_per_frame_median", round_ms(median(after_first)))
-      .add("ms_first_frame", frame_ms.empty() ? std::nan("") : round_ms(frame_ms.front()))
-      .add("pairs_total", pairs_total);
+      .add("ms_first_frame", ms.empty() ? std::nan("") : round_ms(ms.front()))
+      .add("pairs_total", run.pairs_total);
   if (error) json.add("error", *error);
   std::fputs((json.str() + "\n").c_str(), stdout);
 

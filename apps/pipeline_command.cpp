@@ -89,6 +89,95 @@ T named_option(const Args& args, const char* option, Parse parse, T fallback,
                    "'; valid: " + valid);
 }
 
+/// What a run of the scene measured, kept when an input error stops it.
+struct PipelineRun {
+  std::uint64_t parts = 0, frames = 0, frames_done = 0, pairs_total = 0;
+  double build_ms = 0;
+  std::vector<double> frame_ms;
+};
+
+/// Reads the N mesh paths (each file imported once, however many parts use
+/// it) and adds one part per path to the world.
+std::vector<collision::PartId> add_parts(LineReader& reader, const std::filesystem::path& folder,
+                                         std::uint64_t parts, collision::CollisionWorld& world) {
+  std::map<std::string, std::shared_ptr<const collision::Mesh>> meshes;
+  std::vector<collision::PartId> ids;
+  for (std::uint64_t i = 0; i < parts; ++i) {
+    if (!reader.next()) {
+      reader.fail("file ends after " + std::to_string(i) + " of " + std::to_string(parts) +
+                  " mesh paths");
+    }
+    std::string name = reader.text();
+    name.erase(0, name.find_first_not_of(" \t"));
+    name.erase(name.find_last_not_of(" \t") + 1);
+    std::shared_ptr<const collision::Mesh>& mesh = meshes[name];
+    if (!mesh) {
+      try {
+        mesh = std::make_shared<const collision::Mesh>(engine::import_mesh(folder / name));
+      } catch (const std::exception& e) {
+        reader.fail("mesh of part " + std::to_string(i) + ": " + e.what());
+      }
+    }
+    ids.push_back(world.add_part({.mesh = mesh,
+                                  .X_WP = collision::Transform{},
+                                  .movable = true,
+                                  .level = collision::LevelOfDetail::kExact,
+                                  .name = std::to_string(i)}));
+  }
+  return ids;
+}
+
+/// Reads and steps every frame, writing its colliding pairs (i < j, sorted).
+void run_frames(LineReader& reader, collision::CollisionWorld& world,
+                const std::vector<collision::PartId>& ids, PipelineRun& run,
+                FramePairsOutput& output) {
+  std::vector<collision::Transform> poses;
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> pairs;
+  for (std::uint64_t f = 0; f < run.frames; ++f) {
+    poses.clear();
+    for (std::uint64_t i = 0; i < run.parts; ++i) {
+      poses.push_back(read_pose(reader, f, i, run.parts));
+    }
+    const auto start = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < ids.size(); ++i) world.set_pose(ids[i], poses[i]);
+    const collision::StepResult& step = world.step();
+    run.frame_ms.push_back(ms_since(start));
+    pairs.clear();
+    for (const collision::PartPair& p : step.colliding) {
+      const std::uint64_t i = p.a.index, j = p.b.index;
+      pairs.emplace_back(std::min(i, j), std::max(i, j));
+    }
+    std::sort(pairs.begin(), pairs.end());
+    ++run.frames_done;
+    run.pairs_total += pairs.size();
+    output.frame(f, pairs.size());
+    for (const auto& [i, j] : pairs) output.pair(i, j);
+  }
+}
+
+/// Parses the scene and runs it; the first input error, if any.
+std::optional<std::string> run_scene(const std::string& scene_path,
+                                     collision::CollisionWorld& world, PipelineRun& run,
+                                     FramePairsOutput& output) {
+  LineReader reader(scene_path);
+  try {
+    const FrameCounts counts = read_frame_counts(reader, "part");
+    run.parts = counts.items;
+    run.frames = counts.frames;
+    if (run.parts > 1'000'000) reader.fail("more than 1,000,000 parts");
+    const std::vector<collision::PartId> ids =
+        add_parts(reader, std::filesystem::path(scene_path).parent_path(), run.parts, world);
+    const auto build_start = std::chrono::steady_clock::now();
+    world.prepare();
+    run.build_ms = ms_since(build_start);
+    run_frames(reader, world, ids, run, output);
+    expect_end(reader, counts);
+  } catch (const LineError& e) {
+    return e.message;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 int pipeline_command(std::span<const std::string> argv) {
@@ -105,13 +194,9 @@ int pipeline_command(std::span<const std::string> argv) {
   const collision::Method method =
       named_option(args, "method", collision::parse_method, collision::Method::kObb, method_list());
   const int threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
-  const std::optional<std::string> out_path = args.value("out");
 
   const std::string inputs[] = {scene_path};
-  FramePairsOutput output("pipeline", out_path, inputs);
-
-  LineReader reader(scene_path);
-  const std::filesystem::path folder = std::filesystem::path(scene_path).parent_path();
+  FramePairsOutput output("pipeline", args.value("out"), inputs);
   collision::CollisionWorld world({.method = method,
                                    .broadphase = broadphase,
                                    .convex_level = true,
@@ -119,83 +204,22 @@ int pipeline_command(std::span<const std::string> argv) {
                                    .contacts = collision::ContactDetail::kPairs,
                                    .capture = nullptr,
                                    .cross_check = std::nullopt});
-  std::uint64_t parts = 0, frames = 0, frames_done = 0, pairs_total = 0;
-  double build_ms = 0;
-  std::vector<double> frame_ms;
-  std::optional<std::string> error;
-  try {
-    const FrameCounts counts = read_frame_counts(reader, "part");
-    parts = counts.items;
-    frames = counts.frames;
-    if (parts > 1'000'000) reader.fail("more than 1,000,000 parts");
-
-    // The meshes, each file read once however many parts use it.
-    std::map<std::string, std::shared_ptr<const collision::Mesh>> meshes;
-    std::vector<collision::PartId> ids;
-    for (std::uint64_t i = 0; i < parts; ++i) {
-      if (!reader.next()) {
-        reader.fail("file ends after " + std::to_string(i) + " of " + std::to_string(parts) +
-                    " mesh paths");
-      }
-      std::string name = reader.text();
-      name.erase(0, name.find_first_not_of(" \t"));
-      name.erase(name.find_last_not_of(" \t") + 1);
-      std::shared_ptr<const collision::Mesh>& mesh = meshes[name];
-      if (!mesh) {
-        try {
-          mesh = std::make_shared<const collision::Mesh>(engine::import_mesh(folder / name));
-        } catch (const std::exception& e) {
-          reader.fail("mesh of part " + std::to_string(i) + ": " + e.what());
-        }
-      }
-      ids.push_back(world.add_part({.mesh = mesh,
-                                    .X_WP = collision::Transform{},
-                                    .movable = true,
-                                    .level = collision::LevelOfDetail::kExact,
-                                    .name = std::to_string(i)}));
-    }
-    const auto build_start = std::chrono::steady_clock::now();
-    world.prepare();
-    build_ms = ms_since(build_start);
-
-    std::vector<collision::Transform> poses;
-    std::vector<std::pair<std::uint64_t, std::uint64_t>> pairs;
-    for (std::uint64_t f = 0; f < frames; ++f) {
-      poses.clear();
-      for (std::uint64_t i = 0; i < parts; ++i) poses.push_back(read_pose(reader, f, i, parts));
-      const auto start = std::chrono::steady_clock::now();
-      for (std::size_t i = 0; i < ids.size(); ++i) world.set_pose(ids[i], poses[i]);
-      const collision::StepResult& step = world.step();
-      frame_ms.push_back(ms_since(start));
-      pairs.clear();
-      for (const collision::PartPair& p : step.colliding) {
-        const std::uint64_t i = p.a.index, j = p.b.index;
-        pairs.emplace_back(std::min(i, j), std::max(i, j));
-      }
-      std::sort(pairs.begin(), pairs.end());
-      ++frames_done;
-      pairs_total += pairs.size();
-      output.frame(f, pairs.size());
-      for (const auto& [i, j] : pairs) output.pair(i, j);
-    }
-    expect_end(reader, counts);
-  } catch (const LineError& e) {
-    error = e.message;
-  }
+  PipelineRun run;
+  const std::optional<std::string> error = run_scene(scene_path, world, run, output);
   output.close();
 
-  const std::vector<double> after_first(frame_ms.begin() + (frame_ms.empty() ? 0 : 1),
-                                        frame_ms.end());
+  const std::vector<double> after_first(run.frame_ms.begin() + (run.frame_ms.empty() ? 0 : 1),
+                                        run.frame_ms.end());
   JsonLine json;
   json.add("scene", scene_path)
       .add("broadphase", collision::broadphase_name(broadphase))
       .add("method", collision::method_name(method))
       .add("threads", threads)
-      .add("parts", parts)
-      .add("frames", frames_done)
-      .add("build_ms", round_ms(build_ms))
+      .add("parts", run.parts)
+      .add("frames", run.frames_done)
+      .add("build_ms", round_ms(run.build_ms))
       .add("ms_per_frame_median", round_ms(median(after_first)))
-      .add("pairs_total", pairs_total);
+      .add("pairs_total", run.pairs_total);
   if (error) json.add("error", *error);
   std::fputs((json.str() + "\n").c_str(), stdout);
 

@@ -46,6 +46,23 @@ std::string one_line(std::string text) {
 /// Shortest text that reads back as the same double.
 std::string shortest(double value) { return json_number(value); }
 
+/// The pose list with its comment header (the command line that makes it again).
+void write_poses(std::ofstream& out, const std::string& path_a, const std::string& path_b,
+                 const collision::ContactPoseSettings& settings,
+                 const std::vector<collision::SampledPose>& poses) {
+  std::string gaps_text;
+  for (double g : settings.gaps) {
+    if (!gaps_text.empty()) gaps_text += ',';
+    gaps_text += shortest(g);
+  }
+  out << "# dovetail poses " << one_line(path_a) << " " << one_line(path_b) << " --directions "
+      << settings.directions << " --seed " << settings.seed << " --gaps " << gaps_text << "\n";
+  out << "# tx ty tz qw qx qy qz gap\n";
+  for (const collision::SampledPose& pose : poses) {
+    out << engine::format_pose(pose.X_AB) << ' ' << shortest(pose.gap) << '\n';
+  }
+}
+
 }  // namespace
 
 int poses_command(std::span<const std::string> argv) {
@@ -79,17 +96,7 @@ int poses_command(std::span<const std::string> argv) {
       collision::contact_distance_poses(*model_a.model, *model_b.model, settings);
   const double generate_ms = ms_since(start);
 
-  std::string gaps_text;
-  for (double g : settings.gaps) {
-    if (!gaps_text.empty()) gaps_text += ',';
-    gaps_text += shortest(g);
-  }
-  out << "# dovetail poses " << one_line(path_a) << " " << one_line(path_b) << " --directions "
-      << settings.directions << " --seed " << settings.seed << " --gaps " << gaps_text << "\n";
-  out << "# tx ty tz qw qx qy qz gap\n";
-  for (const collision::SampledPose& pose : poses) {
-    out << engine::format_pose(pose.X_AB) << ' ' << shortest(pose.gap) << '\n';
-  }
+  write_poses(out, path_a, path_b, settings, poses);
   out.close();
   if (!out) throw InputError(out_path + ": write failed: " + std::strerror(errno));
 

@@ -19,6 +19,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "cli.h"
@@ -206,6 +207,58 @@ std::string html_text(const nlohmann::json& value) {
   return value.is_string() ? xml_escape(value.get<std::string>()) : xml_escape(value.dump());
 }
 
+/// One scenario's part of the HTML report: outcome, log, final frame,
+/// expectations, steps and event timeline.
+std::string html_scenario(const Job& j, const std::filesystem::path& out) {
+  std::string h;
+  const nlohmann::json& r = j.report;
+  h += "<div class=\"scenario\" id=\"" + xml_escape(j.stem) + "\"><h2>" + xml_escape(j.stem);
+  if (r.contains("scenario")) h += ": " + html_text(r["scenario"]);
+  h += " <span class=\"" + j.status + "\">" + j.status + "</span></h2>\n";
+  h += "<p>" + xml_escape(j.file.generic_string()) + "</p>\n";
+  if (!j.log.empty()) h += "<pre>" + xml_escape(j.log) + "</pre>\n";
+  const std::filesystem::path png = out / j.stem / "final.png";
+  if (std::filesystem::exists(png)) {
+    h += "<img alt=\"final frame of " + xml_escape(j.stem) + "\" src=\"data:image/png;base64," +
+         base64(read_file(png)) + "\">\n";
+  }
+  if (r.contains("expectations") && r["expectations"].is_array()) {
+    h += "<table><tr><th>expectation</th><th>where</th><th></th><th>detail</th></tr>\n";
+    for (const auto& e : r["expectations"]) {
+      const bool ok = e.value("passed", false);
+      h += "<tr><td><code>" + html_text(e.value("expect", "")) + "</code></td><td>" +
+           html_text(e.value("where", "")) + "</td><td class=\"" + (ok ? "passed" : "failed") +
+           "\">" + (ok ? "holds" : "fails") + "</td><td>" + html_text(e.value("detail", "")) +
+           "</td></tr>\n";
+    }
+    h += "</table>\n";
+  }
+  if (r.contains("steps") && r["steps"].is_array() && !r["steps"].empty()) {
+    h += "<table><tr><th>step</th><th>done at (s)</th></tr>\n";
+    for (const auto& s : r["steps"]) {
+      h += "<tr><td>" + html_text(s.value("name", "")) + "</td><td>" +
+           (s["done_at"].is_number() ? format_seconds(s["done_at"].get<double>())
+                                     : std::string("not done")) +
+           (s.value("out_of_order", false) ? " (out of order)" : "") + "</td></tr>\n";
+    }
+    h += "</table>\n";
+  }
+  if (r.contains("simulation") && r["simulation"].contains("events")) {
+    const auto& events = r["simulation"]["events"];
+    h += "<details><summary>event timeline (" + std::to_string(events.size()) +
+         " events)</summary><table><tr><th>time (s)</th><th>event</th><th>a</th><th>b</th></tr>\n";
+    for (const auto& e : events) {
+      h += "<tr><td>" +
+           (e["time"].is_number() ? format_seconds(e["time"].get<double>()) : std::string()) +
+           "</td><td>" + html_text(e.value("kind", "")) + "</td><td>" +
+           html_text(e.value("a", "")) + "</td><td>" + html_text(e.value("b", "")) + "</td></tr>\n";
+    }
+    h += "</table></details>\n";
+  }
+  h += "</div>\n";
+  return h;
+}
+
 void write_html(const std::vector<Job>& jobs, const std::filesystem::path& path,
                 const std::filesystem::path& out) {
   std::size_t passed = 0;
@@ -234,59 +287,92 @@ details{margin:.5em 0}
          (j.status == "passed" ? "" : xml_escape(first_reason(j))) + "</td></tr>\n";
   }
   h += "</table>\n";
-  for (const Job& j : jobs) {
-    const nlohmann::json& r = j.report;
-    h += "<div class=\"scenario\" id=\"" + xml_escape(j.stem) + "\"><h2>" + xml_escape(j.stem);
-    if (r.contains("scenario")) h += ": " + html_text(r["scenario"]);
-    h += " <span class=\"" + j.status + "\">" + j.status + "</span></h2>\n";
-    h += "<p>" + xml_escape(j.file.generic_string()) + "</p>\n";
-    if (!j.log.empty()) h += "<pre>" + xml_escape(j.log) + "</pre>\n";
-    const std::filesystem::path png = out / j.stem / "final.png";
-    if (std::filesystem::exists(png)) {
-      h += "<img alt=\"final frame of " + xml_escape(j.stem) + "\" src=\"data:image/png;base64," +
-           base64(read_file(png)) + "\">\n";
-    }
-    if (r.contains("expectations") && r["expectations"].is_array()) {
-      h += "<table><tr><th>expectation</th><th>where</th><th></th><th>detail</th></tr>\n";
-      for (const auto& e : r["expectations"]) {
-        const bool ok = e.value("passed", false);
-        h += "<tr><td><code>" + html_text(e.value("expect", "")) + "</code></td><td>" +
-             html_text(e.value("where", "")) + "</td><td class=\"" + (ok ? "passed" : "failed") +
-             "\">" + (ok ? "holds" : "fails") + "</td><td>" + html_text(e.value("detail", "")) +
-             "</td></tr>\n";
-      }
-      h += "</table>\n";
-    }
-    if (r.contains("steps") && r["steps"].is_array() && !r["steps"].empty()) {
-      h += "<table><tr><th>step</th><th>done at (s)</th></tr>\n";
-      for (const auto& s : r["steps"]) {
-        h += "<tr><td>" + html_text(s.value("name", "")) + "</td><td>" +
-             (s["done_at"].is_number() ? format_seconds(s["done_at"].get<double>())
-                                       : std::string("not done")) +
-             (s.value("out_of_order", false) ? " (out of order)" : "") + "</td></tr>\n";
-      }
-      h += "</table>\n";
-    }
-    if (r.contains("simulation") && r["simulation"].contains("events")) {
-      const auto& events = r["simulation"]["events"];
-      h +=
-          "<details><summary>event timeline (" + std::to_string(events.size()) +
-          " events)</summary><table><tr><th>time (s)</th><th>event</th><th>a</th><th>b</th></tr>\n";
-      for (const auto& e : events) {
-        h += "<tr><td>" +
-             (e["time"].is_number() ? format_seconds(e["time"].get<double>()) : std::string()) +
-             "</td><td>" + html_text(e.value("kind", "")) + "</td><td>" +
-             html_text(e.value("a", "")) + "</td><td>" + html_text(e.value("b", "")) +
-             "</td></tr>\n";
-      }
-      h += "</table></details>\n";
-    }
-    h += "</div>\n";
-  }
+  for (const Job& j : jobs) h += html_scenario(j, out);
   h += "</body></html>\n";
   std::ofstream file(path, std::ios::binary);
   file << h;
   if (!file.flush()) throw InputError(path.string() + ": cannot be written");
+}
+
+/// --shard K/N as (K, N); (1, 1) without it.
+std::pair<std::size_t, std::size_t> parse_shard(const Args& args) {
+  const std::optional<std::string> shard = args.value("shard");
+  if (!shard) return {1, 1};
+  unsigned long k = 0, n = 0;
+  char extra = 0;
+  if (std::sscanf(shard->c_str(), "%lu/%lu%c", &k, &n, &extra) != 2 || n == 0 || k == 0 || k > n) {
+    throw UsageError("regress: --shard must be K/N with 1 <= K <= N, not '" + *shard + "'");
+  }
+  return {k, n};
+}
+
+/// The scenarios of `folder` that fall to shard K of N (every N-th, in file-name order).
+std::vector<Job> shard_jobs(const std::filesystem::path& folder, std::size_t shard_k,
+                            std::size_t shard_n) {
+  const std::vector<std::filesystem::path> files = scenario_files(folder);
+  std::vector<Job> jobs;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    if (i % shard_n != shard_k - 1) continue;
+    Job job;
+    job.file = files[i];
+    job.stem = files[i].stem().string();
+    jobs.push_back(std::move(job));
+  }
+  if (jobs.empty()) {
+    std::fprintf(stderr, "regress: no scenarios in %s%s\n", folder.string().c_str(),
+                 shard_n > 1 ? " for this shard" : "");
+  }
+  return jobs;
+}
+
+/// Collects the child `pid` that ended with `wait_status` and prints its
+/// line; false when it is none of the jobs.
+bool collect(std::vector<Job>& jobs, pid_t pid, int wait_status, const std::filesystem::path& out) {
+  for (Job& job : jobs) {
+    if (job.pid != pid) continue;
+    finish(job, wait_status, out);
+    job.pid = -1;
+    std::printf("%-6s %-32s %8.2f s  %s\n",
+                job.status == "passed"   ? "PASS"
+                : job.status == "failed" ? "FAIL"
+                                         : "ERROR",
+                job.stem.c_str(), job.seconds,
+                job.status == "passed" ? "" : first_reason(job).c_str());
+    std::fflush(stdout);
+    return true;
+  }
+  return false;
+}
+
+/// Runs the jobs, `parallel` at a time, each in its own process killed after
+/// `timeout` seconds.
+void run_jobs(std::vector<Job>& jobs, const std::filesystem::path& out, std::size_t parallel,
+              int threads, double timeout) {
+  std::size_t next = 0, running = 0, done = 0;
+  while (done < jobs.size()) {
+    while (running < parallel && next < jobs.size()) {
+      start(jobs[next++], out, threads);
+      ++running;
+    }
+    int wait_status = 0;
+    const pid_t pid = waitpid(-1, &wait_status, WNOHANG);
+    if (pid > 0) {
+      if (collect(jobs, pid, wait_status, out)) {
+        --running;
+        ++done;
+      }
+      continue;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    for (Job& job : jobs) {
+      if (job.pid > 0 && !job.timed_out &&
+          std::chrono::duration<double>(now - job.start).count() > timeout) {
+        job.timed_out = true;
+        kill(job.pid, SIGKILL);
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
 }
 
 }  // namespace
@@ -305,68 +391,12 @@ int regress_command(std::span<const std::string> argv) {
   const auto parallel = static_cast<std::size_t>(args.integer("j", 1, 256).value_or(1));
   const int threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
   const double timeout = args.number("timeout", 1).value_or(900);
-  std::size_t shard_k = 1, shard_n = 1;
-  if (auto shard = args.value("shard")) {
-    unsigned long k = 0, n = 0;
-    char extra = 0;
-    if (std::sscanf(shard->c_str(), "%lu/%lu%c", &k, &n, &extra) != 2 || n == 0 || k == 0 ||
-        k > n) {
-      throw UsageError("regress: --shard must be K/N with 1 <= K <= N, not '" + *shard + "'");
-    }
-    shard_k = k;
-    shard_n = n;
-  }
+  const auto [shard_k, shard_n] = parse_shard(args);
   make_folder(out);
-  const std::vector<std::filesystem::path> files = scenario_files(folder);
-  std::vector<Job> jobs;
-  for (std::size_t i = 0; i < files.size(); ++i) {
-    if (i % shard_n != shard_k - 1) continue;
-    Job job;
-    job.file = files[i];
-    job.stem = files[i].stem().string();
-    jobs.push_back(std::move(job));
-  }
-  if (jobs.empty()) {
-    std::fprintf(stderr, "regress: no scenarios in %s%s\n", folder.string().c_str(),
-                 shard_n > 1 ? " for this shard" : "");
-  }
+  std::vector<Job> jobs = shard_jobs(folder, shard_k, shard_n);
 
   const auto begin = std::chrono::steady_clock::now();
-  std::size_t next = 0, running = 0, done = 0;
-  while (done < jobs.size()) {
-    while (running < parallel && next < jobs.size()) {
-      start(jobs[next++], out, threads);
-      ++running;
-    }
-    int wait_status = 0;
-    const pid_t pid = waitpid(-1, &wait_status, WNOHANG);
-    if (pid > 0) {
-      for (Job& job : jobs) {
-        if (job.pid != pid) continue;
-        finish(job, wait_status, out);
-        job.pid = -1;
-        --running;
-        ++done;
-        std::printf("%-6s %-32s %8.2f s  %s\n",
-                    job.status == "passed"   ? "PASS"
-                    : job.status == "failed" ? "FAIL"
-                                             : "ERROR",
-                    job.stem.c_str(), job.seconds,
-                    job.status == "passed" ? "" : first_reason(job).c_str());
-        std::fflush(stdout);
-      }
-      continue;
-    }
-    const auto now = std::chrono::steady_clock::now();
-    for (Job& job : jobs) {
-      if (job.pid > 0 && !job.timed_out &&
-          std::chrono::duration<double>(now - job.start).count() > timeout) {
-        job.timed_out = true;
-        kill(job.pid, SIGKILL);
-      }
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
+  run_jobs(jobs, out, parallel, threads, timeout);
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   std::size_t passed = 0;

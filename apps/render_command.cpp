@@ -124,6 +124,39 @@ engine::RenderScene scene_with_hand(const Args& args, const std::string& input,
   return scene;
 }
 
+/// UsageError naming the scene's cameras and the built-in views when
+/// `camera` is neither.
+void check_camera(const engine::RenderScene& scene, const std::string& camera,
+                  const std::string& input) {
+  if (engine::has_camera(scene, camera)) return;
+  std::string known;
+  for (const auto& entry : scene.cameras) known += (known.empty() ? "" : ", ") + entry.first;
+  std::string views;
+  for (const std::string& v : engine::builtin_views()) views += (views.empty() ? "" : ", ") + v;
+  throw UsageError("render: no camera named '" + camera + "' in " + input +
+                   " (its cameras: " + (known.empty() ? std::string("none") : known) +
+                   "; views: " + views + "; or auto)");
+}
+
+/// Renders and writes the PNG; the rendering's ms. InputError on failure.
+double render_to_png(const engine::RenderScene& scene, const engine::RenderSettings& settings,
+                     const std::string& input, const std::string& out) {
+  const auto start = std::chrono::steady_clock::now();
+  engine::Image image;
+  try {
+    image = engine::render(scene, settings);
+  } catch (const engine::RenderError& e) {
+    throw InputError(input + ": " + e.what());
+  }
+  const double render_ms = ms_since(start);
+  try {
+    engine::write_png(image, out);
+  } catch (const engine::RenderError& e) {
+    throw InputError(e.what());
+  }
+  return render_ms;
+}
+
 }  // namespace
 
 int render_command(std::span<const std::string> argv) {
@@ -163,29 +196,8 @@ int render_command(std::span<const std::string> argv) {
   const engine::RenderScene scene = with_hand ? scene_with_hand(args, input, trace, plan, triangles)
                                               : scene_of_file(input, triangles);
 
-  if (!engine::has_camera(scene, settings.camera)) {
-    std::string known;
-    for (const auto& entry : scene.cameras) known += (known.empty() ? "" : ", ") + entry.first;
-    std::string views;
-    for (const std::string& v : engine::builtin_views()) views += (views.empty() ? "" : ", ") + v;
-    throw UsageError("render: no camera named '" + settings.camera + "' in " + input +
-                     " (its cameras: " + (known.empty() ? std::string("none") : known) +
-                     "; views: " + views + "; or auto)");
-  }
-
-  const auto start = std::chrono::steady_clock::now();
-  engine::Image image;
-  try {
-    image = engine::render(scene, settings);
-  } catch (const engine::RenderError& e) {
-    throw InputError(input + ": " + e.what());
-  }
-  const double render_ms = ms_since(start);
-  try {
-    engine::write_png(image, out);
-  } catch (const engine::RenderError& e) {
-    throw InputError(e.what());
-  }
+  check_camera(scene, settings.camera, input);
+  const double render_ms = render_to_png(scene, settings, input, out);
 
   JsonLine json;
   json.add("input", input)
