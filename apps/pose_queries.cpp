@@ -1,15 +1,12 @@
 #include "pose_queries.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <limits>
 
 #include "cli.h"
+#include "dovetail/collision/task_system.h"
 
 namespace dovetail::cli {
 
@@ -43,12 +40,12 @@ double for_each_pose(std::size_t n, int threads, const std::function<void(std::s
   if (threads == 1 || n < 2) {
     for (std::size_t i = 0; i < n; ++i) one(i);
   } else {
-    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
-    arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n),
-                        [&](const tbb::blocked_range<std::size_t>& range) {
-                          for (std::size_t i = range.begin(); i != range.end(); ++i) one(i);
-                        });
+    // Threads come from the collision layer's task system, as everywhere
+    // else; a grain of 1: a pose's query may cost anything from a volume
+    // test to a deep traversal.
+    const std::unique_ptr<collision::TaskSystem> tasks = collision::make_task_system(threads);
+    tasks->parallel_for(n, 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i != end; ++i) one(i);
     });
   }
   return ms_since(start);
