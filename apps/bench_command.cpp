@@ -292,8 +292,7 @@ int tumble_protocol(const Args& args) {
   }
   check_table(args);
   const ProtocolPair pair = protocol_pair(args, bench::normalized);
-  std::vector<bench::Contender> contenders = bench::exact_contenders(pair.a, pair.b);
-  contenders.push_back(bench::hull_plane_contender(pair.a, pair.b));
+  const std::vector<bench::Contender> contenders = bench::tumble_contenders(pair.a, pair.b);
   const bench::TumbleResult result =
       bench::run_tumble(contenders, settings, terminal_progress("tumbling"));
   bench::print_tumble(stdout, contenders, result);
@@ -301,13 +300,7 @@ int tumble_protocol(const Args& args) {
   std::vector<std::string> items;
   std::size_t disagreements = 0;
   for (std::size_t c = 0; c < contenders.size(); ++c) {
-    bench::TumbleCell all;
-    for (const bench::TumbleCell& x : result.cells[c]) {
-      all.colliding += x.colliding;
-      all.free += x.free;
-      all.sum_us_colliding += x.sum_us_colliding;
-      all.sum_us_free += x.sum_us_free;
-    }
+    const bench::TumbleCell all = bench::total(result.cells[c]);
     JsonLine item;
     item.add("method", contenders[c].name)
         .add("exact", contenders[c].exact)
@@ -340,15 +333,8 @@ int poses_protocol(const Args& args) {
   const int runs = static_cast<int>(args.integer("runs", 1, 1000).value_or(5));
   check_table(args);
   const ProtocolPair pair = protocol_pair(args, [](collision::Mesh m) { return m; });
-  const auto pose_a = collision::build_model(collision::Method::kBoxtree, pair.a);
-  const auto pose_b =
-      pair.a == pair.b ? pose_a : collision::build_model(collision::Method::kBoxtree, pair.b);
-  const std::vector<collision::SampledPose> poses =
-      collision::contact_distance_poses(*pose_a, *pose_b, settings);
-  std::vector<bench::Contender> contenders = bench::exact_contenders(pair.a, pair.b);
-  for (bench::Contender& c : bench::approximate_contenders(pair.a, pair.b)) {
-    contenders.push_back(std::move(c));
-  }
+  const std::vector<collision::SampledPose> poses = bench::contact_poses(pair.a, pair.b, settings);
+  const std::vector<bench::Contender> contenders = bench::contact_pose_contenders(pair.a, pair.b);
   const bench::PoseResult result =
       bench::run_contact_poses(contenders, poses, settings.gaps, runs, terminal_progress("timing"));
   bench::print_contact_poses(stdout, contenders, result);

@@ -92,16 +92,9 @@ int run(const Options& options) {
   collision::ContactPoseSettings pose_settings;
   pose_settings.directions = options.directions;
   pose_settings.seed = options.seed;
-  const auto pose_model_a = collision::build_model(collision::Method::kObb, pair.a);
-  const auto pose_model_b =
-      pair.a == pair.b ? pose_model_a : collision::build_model(collision::Method::kObb, pair.b);
   const std::vector<collision::SampledPose> poses =
-      collision::contact_distance_poses(*pose_model_a, *pose_model_b, pose_settings);
-
-  std::vector<bench::Contender> contenders = bench::exact_contenders(pair.a, pair.b);
-  for (bench::Contender& c : bench::approximate_contenders(pair.a, pair.b)) {
-    contenders.push_back(std::move(c));
-  }
+      bench::contact_poses(pair.a, pair.b, pose_settings);
+  std::vector<bench::Contender> contenders = bench::contact_pose_contenders(pair.a, pair.b);
   for (bench::Contender& peer : bench::peer_contenders(pair.a, pair.b, true)) {
     contenders.push_back(std::move(peer));
   }

@@ -76,8 +76,7 @@ Options parse(int argc, char** argv) {
 
 int run(const Options& options) {
   const bench::MeshPair pair = bench::mesh_pair(options.mesh_a, options.mesh_b, bench::normalized);
-  std::vector<bench::Contender> contenders = bench::exact_contenders(pair.a, pair.b);
-  contenders.push_back(bench::hull_plane_contender(pair.a, pair.b));
+  std::vector<bench::Contender> contenders = bench::tumble_contenders(pair.a, pair.b);
   for (bench::Contender& peer : bench::peer_contenders(pair.a, pair.b, true)) {
     contenders.push_back(std::move(peer));
   }

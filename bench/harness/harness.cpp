@@ -67,6 +67,21 @@ HullPair build_hulls(const MeshPtr& a, const MeshPtr& b) {
   return pair;
 }
 
+/// A convex-level approximation on both hulls.
+Contender hull_contender(std::string name, std::string family, const HullPair& hulls,
+                         std::function<bool(const collision::ConvexHull&,
+                                            const collision::ConvexHull&, const Transform&)>
+                             query) {
+  Contender c;
+  c.name = std::move(name);
+  c.family = std::move(family);
+  c.exact = false;
+  c.build_ms = hulls.build_ms;
+  c.query = [a = hulls.a, b = hulls.b, query = std::move(query)](
+                const Transform& X, CollideStats&) { return query(*a, *b, X); };
+  return c;
+}
+
 /// A hierarchy's query with `request`, adding its counters to the work.
 Contender hierarchy_contender(std::string name, std::string family, bool exact,
                               const ModelPair& models, collision::CollideRequest request) {
@@ -149,42 +164,64 @@ std::vector<Contender> approximate_contenders(const MeshPtr& a, const MeshPtr& b
     }
   }
   const HullPair hulls = build_hulls(a, b);
-  Contender hull;
-  hull.name = "hull";
-  hull.family = "hull";
-  hull.exact = false;
-  hull.build_ms = hulls.build_ms;
-  hull.query = [a = hulls.a, b = hulls.b](const Transform& X, CollideStats&) {
-    return collision::gjk(*a, *b, X).intersecting;
-  };
-  contenders.push_back(std::move(hull));
+  contenders.push_back(
+      hull_contender("hull", "hull", hulls,
+                     [](const collision::ConvexHull& ha, const collision::ConvexHull& hb,
+                        const Transform& X) { return collision::gjk(ha, hb, X).intersecting; }));
   for (const int cap : {1, 2, 4, 8, 16, 64}) {
-    Contender plane;
-    plane.name = "plane cap " + std::to_string(cap);
-    plane.family = "plane";
-    plane.exact = false;
-    plane.build_ms = hulls.build_ms;
-    plane.query = [a = hulls.a, b = hulls.b, cap](const Transform& X, CollideStats&) {
-      collision::SeparatingPlaneCache cache;
-      return !collision::separating_plane_test(*a, *b, X, cache, {.max_iterations = cap}).separated;
-    };
-    contenders.push_back(std::move(plane));
+    contenders.push_back(hull_contender("plane cap " + std::to_string(cap), "plane", hulls,
+                                        [cap](const collision::ConvexHull& ha,
+                                              const collision::ConvexHull& hb, const Transform& X) {
+                                          collision::SeparatingPlaneCache cache;
+                                          return !collision::separating_plane_test(
+                                                      ha, hb, X, cache, {.max_iterations = cap})
+                                                      .separated;
+                                        }));
   }
   return contenders;
 }
 
 Contender hull_plane_contender(const MeshPtr& a, const MeshPtr& b) {
-  const HullPair hulls = build_hulls(a, b);
-  Contender c;
-  c.name = "hull-plane";
-  c.family = "plane";
-  c.exact = false;
-  c.build_ms = hulls.build_ms;
   auto cache = std::make_shared<collision::SeparatingPlaneCache>();
-  c.query = [a = hulls.a, b = hulls.b, cache](const Transform& X, CollideStats&) {
-    return !collision::separating_plane_test(*a, *b, X, *cache).separated;
-  };
-  return c;
+  return hull_contender("hull-plane", "plane", build_hulls(a, b),
+                        [cache](const collision::ConvexHull& ha, const collision::ConvexHull& hb,
+                                const Transform& X) {
+                          return !collision::separating_plane_test(ha, hb, X, *cache).separated;
+                        });
+}
+
+std::vector<Contender> tumble_contenders(const MeshPtr& a, const MeshPtr& b) {
+  std::vector<Contender> contenders = exact_contenders(a, b);
+  contenders.push_back(hull_plane_contender(a, b));
+  return contenders;
+}
+
+std::vector<Contender> contact_pose_contenders(const MeshPtr& a, const MeshPtr& b) {
+  std::vector<Contender> contenders = exact_contenders(a, b);
+  for (Contender& c : approximate_contenders(a, b)) contenders.push_back(std::move(c));
+  return contenders;
+}
+
+std::vector<collision::SampledPose> contact_poses(const MeshPtr& a, const MeshPtr& b,
+                                                  const collision::ContactPoseSettings& settings) {
+  const auto model_a = collision::build_model(Method::kObb, a);
+  const auto model_b = a == b ? model_a : collision::build_model(Method::kObb, b);
+  return collision::contact_distance_poses(*model_a, *model_b, settings);
+}
+
+TumbleCell total(const std::vector<TumbleCell>& cells) {
+  TumbleCell all;
+  for (const TumbleCell& x : cells) {
+    all.colliding += x.colliding;
+    all.free += x.free;
+    all.sum_us_colliding += x.sum_us_colliding;
+    all.sum_us_free += x.sum_us_free;
+    all.max_us_colliding = std::max(all.max_us_colliding, x.max_us_colliding);
+    all.max_us_free = std::max(all.max_us_free, x.max_us_free);
+    all.volume_tests += x.volume_tests;
+    all.triangle_tests += x.triangle_tests;
+  }
+  return all;
 }
 
 TumbleResult run_tumble(const std::vector<Contender>& contenders,
@@ -237,17 +274,7 @@ void print_tumble(std::FILE* out, const std::vector<Contender>& contenders,
   std::fprintf(out, "%-14s %10s %10s %10s %10s %12s %12s %9s\n", "method", "colliding", "(max)",
                "free", "(max)", "volume tests", "tri tests", "differ");
   for (std::size_t c = 0; c < contenders.size(); ++c) {
-    TumbleCell all;
-    for (const TumbleCell& x : result.cells[c]) {
-      all.colliding += x.colliding;
-      all.free += x.free;
-      all.sum_us_colliding += x.sum_us_colliding;
-      all.sum_us_free += x.sum_us_free;
-      all.max_us_colliding = std::max(all.max_us_colliding, x.max_us_colliding);
-      all.max_us_free = std::max(all.max_us_free, x.max_us_free);
-      all.volume_tests += x.volume_tests;
-      all.triangle_tests += x.triangle_tests;
-    }
+    const TumbleCell all = total(result.cells[c]);
     const double n = std::max(1, all.colliding + all.free);
     const std::string differ = c == result.reference ? "reference"
                                : contenders[c].exact ? std::to_string(result.disagreements[c])

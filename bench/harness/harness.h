@@ -64,6 +64,20 @@ std::vector<Contender> approximate_contenders(const MeshPtr& a, const MeshPtr& b
 /// as colliding).
 Contender hull_plane_contender(const MeshPtr& a, const MeshPtr& b);
 
+/// What `dovetail bench --protocol tumble` and tumble_bench run: every
+/// hierarchy, then hull_plane_contender (the peers come after).
+std::vector<Contender> tumble_contenders(const MeshPtr& a, const MeshPtr& b);
+
+/// What `dovetail bench --protocol poses` and accuracy_bench run: every
+/// hierarchy, then every approximate setting (the peers come after).
+std::vector<Contender> contact_pose_contenders(const MeshPtr& a, const MeshPtr& b);
+
+/// The contact-distance poses of B against A (`b` may be `a`), the bisection
+/// run on OBB trees; every exact method gives the same list (the bisection
+/// only asks exact yes/no questions), the one `dovetail poses` writes.
+std::vector<collision::SampledPose> contact_poses(const MeshPtr& a, const MeshPtr& b,
+                                                  const collision::ContactPoseSettings& settings);
+
 /// Called with (done, total) while a protocol runs; may be empty.
 using Progress = std::function<void(std::size_t done, std::size_t total)>;
 
@@ -76,6 +90,9 @@ struct TumbleCell {
   double sum_us_free = 0, max_us_free = 0;
   double volume_tests = 0, triangle_tests = 0;  ///< summed over the cell's queries
 };
+
+/// The cells of all distances together (sums, and maxima of the maxima).
+TumbleCell total(const std::vector<TumbleCell>& cells);
 
 struct TumbleResult {
   std::vector<collision::Real> distances;
