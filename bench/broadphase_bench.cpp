@@ -3,8 +3,11 @@
 // (and its array variant) on the same box trajectories, in one run.
 //
 //   broadphase_bench [--scene sparse|crowded] [--objects N] [--frames F] [--runs R]
-//                    [--seed S] [--size E] [--speed V] [--no-brute] [--write-scene FILE]
+//                    [--seed S] [--size E] [--speed V] [--no-brute] [--methods LIST]
+//                    [--no-peers] [--write-scene FILE]
 //
+// --methods sap,grid,... runs only those of Dovetail's broad phases; --no-peers
+// leaves out Bullet and FCL (for profiling one method).
 // Scenes: `sparse` (the default), N boxes in a cube of edge 100, moving
 // coherently (random velocities, bouncing off the walls), each box's edges
 // breathing by up to +-25% over time as the box of a rotating part does.
@@ -30,6 +33,7 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -90,6 +94,8 @@ struct Options {
   double size = 0.7;    ///< mean box edge
   double speed = 0.05;  ///< mean distance per frame
   bool brute = true;
+  bool peers = true;
+  std::vector<BroadphaseMethod> methods;  ///< Dovetail's contenders; empty = all
   std::string write_scene;
 };
 
@@ -433,7 +439,8 @@ double frame_median(const std::vector<double>& ms) {
       stderr,
       "broadphase_bench: %s\nusage: broadphase_bench [--scene sparse|crowded] [--objects N] "
       "[--frames F] "
-      "[--runs R] [--seed S] [--size E] [--speed V] [--no-brute] [--write-scene FILE]\n",
+      "[--runs R] [--seed S] [--size E] [--speed V] [--no-brute] [--methods LIST] [--no-peers] "
+      "[--write-scene FILE]\n",
       message);
   std::exit(2);
 }
@@ -444,6 +451,10 @@ Options parse(int argc, char** argv) {
     const std::string arg = argv[i];
     if (arg == "--no-brute") {
       o.brute = false;
+      continue;
+    }
+    if (arg == "--no-peers") {
+      o.peers = false;
       continue;
     }
     if (i + 1 >= argc) usage(("missing value for " + arg).c_str());
@@ -468,6 +479,19 @@ Options parse(int argc, char** argv) {
       o.size = dovetail::bench::real("broadphase_bench", "--size", value, 0);
     } else if (arg == "--speed") {
       o.speed = dovetail::bench::real("broadphase_bench", "--speed", value, 0);
+    } else if (arg == "--methods") {
+      o.methods.clear();
+      std::string list = value;
+      for (std::size_t start = 0; start <= list.size();) {
+        const std::size_t comma = std::min(list.find(',', start), list.size());
+        const std::string name = list.substr(start, comma - start);
+        const std::optional<BroadphaseMethod> m = parse_broadphase(name);
+        if (!m || *m == BroadphaseMethod::kBrute) {
+          usage(("unknown method '" + name + "' in --methods (sap, grid, octree, mbp)").c_str());
+        }
+        o.methods.push_back(*m);
+        start = comma + 1;
+      }
     } else if (arg == "--write-scene") {
       o.write_scene = value;
     } else {
@@ -520,7 +544,9 @@ int main(int argc, char** argv) {
   // Everything else, interleaved run by run.
   std::vector<BroadphaseMethod> methods;
   for (BroadphaseMethod m : all_broadphases()) {
-    if (m != BroadphaseMethod::kBrute) methods.push_back(m);
+    const bool chosen =
+        o.methods.empty() || std::find(o.methods.begin(), o.methods.end(), m) != o.methods.end();
+    if (m != BroadphaseMethod::kBrute && chosen) methods.push_back(m);
   }
   const std::size_t first = results.size();
   for (BroadphaseMethod m : methods) {
@@ -561,6 +587,7 @@ int main(int argc, char** argv) {
   fcl_peer("fcl DynamicAABBTree_Array",
            [] { return std::make_unique<fcl::DynamicAABBTreeCollisionManager_Arrayd>(); });
 #endif
+  if (!o.peers) peers.clear();
   for (const Peer& peer : peers) {
     Result r;
     r.name = peer.name;

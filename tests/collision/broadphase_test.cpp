@@ -249,6 +249,12 @@ std::vector<Contender> contenders(bool extremes) {
   shallow.octree_leaf_size = 2;
   shallow.octree_max_depth = 2;
   list.push_back({"octree depth 2", make_broadphase(BroadphaseMethod::kOctree, shallow)});
+  BroadphaseSettings narrow;
+  narrow.mbp_column = 0.25;  // boxes in many columns, the larger ones tested against all
+  list.push_back({"mbp column 0.25", make_broadphase(BroadphaseMethod::kMultiBoxPruning, narrow)});
+  BroadphaseSettings wide;
+  wide.mbp_column = 1000;  // one column: a single sweep
+  list.push_back({"mbp column 1000", make_broadphase(BroadphaseMethod::kMultiBoxPruning, wide)});
   return list;
 }
 
@@ -324,7 +330,7 @@ void expect_agreement(const SceneSpec& spec) {
 }
 
 TEST(Broadphase, NamesRoundTrip) {
-  ASSERT_EQ(all_broadphases().size(), 4u);
+  ASSERT_EQ(all_broadphases().size(), 5u);
   for (BroadphaseMethod m : all_broadphases()) {
     EXPECT_EQ(parse_broadphase(broadphase_name(m)), m);
   }
@@ -522,7 +528,7 @@ TEST(Broadphase, PairSortingMatchesAComparisonSort) {
     state = state * 6364136223846793005ull + 1442695040888963407ull;
     return static_cast<std::uint32_t>(state >> 32);
   };
-  std::vector<std::uint64_t> keys;
+  detail::PairSortScratch keys;
   for (const std::size_t n : {0, 1, 2, 100, 511, 512, 513, 5000, 70000}) {
     for (const int width : {1, 5, 11, 14, 16, 17, 22, 31, 32}) {
       const std::uint64_t range = std::uint64_t{1} << width;

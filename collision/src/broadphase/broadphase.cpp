@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "broadphase/brute_broadphase.h"
+#include "broadphase/multi_box_pruning.h"
 #include "broadphase/octree.h"
 #include "broadphase/sweep_and_prune.h"
 #include "broadphase/uniform_grid.h"
@@ -12,10 +13,11 @@ namespace dovetail::collision {
 
 namespace {
 
-constexpr std::array<BroadphaseMethod, 4> kBroadphases = {
+constexpr std::array<BroadphaseMethod, 5> kBroadphases = {
     BroadphaseMethod::kBrute, BroadphaseMethod::kSweepAndPrune, BroadphaseMethod::kGrid,
-    BroadphaseMethod::kOctree};
-constexpr std::array<std::string_view, 4> kBroadphaseNames = {"brute", "sap", "grid", "octree"};
+    BroadphaseMethod::kOctree, BroadphaseMethod::kMultiBoxPruning};
+constexpr std::array<std::string_view, 5> kBroadphaseNames = {"brute", "sap", "grid", "octree",
+                                                              "mbp"};
 
 }  // namespace
 
@@ -46,6 +48,8 @@ std::unique_ptr<Broadphase> make_broadphase(BroadphaseMethod method,
       return std::make_unique<UniformGrid>(settings.grid_cell);
     case BroadphaseMethod::kOctree:
       return std::make_unique<Octree>(settings.octree_leaf_size, settings.octree_max_depth);
+    case BroadphaseMethod::kMultiBoxPruning:
+      return std::make_unique<MultiBoxPruning>(settings.mbp_column);
   }
   throw std::invalid_argument("make_broadphase: unknown method");
 }

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "broadphase/proxy_pairs.h"
 #include "dovetail/collision/broadphase.h"
 
 namespace dovetail::collision {
@@ -43,7 +44,7 @@ class Octree final : public Broadphase {
   std::size_t node_count() const { return nodes_.size() - 8 * free_blocks_.size(); }
 
  private:
-  std::vector<std::uint64_t> sort_keys_;  ///< scratch of pairs()
+  detail::PairSortScratch sort_keys_;  ///< scratch of pairs()
   static constexpr std::uint32_t kNone = 0xffffffffu;
   struct Node {
     Vec3 lo = Vec3::Zero();  ///< cell bounds

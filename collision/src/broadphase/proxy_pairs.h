@@ -2,8 +2,9 @@
 // Sorting a broad phase's output. A crowded scene reports tens of thousands
 // of pairs a frame, and a comparison sort of them cost as much as finding
 // them; pairs packed into integer keys of just the bits the ids need are
-// sorted by a least-significant-digit radix sort instead, in as many passes
-// of 11 bits as the keys have (three for ids below 2^16).
+// sorted by a least-significant-digit radix sort instead, in as few passes
+// of at most 14 bits as the keys allow (two for ids below 2^14, whose keys
+// are 32-bit words).
 
 #include <algorithm>
 #include <array>
@@ -16,37 +17,75 @@
 
 namespace dovetail::collision::detail {
 
-/// Sorts `pairs` by (a, b), using `keys` as scratch.
-inline void sort_proxy_pairs(std::vector<ProxyPair>& pairs, std::vector<std::uint64_t>& keys) {
-  const std::size_t n = pairs.size();
-  if (n < 2) return;
-  std::uint32_t largest = 0;
-  for (const ProxyPair& p : pairs) largest = std::max({largest, p.a, p.b});
-  const int bits = std::bit_width(largest);  // every id < 2^bits
-  const std::uint64_t low_mask = (std::uint64_t{1} << bits) - 1;
-  keys.resize(2 * n);
-  std::uint64_t* in = keys.data();
-  std::uint64_t* out = keys.data() + n;
+/// LSD radix sort of `n` keys of `bits` bits in `in`, using `out` as scratch
+/// (both hold n keys) and `counts` for the digit counts; returns the one that
+/// holds the sorted keys. As few passes as digits of at most kMaxDigitBits
+/// allow, the digits as even as possible: each pass reads and scatters every
+/// key once, so a pass saved is worth more than small count arrays (28-bit
+/// keys: two passes of 14 bits took 0.19-0.25 ms for 40,000 keys on the
+/// project's machine, three of 11 bits 0.40 ms). The counts of every digit
+/// come from one read of the keys.
+template <typename Key>
+Key* radix_sort(Key* in, Key* out, std::size_t n, int bits, std::vector<std::uint32_t>& counts) {
+  constexpr int kMaxDigitBits = 14;
+  const int passes = std::max(1, (bits + kMaxDigitBits - 1) / kMaxDigitBits);
+  const int digit_bits = (bits + passes - 1) / passes;
+  const std::size_t buckets = std::size_t{1} << digit_bits;
+  const Key mask = static_cast<Key>(buckets - 1);
+  counts.assign(buckets * static_cast<std::size_t>(passes), 0);
   for (std::size_t i = 0; i < n; ++i) {
-    in[i] = (static_cast<std::uint64_t>(pairs[i].a) << bits) | pairs[i].b;
+    for (int p = 0; p < passes; ++p) ++counts[p * buckets + ((in[i] >> (p * digit_bits)) & mask)];
+  }
+  for (int p = 0; p < passes; ++p) {
+    std::uint32_t* offset = counts.data() + p * buckets;
+    std::uint32_t sum = 0;
+    for (std::size_t d = 0; d < buckets; ++d) sum += std::exchange(offset[d], sum);
+    const int shift = p * digit_bits;
+    for (std::size_t i = 0; i < n; ++i) out[offset[(in[i] >> shift) & mask]++] = in[i];
+    std::swap(in, out);
+  }
+  return in;
+}
+
+/// Sorts `pairs` by (a, b) as keys (a << bits) | b, where every id < 2^bits.
+template <typename Key>
+void sort_pair_keys(std::vector<ProxyPair>& pairs, std::vector<Key>& keys, int bits,
+                    std::vector<std::uint32_t>& counts) {
+  const std::size_t n = pairs.size();
+  const Key low_mask = static_cast<Key>((std::uint64_t{1} << bits) - 1);
+  keys.resize(2 * n);
+  Key* in = keys.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    in[i] = static_cast<Key>((static_cast<Key>(pairs[i].a) << bits) | pairs[i].b);
   }
   if (n < 512) {
     std::sort(in, in + n);
   } else {
-    constexpr int kDigitBits = 11;
-    constexpr std::uint64_t kDigitMask = (1u << kDigitBits) - 1;
-    std::array<std::uint32_t, std::size_t{1} << kDigitBits> offset;
-    for (int shift = 0; shift < 2 * bits; shift += kDigitBits) {
-      offset.fill(0);
-      for (std::size_t i = 0; i < n; ++i) ++offset[(in[i] >> shift) & kDigitMask];
-      std::uint32_t sum = 0;
-      for (std::uint32_t& o : offset) sum += std::exchange(o, sum);
-      for (std::size_t i = 0; i < n; ++i) out[offset[(in[i] >> shift) & kDigitMask]++] = in[i];
-      std::swap(in, out);
-    }
+    in = radix_sort(in, in + n, n, 2 * bits, counts);
   }
   for (std::size_t i = 0; i < n; ++i) {
     pairs[i] = {static_cast<ProxyId>(in[i] >> bits), static_cast<ProxyId>(in[i] & low_mask)};
+  }
+}
+
+/// Scratch of sort_proxy_pairs, kept by its owner from frame to frame.
+struct PairSortScratch {
+  std::vector<std::uint32_t> narrow;
+  std::vector<std::uint64_t> wide;
+  std::vector<std::uint32_t> counts;
+};
+
+/// Sorts `pairs` by (a, b): 32-bit keys while both ids fit in 16 bits (half
+/// the memory traffic of 64-bit keys), 64-bit keys beyond.
+inline void sort_proxy_pairs(std::vector<ProxyPair>& pairs, PairSortScratch& scratch) {
+  if (pairs.size() < 2) return;
+  std::uint32_t largest = 0;
+  for (const ProxyPair& p : pairs) largest = std::max({largest, p.a, p.b});
+  const int bits = std::max(1, static_cast<int>(std::bit_width(largest)));  // every id < 2^bits
+  if (bits <= 16) {
+    sort_pair_keys(pairs, scratch.narrow, bits, scratch.counts);
+  } else {
+    sort_pair_keys(pairs, scratch.wide, bits, scratch.counts);
   }
 }
 

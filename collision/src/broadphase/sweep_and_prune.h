@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "broadphase/proxy_pairs.h"
 #include "dovetail/collision/broadphase.h"
 
 namespace dovetail::collision {
@@ -41,7 +42,7 @@ class SweepAndPrune final : public Broadphase {
   BroadphaseStats stats() const override { return last_stats_; }
 
  private:
-  std::vector<std::uint64_t> sort_keys_;  ///< scratch of pairs()
+  detail::PairSortScratch sort_keys_;  ///< scratch of pairs()
   static constexpr std::uint32_t kNone = 0xffffffffu;
 
   /// One box end on one axis. `key` is handle * 2 + (1 for an end, 0 for a begin),

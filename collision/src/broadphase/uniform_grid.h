@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "broadphase/proxy_pairs.h"
 #include "dovetail/collision/broadphase.h"
 
 namespace dovetail::collision {
@@ -49,7 +50,7 @@ class UniformGrid final : public Broadphase {
   static constexpr std::uint64_t kMaxCells = 4096;
 
  private:
-  std::vector<std::uint64_t> sort_keys_;  ///< scratch of pairs()
+  detail::PairSortScratch sort_keys_;  ///< scratch of pairs()
   static constexpr std::uint32_t kNone = 0xffffffffu;
   using CellIndex = std::array<std::int32_t, 3>;
   struct Range {

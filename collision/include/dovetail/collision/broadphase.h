@@ -46,9 +46,9 @@ struct ProxyPair {
 };
 
 /// Object-level methods.
-enum class BroadphaseMethod { kBrute, kSweepAndPrune, kGrid, kOctree };
+enum class BroadphaseMethod { kBrute, kSweepAndPrune, kGrid, kOctree, kMultiBoxPruning };
 
-/// Command-line name: brute, sap, grid, octree.
+/// Command-line name: brute, sap, grid, octree, mbp.
 std::string_view broadphase_name(BroadphaseMethod method);
 std::optional<BroadphaseMethod> parse_broadphase(std::string_view name);
 std::span<const BroadphaseMethod> all_broadphases();
@@ -69,6 +69,9 @@ struct BroadphaseSettings {
   int octree_leaf_size = 8;
   /// ... until this depth.
   int octree_max_depth = 10;
+  /// Multi-box pruning: column edge across the sweep axis; 0 = chosen from
+  /// the boxes (4 times their median extent across it).
+  Real mbp_column = 0;
 };
 
 /// An incremental broad phase. Not thread-safe: one owner updates and queries it.
