@@ -1,6 +1,7 @@
 #include "broadphase/multi_box_pruning.h"
 
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <cmath>
 #include <stdexcept>
@@ -212,13 +213,16 @@ void MultiBoxPruning::sort_columns() {
   }
 }
 
-void MultiBoxPruning::sweep_columns(std::vector<ProxyPair>& out) {
+template <typename Key>
+std::size_t MultiBoxPruning::sweep_columns(std::vector<Key>& keys, int bits) {
   // In each column, every box against the boxes after it that start before it
   // ends along the sweep axis; branch-free: every tested pair is written past
   // the found ones and counted only when the boxes overlap across the sweep
-  // axis and this column holds the lower corner of their intersection.
+  // axis and this column holds the lower corner of their intersection. The
+  // pairs are written as the sort's keys, so they are not packed again.
   const std::size_t columns = std::size_t{columns_u_} * columns_v_;
   std::uint64_t tests = 0;
+  std::size_t found = 0;
   for (std::size_t c = 0; c < columns; ++c) {
     const std::size_t begin = offsets_[c], end = offsets_[c + 1];
     if (end - begin < 2) continue;
@@ -228,29 +232,30 @@ void MultiBoxPruning::sweep_columns(std::vector<ProxyPair>& out) {
     const Entry* e = entries_.data();
     for (std::size_t i = begin; i + 1 < end; ++i) {
       const Entry a = e[i];
-      std::size_t stop = i + 1;
-      while (stop < end && e[stop].lo_s <= a.hi_s) ++stop;
-      const std::size_t count = stop - i - 1;
-      if (count == 0) continue;
-      tests += count;
-      if (found_ + count > out.size()) out.resize(2 * (found_ + count) + 64);
-      ProxyPair* dst = out.data() + found_;
-      std::size_t found = 0;
-      for (std::size_t j = i + 1; j < stop; ++j) {
+      // Room for every box after this one (the sort's half of `keys` stays free).
+      if (2 * (found + end - i) > keys.size()) keys.resize(4 * (found + end - i) + 128);
+      Key* dst = keys.data() + found;
+      std::size_t j = i + 1;
+      std::size_t hits = 0;
+      for (; j < end && e[j].lo_s <= a.hi_s; ++j) {
         const Entry& b = e[j];
         const bool hit = (a.lo_u <= b.hi_u) & (b.lo_u <= a.hi_u) & (a.lo_v <= b.hi_v) &
                          (b.lo_v <= a.hi_v) & (std::max(a.u0, b.u0) == cu) &
                          (std::max(a.v0, b.v0) == cv);
-        dst[found] = a.id < b.id ? ProxyPair{a.id, b.id} : ProxyPair{b.id, a.id};
-        found += hit;
+        const Key low = std::min(a.id, b.id), high = std::max(a.id, b.id);
+        dst[hits] = static_cast<Key>((low << bits) | high);
+        hits += hit;
       }
-      found_ += found;
+      tests += j - i - 1;
+      found += hits;
     }
   }
   stats_.box_tests += tests;
+  return found;
 }
 
-void MultiBoxPruning::test_big_boxes(std::vector<ProxyPair>& out) {
+template <typename Key>
+std::size_t MultiBoxPruning::test_big_boxes(std::vector<Key>& keys, std::size_t found, int bits) {
   // Each big box against every other box; two big boxes once.
   for (ProxyId big : big_) {
     const Aabb& box = boxes_[big];
@@ -258,16 +263,24 @@ void MultiBoxPruning::test_big_boxes(std::vector<ProxyPair>& out) {
       const ProxyId other = sequence_[i];
       if (other == big || (spans_[i].u0 == kBig && other < big)) continue;
       ++stats_.box_tests;
-      if (box.overlaps(boxes_[other])) {
-        out.push_back(big < other ? ProxyPair{big, other} : ProxyPair{other, big});
-      }
+      if (!box.overlaps(boxes_[other])) continue;
+      if (2 * (found + 1) > keys.size()) keys.resize(4 * (found + 1) + 128);
+      const Key low = std::min(big, other), high = std::max(big, other);
+      keys[found++] = static_cast<Key>((low << bits) | high);
     }
   }
+  return found;
+}
+
+template <typename Key>
+void MultiBoxPruning::find_pairs(std::vector<Key>& keys, int bits, std::vector<ProxyPair>& out) {
+  std::size_t found = sweep_columns(keys, bits);
+  found = test_big_boxes(keys, found, bits);
+  detail::pairs_from_keys(keys, found, bits, sort_keys_.counts, out);
 }
 
 void MultiBoxPruning::pairs(std::vector<ProxyPair>& out) {
   out.clear();
-  found_ = 0;
   if (present_.empty()) {
     last_stats_ = stats_;
     stats_ = {};
@@ -302,9 +315,13 @@ void MultiBoxPruning::pairs(std::vector<ProxyPair>& out) {
   }
   fill_columns();
   sort_columns();
-  sweep_columns(out);
-  out.resize(found_);
-  test_big_boxes(out);
+  // Keys of 32 bits while every id fits in 16 bits.
+  const int bits = std::max(1, static_cast<int>(std::bit_width(slot_.size() - 1)));
+  if (bits <= 16) {
+    find_pairs(sort_keys_.narrow, bits, out);
+  } else {
+    find_pairs(sort_keys_.wide, bits, out);
+  }
 
   // Next frame's order: each box where its first column holds it, then the big ones.
   order_.clear();
@@ -317,8 +334,6 @@ void MultiBoxPruning::pairs(std::vector<ProxyPair>& out) {
     }
   }
   order_.insert(order_.end(), big_.begin(), big_.end());
-
-  detail::sort_proxy_pairs(out, sort_keys_);
   last_stats_ = stats_;
   stats_ = {};
 }

@@ -86,8 +86,13 @@ class MultiBoxPruning final : public Broadphase {
   bool span_all(bool allow_drift);
   void fill_columns();
   void sort_columns();
-  void sweep_columns(std::vector<ProxyPair>& out);
-  void test_big_boxes(std::vector<ProxyPair>& out);
+  /// Writes the pairs found as keys (a << bits) | b into `keys`; returns how many.
+  template <typename Key>
+  std::size_t sweep_columns(std::vector<Key>& keys, int bits);
+  template <typename Key>
+  std::size_t test_big_boxes(std::vector<Key>& keys, std::size_t found, int bits);
+  template <typename Key>
+  void find_pairs(std::vector<Key>& keys, int bits, std::vector<ProxyPair>& out);
 
   Real fixed_column_ = 0;
   Real column_ = 0;
@@ -111,8 +116,7 @@ class MultiBoxPruning final : public Broadphase {
   std::vector<std::uint32_t> cursor_;   ///< scratch of fill_columns()
   std::vector<Entry> entries_;
   std::vector<ProxyId> big_;
-  std::size_t found_ = 0;  ///< pairs found so far this frame
-  detail::PairSortScratch sort_keys_;
+  detail::PairSortScratch sort_keys_;  ///< pairs found, as keys, and the sort's counts
   std::vector<Real> scratch_;
   BroadphaseStats stats_, last_stats_;
 };

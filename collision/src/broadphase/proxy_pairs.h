@@ -47,25 +47,34 @@ Key* radix_sort(Key* in, Key* out, std::size_t n, int bits, std::vector<std::uin
   return in;
 }
 
-/// Sorts `pairs` by (a, b) as keys (a << bits) | b, where every id < 2^bits.
+/// The pairs of the first `n` keys (a << bits) | b of `keys` (which has room
+/// for 2n), sorted by (a, b), into `pairs`.
 template <typename Key>
-void sort_pair_keys(std::vector<ProxyPair>& pairs, std::vector<Key>& keys, int bits,
-                    std::vector<std::uint32_t>& counts) {
-  const std::size_t n = pairs.size();
-  const Key low_mask = static_cast<Key>((std::uint64_t{1} << bits) - 1);
-  keys.resize(2 * n);
+void pairs_from_keys(std::vector<Key>& keys, std::size_t n, int bits,
+                     std::vector<std::uint32_t>& counts, std::vector<ProxyPair>& pairs) {
   Key* in = keys.data();
-  for (std::size_t i = 0; i < n; ++i) {
-    in[i] = static_cast<Key>((static_cast<Key>(pairs[i].a) << bits) | pairs[i].b);
-  }
   if (n < 512) {
     std::sort(in, in + n);
   } else {
     in = radix_sort(in, in + n, n, 2 * bits, counts);
   }
+  const Key low_mask = static_cast<Key>((std::uint64_t{1} << bits) - 1);
+  pairs.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     pairs[i] = {static_cast<ProxyId>(in[i] >> bits), static_cast<ProxyId>(in[i] & low_mask)};
   }
+}
+
+/// Sorts `pairs` by (a, b) as keys (a << bits) | b, where every id < 2^bits.
+template <typename Key>
+void sort_pair_keys(std::vector<ProxyPair>& pairs, std::vector<Key>& keys, int bits,
+                    std::vector<std::uint32_t>& counts) {
+  const std::size_t n = pairs.size();
+  keys.resize(2 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    keys[i] = static_cast<Key>((static_cast<Key>(pairs[i].a) << bits) | pairs[i].b);
+  }
+  pairs_from_keys(keys, n, bits, counts, pairs);
 }
 
 /// Scratch of sort_proxy_pairs, kept by its owner from frame to frame.
