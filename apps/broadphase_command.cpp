@@ -28,7 +28,8 @@ Finds, frame by frame, every pair of overlapping axis-aligned boxes.
   --boxes FILE   text: a first line `N F` (objects, frames), then F frames of N
                  lines `minx miny minz maxx maxy maxz`, box i of a frame on its
                  i-th line (blank lines and `#` lines are skipped)
-  --method M     grid (default), sap, octree, brute
+  --method M     grid (default), sap, octree, mbp (multi-box pruning: best on
+                 crowded scenes), brute
   --out PAIRS    write the pairs there: per frame a line `frame K count C`
                  (K from 0), then the C overlapping pairs `i j`, i < j, sorted
                  (default: standard output, before the summary)

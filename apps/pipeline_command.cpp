@@ -39,7 +39,7 @@ intersect (touching counts).
                   mesh path relative to FILE's folder; then F frames of N lines
                   `tx ty tz qw qx qy qz`, the pose of part i in the world (the
                   quaternion is normalized; blank lines and `#` lines skipped)
-  --broadphase M  sap (default), grid, octree, brute
+  --broadphase M  sap (default), grid, octree, mbp, brute
   --method M      polygon level: obb (default), boxtree, dop6, dop14, dop18,
                   dop26, aabb, brute
   --threads N     worker threads (default 1; 0 = one per core); the pairs do

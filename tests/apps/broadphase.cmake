@@ -7,13 +7,13 @@ set(bp_keys
     "\"objects\":4&&\"frames\":3&&\"ms_per_frame_median\":[0-9]&&\"pairs_total\":7")
 
 dovetail_cli_test(broadphase_help EXIT 0 ARGS broadphase --help
-                  STDOUT "^usage: dovetail broadphase&&--boxes FILE&&grid&&sap&&octree&&brute")
+                  STDOUT "^usage: dovetail broadphase&&--boxes FILE&&grid&&sap&&octree&&mbp&&brute")
 dovetail_cli_test(broadphase_listed EXIT 0 ARGS --help STDOUT "broadphase")
 
 # ---- results: touching boxes, a point, coincident boxes, every method
 dovetail_cli_test(broadphase_stdout EXIT 0 ARGS broadphase --boxes ${bp_data}/touching.txt
                   STDOUT "^${bp_touching_pairs}{[^\n]*}\n$&&\"method\":\"grid\"&&${bp_keys}")
-foreach(method brute sap grid octree)
+foreach(method brute sap grid octree mbp)
   dovetail_cli_test(broadphase_out_${method} EXIT 0
                     ARGS broadphase --boxes ${bp_data}/touching.txt --method ${method}
                          --out ${out}/bp_pairs_${method}.txt
@@ -69,7 +69,7 @@ dovetail_cli_test(broadphase_unwritable_out EXIT 1
 # ---- usage errors
 dovetail_cli_test(broadphase_unknown_method EXIT 2
                   ARGS broadphase --boxes ${bp_data}/touching.txt --method boxtree
-                  STDERR "unknown method 'boxtree'&&brute, sap, grid, octree")
+                  STDERR "unknown method 'boxtree'&&brute, sap, grid, octree, mbp")
 dovetail_cli_test(broadphase_missing_boxes EXIT 2 ARGS broadphase STDERR "missing --boxes")
 dovetail_cli_test(broadphase_positional EXIT 2
                   ARGS broadphase ${bp_data}/touching.txt --boxes ${bp_data}/touching.txt

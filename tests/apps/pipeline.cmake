@@ -9,7 +9,7 @@ dovetail_cli_test(pipeline_listed EXIT 0 ARGS --help STDOUT "pipeline")
 dovetail_cli_test(pipeline_stdout EXIT 0 ARGS pipeline --scene ${pl_data}/three_parts.txt
                   STDOUT "^${pl_pairs}{[^\n]*}\n$&&${pl_keys}&&\"broadphase\":\"sap\"&&\"method\":\"obb\"")
 # The same pairs with every broad phase and polygon-level method, at 1, 2 and 8 threads.
-foreach(combo "sap;obb;1" "grid;boxtree;2" "octree;dop18;8" "brute;aabb;1" "sap;brute;2" "grid;dop6;1")
+foreach(combo "sap;obb;1" "grid;boxtree;2" "octree;dop18;8" "brute;aabb;1" "sap;brute;2" "grid;dop6;1" "mbp;obb;8")
   list(GET combo 0 bp)
   list(GET combo 1 method)
   list(GET combo 2 threads)

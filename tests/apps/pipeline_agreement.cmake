@@ -34,7 +34,7 @@ endif()
 message(STATUS "brute force: ${count} intersecting pairs over ${FRAMES} frames")
 
 foreach(combo "sap;obb;1" "sap;obb;2" "sap;obb;8" "grid;obb;2" "octree;obb;8" "sap;dop18;2"
-              "grid;boxtree;1" "octree;aabb;2")
+              "grid;boxtree;1" "octree;aabb;2" "mbp;obb;2")
   list(GET combo 0 broadphase)
   list(GET combo 1 method)
   list(GET combo 2 threads)
