@@ -59,9 +59,11 @@ void pairs_from_keys(std::vector<Key>& keys, std::size_t n, int bits,
     in = radix_sort(in, in + n, n, 2 * bits, counts);
   }
   const Key low_mask = static_cast<Key>((std::uint64_t{1} << bits) - 1);
-  pairs.resize(n);
+  // Appended, not resized and overwritten: no pass to zero them first.
+  pairs.clear();
+  pairs.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
-    pairs[i] = {static_cast<ProxyId>(in[i] >> bits), static_cast<ProxyId>(in[i] & low_mask)};
+    pairs.push_back({static_cast<ProxyId>(in[i] >> bits), static_cast<ProxyId>(in[i] & low_mask)});
   }
 }
 
