@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "broadphase/proxy_pairs.h"
+#include "broadphase/scene_bulk.h"
 
 namespace dovetail::collision {
 
@@ -52,18 +53,9 @@ void MultiBoxPruning::choose_layout() {
   // The bulk of the scene: 2nd to 98th percentile of the box centres per axis.
   Real low[3], spread[3];
   for (int k = 0; k < 3; ++k) {
-    for (std::size_t i = 0; i < n; ++i) {
-      const Aabb& b = boxes_[present_[i]];
-      scratch_[i] = (b.min[k] + b.max[k]) / 2;
-    }
-    const std::size_t lo = n / 50;
-    const std::size_t hi = n - 1 - n / 50;
-    std::nth_element(scratch_.begin(), scratch_.begin() + static_cast<std::ptrdiff_t>(lo),
-                     scratch_.end());
-    low[k] = scratch_[lo];
-    std::nth_element(scratch_.begin(), scratch_.begin() + static_cast<std::ptrdiff_t>(hi),
-                     scratch_.end());
-    spread[k] = scratch_[hi] - low[k];
+    const detail::Bulk bulk = detail::bulk_of_centres(boxes_, present_, k, scratch_);
+    low[k] = bulk.low;
+    spread[k] = bulk.spread;
   }
   s_ = 0;
   for (int k = 1; k < 3; ++k) {

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "broadphase/proxy_pairs.h"
+#include "broadphase/scene_bulk.h"
 
 namespace dovetail::collision {
 
@@ -255,16 +256,7 @@ void UniformGrid::choose_cell() {
     // box centres) spans more than 2^18 cells on an axis.
     Real spread = 0;
     for (int k = 0; k < 3; ++k) {
-      for (std::size_t i = 0; i < n; ++i) {
-        const Aabb& b = boxes_[present_[i]];
-        scratch_[i] = (b.min[k] + b.max[k]) / 2;
-      }
-      const std::size_t lo = n / 50;
-      const std::size_t hi = n - 1 - n / 50;
-      std::nth_element(scratch_.begin(), scratch_.begin() + lo, scratch_.end());
-      const Real low = scratch_[lo];
-      std::nth_element(scratch_.begin(), scratch_.begin() + hi, scratch_.end());
-      spread = std::max(spread, scratch_[hi] - low);
+      spread = std::max(spread, detail::bulk_of_centres(boxes_, present_, k, scratch_).spread);
     }
     cell = std::max(cell, spread / (1 << 18));
     // All boxes are points at one place: any cell size will do.
