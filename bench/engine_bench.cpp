@@ -146,7 +146,7 @@ void synthetic(std::size_t n, double seconds, int runs) {
       std::string name = "p";
       name += std::to_string(i);
       handles.push_back(scene.add_part(
-          {.name = name, .X_PC = pose[i], .render_mesh = shapes[i % shapes.size()]}));
+          {.name = name, .X_QP = pose[i], .render_mesh = shapes[i % shapes.size()]}));
     }
     engine::Simulation sim(std::move(scene), {.collision_threads = 1});
     const Real dt = sim.settings().time_step;

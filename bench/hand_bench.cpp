@@ -160,7 +160,7 @@ Frames measure(const Scene& scene, collision::ContactDetail detail, int runs) {
   for (int run = 0; run < runs; ++run) {
     engine::Scene parts;
     parts.add_part(
-        {.name = "part", .X_PC = scene.X_WP, .movable = false, .render_mesh = scene.mesh});
+        {.name = "part", .X_QP = scene.X_WP, .movable = false, .render_mesh = scene.mesh});
     engine::Simulation sim(std::move(parts), {.collision_threads = 1, .contacts = detail});
     interaction::Hand hand(sim, std::make_shared<interaction::SimulatedGlove>(scene.plan));
     sim.prepare();
@@ -241,7 +241,7 @@ void grasp_picture(const std::string& pictures) {
   X_bar.R << 0, 0, 1, 0, 1, 0, -1, 0, 0;  // the cylinder's z axis along x
   X_bar.t = Vec3(0.02 - 0.04, -0.0105 - 0.022 - 0.0001, -0.06);
   scene.add_part({.name = "bar",
-                  .X_PC = X_bar,
+                  .X_QP = X_bar,
                   .render_mesh = std::make_shared<const collision::Mesh>(
                       collision::make_cylinder(0.022, 0.08, 48))});
   engine::Simulation sim(std::move(scene));
@@ -317,7 +317,7 @@ SlidingRuns sliding_runs(int runs, const std::string& pictures,
     X_WPeg.t = Vec3(wall ? 0 : 0.0015, kTop + 0.01 + kLength, 0);
     engine::Scene scene;
     scene.add_part({.name = "block", .movable = false, .render_mesh = block});
-    scene.add_part({.name = "peg", .X_PC = X_WPeg, .render_mesh = peg});
+    scene.add_part({.name = "peg", .X_QP = X_WPeg, .render_mesh = peg});
     engine::Simulation sim(std::move(scene), {.collision_threads = 1});
     GlovePlan p;
     p.start.p_WH = X_WPeg.t + Vec3(0, 0.05, 0.09);

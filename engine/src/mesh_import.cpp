@@ -70,12 +70,12 @@ Affine to_affine(const aiMatrix4x4& m) {
   return a;
 }
 
-/// X_PC composed: parent-to-root times child-to-parent, in double.
-Affine compose(const Affine& X_RP, const Affine& X_PC) {
-  Affine X_RC;
-  X_RC.leftCols<3>() = X_RP.leftCols<3>() * X_PC.leftCols<3>();
-  X_RC.col(3) = X_RP.leftCols<3>() * X_PC.col(3) + X_RP.col(3);
-  return X_RC;
+/// X_RN composed: parent-to-root times node-to-parent, in double.
+Affine compose(const Affine& X_RQ, const Affine& X_QN) {
+  Affine X_RN;
+  X_RN.leftCols<3>() = X_RQ.leftCols<3>() * X_QN.leftCols<3>();
+  X_RN.col(3) = X_RQ.leftCols<3>() * X_QN.col(3) + X_RQ.col(3);
+  return X_RN;
 }
 
 Vec3 apply(const Affine& X, const aiVector3D& v) {
@@ -98,7 +98,7 @@ std::vector<Instance> collect_instances(const fs::path& path, const aiScene& sce
   std::vector<Instance> instances;
   struct Pending {
     const aiNode* node;
-    Affine X_RP;
+    Affine X_RQ;  ///< the node's parent Q in the root
   };
   std::vector<Pending> stack{{scene.mRootNode, Affine::Identity()}};
   std::set<const aiNode*> visited;
@@ -108,7 +108,7 @@ std::vector<Instance> collect_instances(const fs::path& path, const aiScene& sce
     if (top.node == nullptr) continue;
     if (!visited.insert(top.node).second)
       fail(path, "node hierarchy contains a cycle or a shared node");
-    const Affine X_RN = compose(top.X_RP, to_affine(top.node->mTransformation));
+    const Affine X_RN = compose(top.X_RQ, to_affine(top.node->mTransformation));
     for (unsigned k = 0; k < top.node->mNumMeshes; ++k) {
       const unsigned mesh = top.node->mMeshes[k];
       if (mesh >= scene.mNumMeshes) {

@@ -86,7 +86,7 @@ PartId Scene::add_part(const PartDef& desc) {
   s.name = desc.name;
   s.tags = desc.tags;
   s.parent = parent;
-  s.X_PC = desc.X_PC;
+  s.X_QP = desc.X_QP;
   s.movable = desc.movable;
   s.collision_group = desc.collision_group;
   s.color = desc.color;
@@ -150,7 +150,7 @@ std::vector<PartId> Scene::children(PartId part) const {
 }
 
 void Scene::set_parent(PartId part, PartId parent, bool keep_world_pose) {
-  const Transform X_WC = world_pose(part);
+  const Transform X_WP = world_pose(part);
   if (parent.valid()) {
     for (PartId p = parent; p.valid(); p = slot(p).parent) {
       if (p == part) {
@@ -160,24 +160,24 @@ void Scene::set_parent(PartId part, PartId parent, bool keep_world_pose) {
     }
   }
   slot(part).parent = parent;
-  if (keep_world_pose) set_world_pose(part, X_WC);
+  if (keep_world_pose) set_world_pose(part, X_WP);
 }
 
-const Transform& Scene::local_pose(PartId part) const { return slot(part).X_PC; }
-void Scene::set_local_pose(PartId part, const Transform& X_PC) { slot(part).X_PC = X_PC; }
+const Transform& Scene::local_pose(PartId part) const { return slot(part).X_QP; }
+void Scene::set_local_pose(PartId part, const Transform& X_QP) { slot(part).X_QP = X_QP; }
 
 Transform Scene::world_pose(PartId part) const {
   // Iterative, root first, so a deep chain cannot exhaust the stack.
   std::vector<const Slot*> chain;
   for (PartId p = part; p.valid(); p = slot(p).parent) chain.push_back(&slot(p));
-  Transform X_WC = chain.back()->X_PC;  // the root, in the world
-  for (std::size_t k = chain.size() - 1; k > 0; --k) X_WC = compose(X_WC, chain[k - 1]->X_PC);
-  return X_WC;
+  Transform X_WP = chain.back()->X_QP;  // the root, in the world
+  for (std::size_t k = chain.size() - 1; k > 0; --k) X_WP = compose(X_WP, chain[k - 1]->X_QP);
+  return X_WP;
 }
 
-void Scene::set_world_pose(PartId part, const Transform& X_WC) {
+void Scene::set_world_pose(PartId part, const Transform& X_WP) {
   const PartId parent = slot(part).parent;
-  slot(part).X_PC = parent.valid() ? compose(world_pose(parent).inverse(), X_WC) : X_WC;
+  slot(part).X_QP = parent.valid() ? compose(world_pose(parent).inverse(), X_WP) : X_WP;
 }
 
 bool Scene::movable(PartId part) const { return slot(part).movable; }
@@ -285,8 +285,8 @@ Scene load_assembly(const fs::path& path, const AssemblyOptions& options, Assemb
     PartDef desc;
     desc.name = part.name;
     desc.tags = options.tags;
-    desc.X_PC = part.X_RP;
-    desc.X_PC.t *= summary.units;
+    desc.X_QP = part.X_RP;
+    desc.X_QP.t *= summary.units;
     desc.movable = options.movable;
     desc.render_mesh = it->second;
     scene.add_part(desc);

@@ -233,7 +233,7 @@ const FrameResult& Simulation::step() {
   // 1-3. Actions queued for this frame, then input, hand and interaction.
   auto due = commands_.begin();
   while (due != commands_.end() && due->frame <= frame_) {
-    scene_.set_local_pose(due->part, due->X_PC);
+    scene_.set_local_pose(due->part, due->X_QP);
     ++due;
   }
   commands_.erase(commands_.begin(), due);

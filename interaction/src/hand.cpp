@@ -61,7 +61,7 @@ Hand::Hand(engine::Simulation& simulation, std::shared_ptr<const GloveSource> so
     desc.render_mesh = model_.proxy(segment);
     desc.collision_group = settings_.name;
     desc.color = kHandColor;
-    desc.X_PC = engine::compose(X_WH_, pose_.X_HS[i]);
+    desc.X_QP = engine::compose(X_WH_, pose_.X_HS[i]);
     parts_[i] = scene.add_part(desc);
     segment_by_part_.emplace(desc.name, segment);
   }

@@ -316,7 +316,7 @@ void Runner::build() {
     engine::PartDef desc;
     desc.name = p.name;
     desc.tags = p.tags;
-    desc.X_PC = p.X_WP;
+    desc.X_QP = p.X_WP;
     desc.movable = !p.fixed;
     desc.render_mesh = p.mesh;
     desc.color = p.color;

@@ -63,12 +63,12 @@ Simulation two_boxes(collision::ContactDetail contacts = collision::ContactDetai
   const auto box =
       std::make_shared<const collision::Mesh>(collision::make_box(Vec3::Constant(0.5)));
   scene.add_part({.name = "block", .movable = false, .render_mesh = box});
-  scene.add_part({.name = "slider", .X_PC = at(kApart), .render_mesh = box});
+  scene.add_part({.name = "slider", .X_QP = at(kApart), .render_mesh = box});
   SimulationSettings settings;
   settings.contacts = contacts;
   settings.collision_threads = threads;
   Simulation simulation(std::move(scene), settings);
-  simulation.queue_pose({.frame = 5, .part = "slider", .X_PC = at(kInside)});
+  simulation.queue_pose({.frame = 5, .part = "slider", .X_QP = at(kInside)});
   return simulation;
 }
 

@@ -93,10 +93,10 @@ TEST(Scene, NamesAreUniqueAndLookedUp) {
 
 TEST(Scene, MovingAParentMovesItsChildren) {
   Scene scene;
-  scene.add_part({.name = "frame", .X_PC = translation(1, 0, 0)});
-  scene.add_part({.name = "arm", .parent = "frame", .X_PC = translation(0, 2, 0)});
+  scene.add_part({.name = "frame", .X_QP = translation(1, 0, 0)});
+  scene.add_part({.name = "arm", .parent = "frame", .X_QP = translation(0, 2, 0)});
   scene.add_part(
-      {.name = "gripper", .parent = "arm", .X_PC = translation(0, 0, 3), .render_mesh = box(1)});
+      {.name = "gripper", .parent = "arm", .X_QP = translation(0, 0, 3), .render_mesh = box(1)});
   EXPECT_TRUE(scene.world_pose("gripper").t.isApprox(Vec3(1, 2, 3)));
 
   scene.set_local_pose("frame", compose(translation(10, 0, 0), rotation_z(M_PI / 2)));

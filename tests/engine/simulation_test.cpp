@@ -41,9 +41,9 @@ Scene test_scene() {
   const auto ball = std::make_shared<const collision::Mesh>(collision::make_sphere(0.5, 3));
   Scene scene;
   scene.add_part({.name = "block", .tags = {"fixture"}, .movable = false, .render_mesh = cube});
-  scene.add_part({.name = "slider", .X_PC = at(3, 0, 0), .render_mesh = cube});
-  scene.add_part({.name = "rider", .parent = "slider", .X_PC = at(0, 2, 0), .render_mesh = ball});
-  scene.add_part({.name = "ball", .X_PC = at(-5, 0, 0), .render_mesh = ball});
+  scene.add_part({.name = "slider", .X_QP = at(3, 0, 0), .render_mesh = cube});
+  scene.add_part({.name = "rider", .parent = "slider", .X_QP = at(0, 2, 0), .render_mesh = ball});
+  scene.add_part({.name = "ball", .X_QP = at(-5, 0, 0), .render_mesh = ball});
   return scene;
 }
 
@@ -262,7 +262,7 @@ TEST(Simulation, StateHashIsTheDocumentedWordHash) {
                                     "sixteen161616161", "seventeen17171717", "x"};
   for (std::size_t i = 0; i < names.size(); ++i) {
     named.add_part({.name = names[i],
-                    .X_PC = at(0.5 * static_cast<double>(i), 0.25, -1),
+                    .X_QP = at(0.5 * static_cast<double>(i), 0.25, -1),
                     .render_mesh = mesh});
   }
   EXPECT_EQ(state_hash(named), documented_state_hash(named, names));
@@ -292,7 +292,7 @@ TEST(Simulation, PartsAddedAndRemovedBetweenFrames) {
   Simulation sim(test_scene());
   sim.run(2);
   sim.scene().add_part({.name = "late",
-                        .X_PC = at(0.5, 0.5, 0),
+                        .X_QP = at(0.5, 0.5, 0),
                         .render_mesh = std::make_shared<const collision::Mesh>(
                             collision::make_box(Vec3::Constant(0.2)))});
   sim.step();

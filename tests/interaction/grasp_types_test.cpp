@@ -30,7 +30,7 @@ engine::PartDef cylinder_part(const std::string& name, Real radius, Real length,
       Eigen::Quaternion<Real>::FromTwoVectors(Vec3::UnitZ(), axis.normalized()).toRotationMatrix();
   X.t = p_W - X.R * Vec3(0, 0, length / 2);
   return {.name = name,
-          .X_PC = X,
+          .X_QP = X,
           .render_mesh = std::make_shared<const collision::Mesh>(
               collision::make_cylinder(radius, length, 48))};
 }
@@ -207,7 +207,7 @@ TEST(GraspTypes, AnOpenHandBrushingPastGraspsNothing) {
   // The open hand sweeps sideways across a block so that its fingers run through its top.
   engine::Scene scene;
   scene.add_part({.name = "block",
-                  .X_PC = {Mat3::Identity(), Vec3(0, -0.02, -0.15)},
+                  .X_QP = {Mat3::Identity(), Vec3(0, -0.02, -0.15)},
                   .render_mesh = std::make_shared<const collision::Mesh>(
                       collision::make_box(Vec3(0.01, 0.0195, 0.01)))});
   engine::Simulation sim(std::move(scene));

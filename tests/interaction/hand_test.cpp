@@ -46,7 +46,7 @@ constexpr Real kSlabBottom = -0.002;
 engine::Scene slab_scene() {
   engine::Scene scene;
   scene.add_part({.name = "slab",
-                  .X_PC = {collision::Mat3::Identity(), Vec3(0, -0.001, -0.1)},
+                  .X_QP = {collision::Mat3::Identity(), Vec3(0, -0.001, -0.1)},
                   .movable = false,
                   .render_mesh = std::make_shared<const collision::Mesh>(
                       collision::make_box(Vec3(0.2, 0.001, 0.2)))});
@@ -151,7 +151,7 @@ engine::Scene blocks_scene() {
       std::make_shared<const collision::Mesh>(collision::make_box(Vec3(0.02, 0.03, 0.05)));
   for (int i = 0; i < 3; ++i) {
     scene.add_part({.name = "block" + std::to_string(i),
-                    .X_PC = {collision::Mat3::Identity(), Vec3(-0.15 + 0.15 * i, 0, -0.08)},
+                    .X_QP = {collision::Mat3::Identity(), Vec3(-0.15 + 0.15 * i, 0, -0.08)},
                     .movable = i == 1,
                     .render_mesh = block});
   }

@@ -37,7 +37,7 @@ engine::Scene peg_and_block(const Transform& X_WPeg, int sides = 64) {
        .render_mesh = std::make_shared<const collision::Mesh>(collision::make_block_with_hole(
            Vec3(0.04, kBlockTop, 0.04), kHoleRadius, kHoleDepth, sides))});
   scene.add_part({.name = "peg",
-                  .X_PC = X_WPeg,
+                  .X_QP = X_WPeg,
                   .render_mesh = std::make_shared<const collision::Mesh>(
                       collision::make_cylinder(kPegRadius, kPegLength, 64))});
   return scene;

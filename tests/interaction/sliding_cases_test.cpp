@@ -62,7 +62,7 @@ TEST(SlidingCases, ACubePressedOntoABlockSlidesAlongItsTopAndOverItsSharpEdge) {
   engine::Scene scene;
   scene.add_part({.name = "block", .movable = false, .render_mesh = box(Vec3(0.03, 0.02, 0.03))});
   scene.add_part({.name = "cube",
-                  .X_PC = {Mat3::Identity(), Vec3(-0.02, 0.0251, 0)},
+                  .X_QP = {Mat3::Identity(), Vec3(-0.02, 0.0251, 0)},
                   .render_mesh = box(Vec3::Constant(0.005))});
   engine::Simulation sim(std::move(scene));
   const Vec3 hand0(-0.02, 0.2, 0);
@@ -95,7 +95,7 @@ TEST(SlidingCases, APartHeldWhileOverlappingAnotherStaysWhereItIsAndIsNeverLost)
   engine::Scene scene;
   scene.add_part({.name = "block", .movable = false, .render_mesh = box(Vec3(0.03, 0.02, 0.03))});
   scene.add_part({.name = "cube",
-                  .X_PC = {Mat3::Identity(), Vec3(0, 0.024, 0)},
+                  .X_QP = {Mat3::Identity(), Vec3(0, 0.024, 0)},
                   .render_mesh = box(Vec3::Constant(0.005))});
   engine::Simulation sim(std::move(scene));
   Hand hand(sim,
@@ -126,10 +126,10 @@ TEST(SlidingCases, TwoHeldPartsSlideAgainstEachOtherAtOnce) {
   // and as the hands then move apart vertically the cubes slide along each other.
   engine::Scene scene;
   scene.add_part({.name = "left_cube",
-                  .X_PC = {Mat3::Identity(), Vec3(-0.03, 0, 0)},
+                  .X_QP = {Mat3::Identity(), Vec3(-0.03, 0, 0)},
                   .render_mesh = box(Vec3::Constant(0.01))});
   scene.add_part({.name = "right_cube",
-                  .X_PC = {Mat3::Identity(), Vec3(0.03, 0, 0)},
+                  .X_QP = {Mat3::Identity(), Vec3(0.03, 0, 0)},
                   .render_mesh = box(Vec3::Constant(0.01))});
   engine::Simulation sim(std::move(scene));
   HandSettings left_settings, right_settings;

@@ -7,7 +7,7 @@
 /// Why: everything above the collision layer (scripts, the hand, reports)
 /// speaks of parts by name. The scene owns those names and the hierarchy, so
 /// a sub-assembly moves as one: a part's world pose is its parent's world
-/// pose times its local pose, X_WC = X_WP * X_PC. Parts are flat arrays
+/// pose times its local pose, X_WP = X_WQ * X_QP. Parts are flat arrays
 /// addressed by PartId (index + generation), never by pointer; meshes are
 /// shared (`shared_ptr<const Mesh>`) between instances of the same geometry.
 
@@ -55,7 +55,7 @@ struct PartDef {
   std::string name{};               ///< unique in the scene, not empty
   std::vector<std::string> tags{};  ///< free labels ("fastener", "housing")
   std::string parent{};             ///< name of the parent part; empty: the world
-  Transform X_PC{};                 ///< local pose: the part in its parent's frame
+  Transform X_QP{};                 ///< local pose: the part in its parent's frame
   bool movable = true;              ///< false: fixed; pairs of two fixed parts are never tested
   /// Geometry to draw; may be null for a group (a sub-assembly node).
   std::shared_ptr<const collision::Mesh> render_mesh{};
@@ -105,18 +105,18 @@ class Scene {
   /// is; otherwise the local pose is kept. Throws SceneError on a cycle.
   void set_parent(PartId part, PartId parent, bool keep_world_pose = true);
 
-  /// X_PC, the part in its parent's frame (the world's for a root part).
+  /// X_QP, the part in its parent's frame (the world's for a root part).
   const Transform& local_pose(PartId part) const;
-  void set_local_pose(PartId part, const Transform& X_PC);
-  void set_local_pose(std::string_view name, const Transform& X_PC) {
-    set_local_pose(get(name), X_PC);
+  void set_local_pose(PartId part, const Transform& X_QP);
+  void set_local_pose(std::string_view name, const Transform& X_QP) {
+    set_local_pose(get(name), X_QP);
   }
-  /// X_WC, the part C in the world: X_WP * X_PC with P its parent (in the
-  /// scene's letters C is the part and P its parent), composed from the root down.
+  /// X_WP, the part P in the world: X_WQ * X_QP with Q its parent, composed
+  /// from the root down.
   Transform world_pose(PartId part) const;
   Transform world_pose(std::string_view name) const { return world_pose(get(name)); }
-  /// Sets the local pose X_PC so that the part's world pose becomes X_WC.
-  void set_world_pose(PartId part, const Transform& X_WC);
+  /// Sets the local pose X_QP so that the part's world pose becomes X_WP.
+  void set_world_pose(PartId part, const Transform& X_WP);
 
   const std::string& collision_group(PartId part) const;
   const std::optional<std::array<float, 3>>& color(PartId part) const;
@@ -149,7 +149,7 @@ class Scene {
     std::string name;
     std::vector<std::string> tags;
     PartId parent;
-    Transform X_PC;
+    Transform X_QP;
     bool movable = true;
     std::string collision_group;
     std::optional<std::array<float, 3>> color;

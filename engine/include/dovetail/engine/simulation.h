@@ -56,7 +56,7 @@ struct SimulationSettings {
 struct PoseCommand {
   std::uint64_t frame = 0;
   std::string part{};
-  Transform X_PC{};  ///< the new local pose
+  Transform X_QP{};  ///< the new local pose
 };
 
 /// An axis-aligned box in the world frame.
