@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "broadphase/multi_box_pruning.h"
 #include "broadphase/octree.h"
 #include "broadphase/proxy_pairs.h"
 #include "broadphase/uniform_grid.h"
@@ -447,6 +448,56 @@ TEST(Broadphase, OctreeSplitsAndMerges) {
   octree.pairs(out);
   EXPECT_EQ(octree.node_count(), 1u);
   EXPECT_TRUE(out.empty());
+}
+
+TEST(Broadphase, MultiBoxPruningLayout) {
+  // Boxes of extent 1 strung out along z: the sweep runs along z, the columns
+  // are 8 median extents wide across it, and re-chosen when the boxes grow.
+  MultiBoxPruning mbp;
+  std::unique_ptr<Broadphase> brute = make_broadphase(BroadphaseMethod::kBrute);
+  std::vector<ProxyPair> out, expected;
+  for (ProxyId id = 0; id < 100; ++id) {
+    const Vec3 c(id % 5, id % 7, 3.0 * id);
+    mbp.add(id, Aabb{c, c + Vec3::Constant(1)});
+    brute->add(id, Aabb{c, c + Vec3::Constant(1)});
+  }
+  mbp.pairs(out);
+  brute->pairs(expected);
+  EXPECT_EQ(mbp.sweep_axis(), 2);
+  EXPECT_DOUBLE_EQ(mbp.column_size(), 8.0);
+  EXPECT_EQ(out, expected);
+  for (ProxyId id = 0; id < 100; ++id) {
+    const Vec3 c(id % 5, id % 7, 3.0 * id);
+    mbp.move(id, Aabb{c, c + Vec3::Constant(4)});
+    brute->move(id, Aabb{c, c + Vec3::Constant(4)});
+  }
+  mbp.pairs(out);
+  brute->pairs(expected);
+  EXPECT_DOUBLE_EQ(mbp.column_size(), 32.0);
+  EXPECT_EQ(out, expected);
+  // Each box overlaps the next along z unless their y offsets wrap (6 -> 0).
+  EXPECT_EQ(out.size(), 85u);
+}
+
+TEST(Broadphase, MultiBoxPruningAtTheEndsOfTheDoubles) {
+  // Centres and spreads that overflow, boxes at +-1e307 and 1e308: no hang,
+  // no undefined arithmetic, and brute force's pairs.
+  const std::vector<Aabb> boxes = {
+      {Vec3(-1e307, 0, 0), Vec3(-1e307, 1, 1)}, {Vec3(-1e307, 0.5, 0.5), Vec3(-1e307, 2, 2)},
+      {Vec3(1e307, 0, 0), Vec3(1e308, 1, 1)},   {Vec3(1.7e308, 0, 0), Vec3(1.7e308, 1, 1)},
+      {Vec3(0, -1e308, 0), Vec3(0, 1e308, 0)},  {Vec3(0, 0, 0), Vec3(1, 1, 1)},
+      {Vec3(0, 0, -1e308), Vec3(1, 1, 1e308)},  {Vec3(1.7e308, 1, 1), Vec3(1.7e308, 2, 2)}};
+  std::unique_ptr<Broadphase> brute = make_broadphase(BroadphaseMethod::kBrute);
+  MultiBoxPruning mbp;
+  for (ProxyId id = 0; id < boxes.size(); ++id) {
+    brute->add(id, boxes[id]);
+    mbp.add(id, boxes[id]);
+  }
+  std::vector<ProxyPair> expected, got;
+  brute->pairs(expected);
+  mbp.pairs(got);
+  EXPECT_EQ(got, expected);
+  EXPECT_FALSE(expected.empty());
 }
 
 TEST(BroadphaseAgreement, Uniform100) {

@@ -4,6 +4,7 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "broadphase/proxy_pairs.h"
@@ -55,7 +56,9 @@ void MultiBoxPruning::choose_layout() {
   for (int k = 0; k < 3; ++k) {
     const detail::Bulk bulk = detail::bulk_of_centres(boxes_, present_, k, scratch_);
     low[k] = bulk.low;
-    spread[k] = bulk.spread;
+    // Coordinates near the largest doubles can overflow a centre or a spread.
+    spread[k] = bulk.spread <= std::numeric_limits<Real>::max() ? bulk.spread
+                                                                : std::numeric_limits<Real>::max();
   }
   s_ = 0;
   for (int k = 1; k < 3; ++k) {
@@ -81,7 +84,8 @@ void MultiBoxPruning::choose_layout() {
   column = std::max(column, across / (kMaxColumnsPerAxis - 2));
   if (!(column > 0) || !std::isfinite(column)) column = 1;
   const auto count = [&](Real extent) {
-    return static_cast<std::uint64_t>(std::floor(extent / column)) + 2;
+    const Real columns = std::min(std::floor(extent / column), Real{kMaxColumnsPerAxis - 2});
+    return static_cast<std::uint64_t>(columns) + 2;
   };
   const std::uint64_t limit =
       fixed_column_ > 0 ? std::uint64_t{1} << 20 : std::max<std::uint64_t>(16, n);
