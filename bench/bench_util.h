@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
 namespace dovetail::bench {
@@ -54,6 +55,17 @@ inline double real(const char* program, const char* option, const char* text, do
     std::exit(2);
   }
   return v;
+}
+
+/// The items of a comma-separated list ("a,b,c"); an empty item stays empty.
+inline std::vector<std::string> comma_list(const std::string& list) {
+  std::vector<std::string> items;
+  for (std::size_t start = 0; start <= list.size();) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    items.push_back(list.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return items;
 }
 
 }  // namespace dovetail::bench

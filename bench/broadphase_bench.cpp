@@ -481,16 +481,12 @@ Options parse(int argc, char** argv) {
       o.speed = dovetail::bench::real("broadphase_bench", "--speed", value, 0);
     } else if (arg == "--methods") {
       o.methods.clear();
-      std::string list = value;
-      for (std::size_t start = 0; start <= list.size();) {
-        const std::size_t comma = std::min(list.find(',', start), list.size());
-        const std::string name = list.substr(start, comma - start);
+      for (const std::string& name : dovetail::bench::comma_list(value)) {
         const std::optional<BroadphaseMethod> m = parse_broadphase(name);
         if (!m || *m == BroadphaseMethod::kBrute) {
           usage(("unknown method '" + name + "' in --methods (sap, grid, octree, mbp)").c_str());
         }
         o.methods.push_back(*m);
-        start = comma + 1;
       }
     } else if (arg == "--write-scene") {
       o.write_scene = value;

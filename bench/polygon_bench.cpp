@@ -244,11 +244,8 @@ int main(int argc, char** argv) {
     else if (arg == "--with-brute")
       options.with_brute = true;
     else if (arg == "--methods") {
-      std::string list = value();
-      for (std::size_t start = 0; start <= list.size();) {
-        const std::size_t comma = std::min(list.find(',', start), list.size());
-        options.methods.push_back(list.substr(start, comma - start));
-        start = comma + 1;
+      for (std::string& name : dovetail::bench::comma_list(value())) {
+        options.methods.push_back(std::move(name));
       }
     } else if (arg == "--help") {
       std::printf(

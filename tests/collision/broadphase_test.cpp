@@ -456,10 +456,13 @@ TEST(Broadphase, MultiBoxPruningLayout) {
   MultiBoxPruning mbp;
   std::unique_ptr<Broadphase> brute = make_broadphase(BroadphaseMethod::kBrute);
   std::vector<ProxyPair> out, expected;
-  for (ProxyId id = 0; id < 100; ++id) {
+  const auto box = [](ProxyId id, Real extent) {
     const Vec3 c(id % 5, id % 7, 3.0 * id);
-    mbp.add(id, Aabb{c, c + Vec3::Constant(1)});
-    brute->add(id, Aabb{c, c + Vec3::Constant(1)});
+    return Aabb{c, c + Vec3::Constant(extent)};
+  };
+  for (ProxyId id = 0; id < 100; ++id) {
+    mbp.add(id, box(id, 1));
+    brute->add(id, box(id, 1));
   }
   mbp.pairs(out);
   brute->pairs(expected);
@@ -467,9 +470,8 @@ TEST(Broadphase, MultiBoxPruningLayout) {
   EXPECT_DOUBLE_EQ(mbp.column_size(), 8.0);
   EXPECT_EQ(out, expected);
   for (ProxyId id = 0; id < 100; ++id) {
-    const Vec3 c(id % 5, id % 7, 3.0 * id);
-    mbp.move(id, Aabb{c, c + Vec3::Constant(4)});
-    brute->move(id, Aabb{c, c + Vec3::Constant(4)});
+    mbp.move(id, box(id, 4));
+    brute->move(id, box(id, 4));
   }
   mbp.pairs(out);
   brute->pairs(expected);

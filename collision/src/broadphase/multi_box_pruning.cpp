@@ -70,8 +70,7 @@ void MultiBoxPruning::choose_layout() {
   // The column edge: a multiple of the median extent across the sweep axis.
   Real extent_sum = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const Aabb& b = boxes_[present_[i]];
-    scratch_[i] = ((b.max[u_] - b.min[u_]) + (b.max[v_] - b.min[v_])) / 2;
+    scratch_[i] = extent_across(boxes_[present_[i]]);
     extent_sum += scratch_[i];
   }
   std::nth_element(scratch_.begin(), scratch_.begin() + static_cast<std::ptrdiff_t>(n / 2),
@@ -100,19 +99,16 @@ void MultiBoxPruning::choose_layout() {
   chosen_mean_extent_ = extent_sum / static_cast<Real>(n);
 }
 
-std::uint16_t MultiBoxPruning::column_u(Real x) const {
-  // floor((x - origin) / edge), clamped: monotone in x.
-  const Real t = (x - origin_u_) * inverse_column_;
+std::uint16_t MultiBoxPruning::column_of(Real x, Real origin, std::uint32_t columns) const {
+  // floor((x - origin) / edge), clamped to [0, columns - 1]: monotone in x.
+  const Real t = (x - origin) * inverse_column_;
   if (!(t > 0)) return 0;
-  if (t >= static_cast<Real>(columns_u_ - 1)) return static_cast<std::uint16_t>(columns_u_ - 1);
+  if (t >= static_cast<Real>(columns - 1)) return static_cast<std::uint16_t>(columns - 1);
   return static_cast<std::uint16_t>(t);
 }
 
-std::uint16_t MultiBoxPruning::column_v(Real x) const {
-  const Real t = (x - origin_v_) * inverse_column_;
-  if (!(t > 0)) return 0;
-  if (t >= static_cast<Real>(columns_v_ - 1)) return static_cast<std::uint16_t>(columns_v_ - 1);
-  return static_cast<std::uint16_t>(t);
+Real MultiBoxPruning::extent_across(const Aabb& b) const {
+  return ((b.max[u_] - b.min[u_]) + (b.max[v_] - b.min[v_])) / 2;
 }
 
 bool MultiBoxPruning::span_all(bool allow_drift) {
@@ -125,10 +121,12 @@ bool MultiBoxPruning::span_all(bool allow_drift) {
   const Real end_v = origin_v_ + static_cast<Real>(columns_v_) * column_;
   for (std::size_t i = 0; i < n; ++i) {
     const Aabb& b = boxes_[sequence_[i]];
-    extent_sum += ((b.max[u_] - b.min[u_]) + (b.max[v_] - b.min[v_])) / 2;
+    extent_sum += extent_across(b);
     const Real cu = (b.min[u_] + b.max[u_]) / 2, cv = (b.min[v_] + b.max[v_]) / 2;
     outside += (cu < origin_u_) | (cu > end_u) | (cv < origin_v_) | (cv > end_v);
-    Span span{column_u(b.min[u_]), column_u(b.max[u_]), column_v(b.min[v_]), column_v(b.max[v_])};
+    Span span{
+        column_of(b.min[u_], origin_u_, columns_u_), column_of(b.max[u_], origin_u_, columns_u_),
+        column_of(b.min[v_], origin_v_, columns_v_), column_of(b.max[v_], origin_v_, columns_v_)};
     const std::uint32_t cover =
         std::uint32_t{span.u1 - span.u0 + 1u} * std::uint32_t{span.v1 - span.v0 + 1u};
     if (cover > kMaxColumnsPerBox) {
@@ -238,8 +236,7 @@ std::size_t MultiBoxPruning::sweep_columns(std::vector<Key>& keys, int bits) {
         const bool hit = (a.lo_u <= b.hi_u) & (b.lo_u <= a.hi_u) & (a.lo_v <= b.hi_v) &
                          (b.lo_v <= a.hi_v) & (std::max(a.u0, b.u0) == cu) &
                          (std::max(a.v0, b.v0) == cv);
-        const Key low = std::min(a.id, b.id), high = std::max(a.id, b.id);
-        dst[hits] = static_cast<Key>((low << bits) | high);
+        dst[hits] = detail::pair_key<Key>(a.id, b.id, bits);
         hits += hit;
       }
       tests += j - i - 1;
@@ -261,8 +258,7 @@ std::size_t MultiBoxPruning::test_big_boxes(std::vector<Key>& keys, std::size_t 
       ++stats_.box_tests;
       if (!box.overlaps(boxes_[other])) continue;
       if (2 * (found + 1) > keys.size()) keys.resize(4 * (found + 1) + 128);
-      const Key low = std::min(big, other), high = std::max(big, other);
-      keys[found++] = static_cast<Key>((low << bits) | high);
+      keys[found++] = detail::pair_key<Key>(big, other, bits);
     }
   }
   return found;

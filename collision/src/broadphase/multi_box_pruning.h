@@ -80,8 +80,10 @@ class MultiBoxPruning final : public Broadphase {
   static constexpr std::uint16_t kBig = 0xffff;
 
   void choose_layout();
-  std::uint16_t column_u(Real x) const;
-  std::uint16_t column_v(Real x) const;
+  /// The column of coordinate x on an axis whose columns start at `origin`.
+  std::uint16_t column_of(Real x, Real origin, std::uint32_t columns) const;
+  /// A box's mean edge across the sweep axis.
+  Real extent_across(const Aabb& b) const;
   /// Spans of every box in sequence_; false when the layout has drifted.
   bool span_all(bool allow_drift);
   void fill_columns();

@@ -47,6 +47,13 @@ Key* radix_sort(Key* in, Key* out, std::size_t n, int bits, std::vector<std::uin
   return in;
 }
 
+/// The sort key of the pair of ids x and y (in either order): (low << bits) | high.
+template <typename Key>
+Key pair_key(ProxyId x, ProxyId y, int bits) {
+  const Key low = std::min(x, y), high = std::max(x, y);
+  return static_cast<Key>((low << bits) | high);
+}
+
 /// The pairs of the first `n` keys (a << bits) | b of `keys` (which has room
 /// for 2n), sorted by (a, b), into `pairs`.
 template <typename Key>
@@ -74,7 +81,7 @@ void sort_pair_keys(std::vector<ProxyPair>& pairs, std::vector<Key>& keys, int b
   const std::size_t n = pairs.size();
   keys.resize(2 * n);
   for (std::size_t i = 0; i < n; ++i) {
-    keys[i] = static_cast<Key>((static_cast<Key>(pairs[i].a) << bits) | pairs[i].b);
+    keys[i] = pair_key<Key>(pairs[i].a, pairs[i].b, bits);
   }
   pairs_from_keys(keys, n, bits, counts, pairs);
 }

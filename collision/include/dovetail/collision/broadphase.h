@@ -70,7 +70,7 @@ struct BroadphaseSettings {
   /// ... until this depth.
   int octree_max_depth = 10;
   /// Multi-box pruning: column edge across the sweep axis; 0 = chosen from
-  /// the boxes (4 times their median extent across it).
+  /// the boxes (8 times their median extent across it).
   Real mbp_column = 0;
 };
 
