@@ -239,9 +239,16 @@ ProtocolPair protocol_pair(const Args& args,
     const PegAndRing job = peg_and_ring();
     pair = {prepared(job.ring), prepared(job.peg)};
   } else {
-    pair.a = prepared(load_mesh(files[0]).mesh);
-    pair.b =
-        files.size() == 1 || files[1] == files[0] ? pair.a : prepared(load_mesh(files[1]).mesh);
+    // The table is not a file the meshes refer to either (a glTF buffer).
+    const auto load = [&args](const std::string& file) {
+      LoadedMesh loaded = load_mesh(file);
+      if (const std::optional<std::string> table = args.value("table")) {
+        refuse_overwriting_input("bench", *table, loaded.report.files);
+      }
+      return loaded.mesh;
+    };
+    pair.a = prepared(load(files[0]));
+    pair.b = files.size() == 1 || files[1] == files[0] ? pair.a : prepared(load(files[1]));
   }
   std::printf("A: %s (%zu triangles)\nB: %s (%zu triangles)\n",
               files.empty() ? "ring (torus)" : files[0].c_str(), pair.a->triangle_count(),
@@ -258,14 +265,14 @@ bench::Progress terminal_progress(const char* what) {
   };
 }
 
-/// InputError when --table names a file that cannot be written: checked
-/// before the protocol runs, so that no run is lost to it.
+/// InputError when --table names a file that cannot be written, UsageError
+/// when it names a mesh: checked before the protocol runs, so that no run is
+/// lost to it, and without touching an existing file.
 void check_table(const Args& args) {
   const std::optional<std::string> path = args.value("table");
   if (!path) return;
-  std::FILE* file = std::fopen(path->c_str(), "w");
-  if (file == nullptr) throw InputError(*path + ": cannot be written");
-  std::fclose(file);
+  refuse_overwriting_input("bench", *path, args.positional());
+  check_writable(*path);
 }
 
 /// Writes the table when --table is given; InputError when it cannot be.

@@ -141,7 +141,7 @@ int broadphase_command(std::span<const std::string> argv) {
   const std::unique_ptr<collision::Broadphase> broadphase = collision::make_broadphase(method);
   BoxesRun run;
   const std::optional<std::string> error = run_boxes(reader, *broadphase, run, output);
-  output.close();
+  output.close(error.has_value());
 
   const std::vector<double>& ms = run.frame_ms;
   const std::vector<double> after_first(ms.begin() + (ms.empty() ? 0 : 1), ms.end());

@@ -3,10 +3,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <utility>
 
 namespace dovetail::cli {
@@ -171,18 +174,42 @@ collision::Method Args::method(collision::Method fallback) const {
   return *m;
 }
 
+bool same_file(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const bool same = fs::exists(a, ec) ? fs::equivalent(a, b, ec)
+                                      : fs::absolute(a, ec).lexically_normal() ==
+                                            fs::absolute(b, ec).lexically_normal();
+  return same && !ec;
+}
+
 void refuse_overwriting_input(const std::string& command, const std::string& output,
                               std::span<const std::string> inputs) {
-  namespace fs = std::filesystem;
   for (const std::string& input : inputs) {
-    std::error_code ec;
-    const bool same = fs::exists(output, ec) ? fs::equivalent(output, input, ec)
-                                             : fs::absolute(output, ec).lexically_normal() ==
-                                                   fs::absolute(input, ec).lexically_normal();
-    if (same && !ec) {
+    if (same_file(output, input)) {
       throw UsageError(command + ": the output '" + output + "' is the input '" + input +
                        "'; it would be overwritten");
     }
+  }
+}
+
+void check_writable(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw InputError(path + ": cannot be written: is a directory");
+  if (fs::exists(path, ec)) {
+    // Appending opens the file for writing without changing it.
+    std::ofstream probe(path, std::ios::binary | std::ios::app);
+    if (!probe) throw InputError(path + ": cannot be written: " + std::strerror(errno));
+    return;
+  }
+  const fs::path folder = fs::path(path).parent_path();
+  if (!folder.empty() && !fs::is_directory(folder, ec)) {
+    throw InputError(path + ": cannot be written: the folder " + folder.string() +
+                     " does not exist");
+  }
+  if (::access(folder.empty() ? "." : folder.c_str(), W_OK) != 0) {
+    throw InputError(path + ": cannot be written: " + std::strerror(errno));
   }
 }
 

@@ -81,10 +81,19 @@ class Args {
   std::set<std::string> flags_set_;
 };
 
+/// Whether two paths name one file (or would, when `a` does not exist yet).
+bool same_file(const std::string& a, const std::string& b);
+
 /// UsageError when `output` names the same file as one of `inputs`: writing
 /// it would destroy an input before it is read.
 void refuse_overwriting_input(const std::string& command, const std::string& output,
                               std::span<const std::string> inputs);
+
+/// InputError unless `path` can be written: not a folder, in a folder that
+/// exists and, when the file exists, open for writing. Creates and truncates
+/// nothing, so that a command can check its outputs before any work and still
+/// leave an existing file as it was when the run fails on its inputs.
+void check_writable(const std::string& path);
 
 /// "boxtree, dop6, ..., brute".
 std::string method_list();

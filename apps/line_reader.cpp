@@ -106,14 +106,18 @@ void expect_end(LineReader& reader, const FrameCounts& counts) {
 FramePairsOutput::FramePairsOutput(const std::string& command,
                                    const std::optional<std::string>& path,
                                    std::span<const std::string> inputs)
-    : path_(path) {
+    : command_(command), path_(path) {
   if (!path_) return;
-  refuse_overwriting_input(command, *path_, inputs);
-  out_.open(*path_, std::ios::binary | std::ios::trunc);
-  if (!out_) throw InputError(*path_ + ": cannot be written: " + std::strerror(errno));
+  refuse(inputs);
+  check_writable(*path_);
+}
+
+void FramePairsOutput::refuse(std::span<const std::string> inputs) const {
+  if (path_) refuse_overwriting_input(command_, *path_, inputs);
 }
 
 void FramePairsOutput::frame(std::uint64_t k, std::size_t count) {
+  framed_ = true;
   if (text_.size() > (std::size_t{1} << 20)) flush();
   text_ += "frame " + std::to_string(k) + " count " + std::to_string(count) + "\n";
 }
@@ -127,6 +131,10 @@ void FramePairsOutput::pair(std::uint64_t i, std::uint64_t j) {
 
 void FramePairsOutput::flush() {
   if (path_) {
+    if (!out_.is_open()) {
+      out_.open(*path_, std::ios::binary | std::ios::trunc);
+      if (!out_) throw InputError(*path_ + ": cannot be written: " + std::strerror(errno));
+    }
     out_.write(text_.data(), static_cast<std::streamsize>(text_.size()));
   } else {
     std::fwrite(text_.data(), 1, text_.size(), stdout);
@@ -134,7 +142,8 @@ void FramePairsOutput::flush() {
   text_.clear();
 }
 
-void FramePairsOutput::close() {
+void FramePairsOutput::close(bool failed) {
+  if (failed && !framed_) return;
   flush();
   if (!path_) return;
   out_.close();

@@ -71,20 +71,26 @@ void expect_end(LineReader& reader, const FrameCounts& counts);
 /// then the C pairs `i j`, buffered.
 class FramePairsOutput {
  public:
-  /// Opens the file at once, so that an unwritable destination fails before
-  /// any work; refuses to overwrite one of `inputs` (usage error).
+  /// Checks the file at once, so that an unwritable destination fails before
+  /// any work, and refuses to overwrite one of `inputs` (usage error). An
+  /// existing file is replaced only when the first frame is written.
   FramePairsOutput(const std::string& command, const std::optional<std::string>& path,
                    std::span<const std::string> inputs);
+  /// Refuses, as the constructor does, inputs known only later (a scene's meshes).
+  void refuse(std::span<const std::string> inputs) const;
   void frame(std::uint64_t k, std::size_t count);
   void pair(std::uint64_t i, std::uint64_t j);
   /// Writes what is buffered; throws InputError when writing the file failed.
-  void close();
+  /// A run that `failed` before its first frame leaves an existing file as it was.
+  void close(bool failed);
 
  private:
   void flush();
+  std::string command_;
   std::optional<std::string> path_;
   std::ofstream out_;
   std::string text_;
+  bool framed_ = false;  ///< a frame was written
 };
 
 }  // namespace dovetail::cli

@@ -99,7 +99,8 @@ struct PipelineRun {
 /// Reads the N mesh paths (each file imported once, however many parts use
 /// it) and adds one part per path to the world.
 std::vector<collision::PartId> add_parts(LineReader& reader, const std::filesystem::path& folder,
-                                         std::uint64_t parts, collision::CollisionWorld& world) {
+                                         std::uint64_t parts, collision::CollisionWorld& world,
+                                         const FramePairsOutput& output) {
   std::map<std::string, std::shared_ptr<const collision::Mesh>> meshes;
   std::vector<collision::PartId> ids;
   for (std::uint64_t i = 0; i < parts; ++i) {
@@ -112,11 +113,14 @@ std::vector<collision::PartId> add_parts(LineReader& reader, const std::filesyst
     name.erase(name.find_last_not_of(" \t") + 1);
     std::shared_ptr<const collision::Mesh>& mesh = meshes[name];
     if (!mesh) {
+      engine::ImportReport report;
       try {
-        mesh = std::make_shared<const collision::Mesh>(engine::import_mesh(folder / name));
+        report = engine::import_file(folder / name);
       } catch (const std::exception& e) {
         reader.fail("mesh of part " + std::to_string(i) + ": " + e.what());
       }
+      output.refuse(report.files);  // the pairs must not overwrite a mesh
+      mesh = std::make_shared<const collision::Mesh>(std::move(report.parts.front().mesh));
     }
     ids.push_back(world.add_part({.mesh = mesh,
                                   .X_WP = collision::Transform{},
@@ -165,8 +169,8 @@ std::optional<std::string> run_scene(const std::string& scene_path,
     run.parts = counts.items;
     run.frames = counts.frames;
     if (run.parts > 1'000'000) reader.fail("more than 1,000,000 parts");
-    const std::vector<collision::PartId> ids =
-        add_parts(reader, std::filesystem::path(scene_path).parent_path(), run.parts, world);
+    const std::vector<collision::PartId> ids = add_parts(
+        reader, std::filesystem::path(scene_path).parent_path(), run.parts, world, output);
     const auto build_start = std::chrono::steady_clock::now();
     world.prepare();
     run.build_ms = ms_since(build_start);
@@ -206,7 +210,7 @@ int pipeline_command(std::span<const std::string> argv) {
                                    .cross_check = std::nullopt});
   PipelineRun run;
   const std::optional<std::string> error = run_scene(scene_path, world, run, output);
-  output.close();
+  output.close(error.has_value());
 
   const std::vector<double> after_first(run.frame_ms.begin() + (run.frame_ms.empty() ? 0 : 1),
                                         run.frame_ms.end());

@@ -81,13 +81,14 @@ int poses_command(std::span<const std::string> argv) {
 
   const std::string inputs[] = {args.positional()[0], args.positional()[1]};
   refuse_overwriting_input("poses", out_path, inputs);
-  std::ofstream out(out_path, std::ios::binary | std::ios::trunc);
-  if (!out) throw InputError(out_path + ": cannot be written: " + std::strerror(errno));
+  check_writable(out_path);  // replaced only once the poses are there
 
   const std::string& path_a = args.positional()[0];
   const std::string& path_b = args.positional()[1];
   const LoadedMesh a = load_mesh(path_a);
   const LoadedMesh b = load_mesh(path_b);
+  refuse_overwriting_input("poses", out_path, a.report.files);
+  refuse_overwriting_input("poses", out_path, b.report.files);
   const BuiltModel model_a = build_timed(collision::Method::kBoxtree, a.mesh);
   const BuiltModel model_b = build_timed(collision::Method::kBoxtree, b.mesh);
 
@@ -96,6 +97,8 @@ int poses_command(std::span<const std::string> argv) {
       collision::contact_distance_poses(*model_a.model, *model_b.model, settings);
   const double generate_ms = ms_since(start);
 
+  std::ofstream out(out_path, std::ios::binary | std::ios::trunc);
+  if (!out) throw InputError(out_path + ": cannot be written: " + std::strerror(errno));
   write_poses(out, path_a, path_b, settings, poses);
   out.close();
   if (!out) throw InputError(out_path + ": write failed: " + std::strerror(errno));

@@ -326,13 +326,12 @@ int query_command(std::span<const std::string> argv) {
   }
   const QueryOptions o = parse_query_options(args);
 
-  // Open the output first: an unwritable destination should fail before any work.
-  std::ofstream out;
+  // Check the output first: an unwritable destination should fail before any
+  // work. It is replaced only once the answers are there.
   if (o.out_path) {
     const std::string inputs[] = {o.path_a, o.path_b, o.poses_path};
     refuse_overwriting_input("query", *o.out_path, inputs);
-    out.open(*o.out_path, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(*o.out_path + ": cannot be written: " + std::strerror(errno));
+    check_writable(*o.out_path);
   }
   std::optional<engine::PoseListReader> reader;
   try {
@@ -344,11 +343,17 @@ int query_command(std::span<const std::string> argv) {
   const LoadedMesh b = load_mesh(o.path_b);
   print_notes(o.path_a, a);
   print_notes(o.path_b, b);
+  if (o.out_path) {  // nor a file the meshes refer to (a glTF buffer)
+    refuse_overwriting_input("query", *o.out_path, a.report.files);
+    refuse_overwriting_input("query", *o.out_path, b.report.files);
+  }
 
   const PoseBatch batch = read_poses(*reader);
   const QueryOutcome r = o.distance_mode ? run_distance_mode(o, a, b, batch.poses)
                                          : run_collision_mode(o, a, b, batch.poses);
   if (o.out_path) {
+    std::ofstream out(*o.out_path, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(*o.out_path + ": cannot be written: " + std::strerror(errno));
     out.write(r.lines.data(), static_cast<std::streamsize>(r.lines.size()));
     out.close();
     if (!out) throw InputError(*o.out_path + ": write failed: " + std::strerror(errno));

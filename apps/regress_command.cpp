@@ -57,8 +57,9 @@ struct Job {
   double seconds = 0;
   int exit_code = -1;
   bool timed_out = false;
-  std::string status;  ///< passed, failed, error
-  std::string log;     ///< what the run wrote on stderr
+  std::string stopped;  ///< why the run was stopped from outside, if it was
+  std::string status;   ///< passed, failed, error
+  std::string log;      ///< what the run wrote on stderr
   nlohmann::json report;
 };
 
@@ -125,7 +126,7 @@ std::string first_reason(const Job& job) {
     if (line.rfind("warning: ", 0) == 0 || line.empty()) continue;
     return line;
   }
-  return job.timed_out ? "stopped after the timeout" : job.status;
+  return job.stopped.empty() ? job.status : job.stopped;
 }
 
 void start(Job& job, const std::filesystem::path& out, int threads) {
@@ -145,6 +146,8 @@ void start(Job& job, const std::filesystem::path& out, int threads) {
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   const std::string log = (out / (job.stem + ".log")).string();
+  std::error_code ec;  // a report left by an earlier regress must not pass for this run's
+  std::filesystem::remove(out / (job.stem + ".json"), ec);
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
@@ -159,14 +162,30 @@ void start(Job& job, const std::filesystem::path& out, int threads) {
 void finish(Job& job, int wait_status, const std::filesystem::path& out) {
   job.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - job.start).count();
   job.exit_code = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : 128 + WTERMSIG(wait_status);
-  job.log = read_file(out / (job.stem + ".log"));
   if (WIFSIGNALED(wait_status) && !job.timed_out) {
-    job.log += "the run ended with signal " + std::to_string(WTERMSIG(wait_status)) + "\n";
+    job.stopped = "the run ended with signal " + std::to_string(WTERMSIG(wait_status));
   }
   job.status = job.exit_code == kExitOk            ? "passed"
                : job.exit_code == kExitCheckFailed ? "failed"
                                                    : "error";
+  const std::filesystem::path log = out / (job.stem + ".log");
   const std::filesystem::path report = out / (job.stem + ".json");
+  if (!job.stopped.empty()) {
+    // The run wrote no report: the log and a report say why it stopped.
+    std::ofstream(log, std::ios::binary | std::ios::app) << job.stopped << "\n";
+    if (!std::filesystem::exists(report)) {
+      const nlohmann::json stub = {{"format", "dovetail-scenario-report"},
+                                   {"version", 1},
+                                   {"scenario", job.stem},
+                                   {"file", job.file.generic_string()},
+                                   {"outcome", "error"},
+                                   {"error", job.stopped},
+                                   {"expectations", nlohmann::json::array()},
+                                   {"steps", nlohmann::json::array()}};
+      std::ofstream(report, std::ios::binary) << stub.dump(2) << "\n";
+    }
+  }
+  job.log = read_file(log);
   if (std::filesystem::exists(report)) {
     job.report = nlohmann::json::parse(read_file(report), nullptr, false);
     if (job.report.is_discarded()) job.report = nlohmann::json();
@@ -368,6 +387,9 @@ void run_jobs(std::vector<Job>& jobs, const std::filesystem::path& out, std::siz
       if (job.pid > 0 && !job.timed_out &&
           std::chrono::duration<double>(now - job.start).count() > timeout) {
         job.timed_out = true;
+        char reason[96];
+        std::snprintf(reason, sizeof reason, "stopped after the timeout of %g s", timeout);
+        job.stopped = reason;
         kill(job.pid, SIGKILL);
       }
     }
@@ -393,6 +415,20 @@ int regress_command(std::span<const std::string> argv) {
   const double timeout = args.number("timeout", 1).value_or(900);
   const auto [shard_k, shard_n] = parse_shard(args);
   make_folder(out);
+  // The summaries are checked before any scenario runs: neither a scenario
+  // nor each other, and writable.
+  std::vector<std::string> scenarios;
+  for (const std::filesystem::path& f : scenario_files(folder)) scenarios.push_back(f.string());
+  const std::optional<std::string> junit = args.value("junit");
+  const std::optional<std::string> html = args.value("html");
+  for (const std::optional<std::string>& summary : {junit, html}) {
+    if (!summary) continue;
+    refuse_overwriting_input("regress", *summary, scenarios);
+    check_writable(*summary);
+  }
+  if (junit && html && same_file(*junit, *html)) {
+    throw UsageError("regress: --junit and --html name the same file '" + *junit + "'");
+  }
   std::vector<Job> jobs = shard_jobs(folder, shard_k, shard_n);
 
   const auto begin = std::chrono::steady_clock::now();
@@ -402,8 +438,8 @@ int regress_command(std::span<const std::string> argv) {
   std::size_t passed = 0;
   for (const Job& j : jobs) passed += j.status == "passed";
   std::printf("%zu of %zu scenarios passed (%.1f s)\n", passed, jobs.size(), total);
-  if (auto junit = args.value("junit")) write_junit(jobs, *junit, total);
-  if (auto html = args.value("html")) write_html(jobs, *html, out);
+  if (junit) write_junit(jobs, *junit, total);
+  if (html) write_html(jobs, *html, out);
   return passed == jobs.size() ? kExitOk : kExitCheckFailed;
 }
 

@@ -49,20 +49,10 @@ same input and options give the same PNG bytes. Prints a one-line JSON summary
 on standard output.
 )";
 
-/// InputError unless `path` could be created: not a folder, and its folder exists.
-void check_writable(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw InputError(path + ": cannot be written: is a directory");
-  const fs::path folder = fs::path(path).parent_path();
-  if (!folder.empty() && !fs::is_directory(folder, ec)) {
-    throw InputError(path + ": cannot be written: the folder " + folder.string() +
-                     " does not exist");
-  }
-}
-
-/// The parts of a mesh or assembly file, in file units.
-engine::RenderScene scene_of_file(const std::string& input, std::uint64_t& triangles) {
+/// The parts of a mesh or assembly file, in file units; `files` gets every
+/// file read.
+engine::RenderScene scene_of_file(const std::string& input, std::uint64_t& triangles,
+                                  std::vector<std::string>& files) {
   engine::ImportReport report;
   try {
     engine::ImportOptions options;
@@ -75,6 +65,7 @@ engine::RenderScene scene_of_file(const std::string& input, std::uint64_t& trian
     std::fprintf(stderr, "dovetail: note: %s: %s\n", input.c_str(), note.c_str());
   }
   for (const engine::ImportedPart& part : report.parts) triangles += part.mesh.triangle_count();
+  files = report.files;
   return engine::scene_from_import(report);
 }
 
@@ -82,7 +73,7 @@ engine::RenderScene scene_of_file(const std::string& input, std::uint64_t& trian
 engine::RenderScene scene_with_hand(const Args& args, const std::string& input,
                                     const std::optional<std::string>& trace,
                                     const std::optional<std::string>& plan,
-                                    std::uint64_t& triangles) {
+                                    std::uint64_t& triangles, std::vector<std::string>& files) {
   const double time = args.number("time", 0).value_or(0);
   interaction::HandDef hand_def;
   hand_def.size = args.value("hand-size").value_or("adult_m50");
@@ -116,6 +107,7 @@ engine::RenderScene scene_with_hand(const Args& args, const std::string& input,
     std::fprintf(stderr, "dovetail: note: %s: %s\n", input.c_str(), note.c_str());
   }
   triangles = assembly.triangles;
+  files = assembly.files;
   engine::RenderScene scene = engine::render_scene(parts);
   for (engine::RenderItem& item : interaction::hand_render_items(*model, source->sample(time))) {
     triangles += item.mesh->triangle_count();
@@ -177,13 +169,14 @@ int render_command(std::span<const std::string> argv) {
       static_cast<int>(args.integer("height", 1, engine::kMaxImageSize).value_or(768));
   settings.camera = args.value("camera").value_or("auto");
   if (settings.camera.empty()) throw UsageError("render: --camera must name a camera or be 'auto'");
-  const std::string inputs[] = {input};
-  refuse_overwriting_input("render", out, inputs);
-  check_writable(out);
-
   const std::optional<std::string> trace = args.value("trace");
   const std::optional<std::string> plan = args.value("plan");
   if (trace && plan) throw UsageError("render: give --trace or --plan, not both");
+  std::vector<std::string> inputs = {input};
+  if (trace || plan) inputs.push_back(trace ? *trace : *plan);
+  refuse_overwriting_input("render", out, inputs);
+  check_writable(out);
+
   const bool with_hand = trace || plan;
   if (!with_hand) {
     for (const char* option : {"time", "hand-size", "hand-length"}) {
@@ -193,8 +186,11 @@ int render_command(std::span<const std::string> argv) {
     }
   }
   std::uint64_t triangles = 0;
-  const engine::RenderScene scene = with_hand ? scene_with_hand(args, input, trace, plan, triangles)
-                                              : scene_of_file(input, triangles);
+  std::vector<std::string> files;
+  const engine::RenderScene scene =
+      with_hand ? scene_with_hand(args, input, trace, plan, triangles, files)
+                : scene_of_file(input, triangles, files);
+  refuse_overwriting_input("render", out, files);  // nor a file the input refers to
 
   check_camera(scene, settings.camera, input);
   const double render_ms = render_to_png(scene, settings, input, out);

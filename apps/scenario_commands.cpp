@@ -169,15 +169,39 @@ int exit_code(scripting::RunOutcome::Status status) {
   return kExitInputError;
 }
 
+/// The report and the recording, before the run: neither an input nor each
+/// other (usage errors), both writable (input error). Files the scenario
+/// itself reads are refused by the run (RunOptions::outputs).
+void check_outputs(const Args& args, const std::filesystem::path& scenario,
+                   const scripting::RunOptions& options) {
+  std::vector<std::string> inputs = {scenario.string()};
+  if (options.trace) inputs.push_back(options.trace->string());
+  const std::optional<std::string> report = args.value("report");
+  const std::optional<std::string> record = args.value("record");
+  for (const std::optional<std::string>& out : {report, record}) {
+    if (!out) continue;
+    refuse_overwriting_input(args.command(), *out, inputs);
+    check_writable(*out);
+  }
+  if (report && record && same_file(*report, *record)) {
+    throw UsageError(args.command() + ": --report and --record name the same file '" + *report +
+                     "'");
+  }
+}
+
 int run_scenario_command(const Args& args, const std::filesystem::path& scenario,
                          std::optional<std::filesystem::path> trace) {
-  const scripting::RunOptions options = run_options(args, std::move(trace));
+  scripting::RunOptions options = run_options(args, std::move(trace));
   if (!std::filesystem::exists(scenario)) throw InputError(scenario.string() + ": no such file");
   if (options.trace && !std::filesystem::exists(*options.trace)) {
     throw InputError(options.trace->string() + ": no such file");
   }
+  check_outputs(args, scenario, options);
+  if (auto path = args.value("report")) options.outputs.emplace_back(*path);
   const scripting::RunOutcome outcome = scripting::run_scenario(scenario, options);
-  if (auto path = args.value("report")) write_report(*path, outcome);
+  if (auto path = args.value("report"); path && !outcome.outputs_refused) {
+    write_report(*path, outcome);
+  }
   print_problems(options, outcome);
   if (!args.flag("quiet")) print_summary(outcome);
   return exit_code(outcome.status);

@@ -45,7 +45,11 @@ Assimp::IOStream* FolderIOSystem::Open(const char* file, const char* mode) {
   if (mode == nullptr || std::strpbrk(mode, "wa+") != nullptr) return nullptr;
   const fs::path p = resolve(file, true);
   if (p.empty()) return nullptr;
-  return files_.Open(p.string().c_str(), mode);
+  Assimp::IOStream* stream = files_.Open(p.string().c_str(), mode);
+  if (stream != nullptr && std::find(opened_.begin(), opened_.end(), p.string()) == opened_.end()) {
+    opened_.push_back(p.string());
+  }
+  return stream;
 }
 
 void FolderIOSystem::Close(Assimp::IOStream* stream) { files_.Close(stream); }

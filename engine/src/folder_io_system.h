@@ -30,6 +30,8 @@ class FolderIOSystem : public Assimp::IOSystem {
 
   /// Paths the importer tried to open and was refused, in order, without repeats.
   const std::vector<std::string>& refused() const { return refused_; }
+  /// Files the importer opened (normalised absolute paths), in order, without repeats.
+  const std::vector<std::string>& opened() const { return opened_; }
 
  private:
   /// The normalised absolute path of `file` when it lies inside root_ and is a
@@ -40,6 +42,7 @@ class FolderIOSystem : public Assimp::IOSystem {
   std::filesystem::path root_;
   Assimp::DefaultIOSystem files_;
   mutable std::vector<std::string> refused_;
+  std::vector<std::string> opened_;
 };
 
 }  // namespace dovetail::engine::detail

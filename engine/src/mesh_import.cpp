@@ -532,7 +532,9 @@ ImportReport import_file(const fs::path& path, const ImportOptions& options) {
         plural(repeated, "triangle with a repeated vertex", "triangles with a repeated vertex") +
         " while reading");
   }
-  return import_scene(path, *scene, options, std::move(notes));
+  ImportReport report = import_scene(path, *scene, options, std::move(notes));
+  report.files = io->opened();
+  return report;
 }
 
 collision::Mesh import_mesh(const fs::path& path, collision::MeshValidation* validation) {

@@ -253,6 +253,7 @@ Scene load_assembly(const fs::path& path, const AssemblyOptions& options, Assemb
 
   AssemblyReport summary;
   summary.notes = imported.notes;
+  summary.files = imported.files;
   summary.skipped_line_or_point_primitives = imported.skipped_line_or_point_primitives;
   if (!(options.units >= 0) || !std::isfinite(options.units)) {
     throw ImportError(path.string() + ": units must be a positive number of metres per unit");

@@ -97,7 +97,10 @@ int message_handler(lua_State* L) {
   } else if (lua_type(L, 1) == LUA_TSTRING || lua_type(L, 1) == LUA_TNUMBER) {
     lua_pushvalue(L, 1);
   } else if (luaL_callmeta(L, 1, "__tostring") == 0 || lua_type(L, -1) != LUA_TSTRING) {
-    lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
+    // error(nil) or error({}): Lua adds no position, so say where it was raised.
+    char where[sizeof(host.where)];
+    write_where(L, 1, where, sizeof(where));
+    lua_pushfstring(L, "%s(error object is a %s value)", where, luaL_typename(L, 1));
   }
   luaL_traceback(L, L, lua_tostring(L, -1), 1);
   return 1;
@@ -220,9 +223,29 @@ void note_memory_error(HostState& host, lua_State* L) {
   limit_exhausted(host, L);
 }
 
+namespace {
+
+/// Whether `where` ("chunk:line: " or "chunk: ") has a line.
+bool has_line(const char* where) {
+  std::size_t n = std::strlen(where);
+  if (n < 4 || where[n - 1] != ' ' || where[n - 2] != ':') return false;
+  n -= 2;
+  std::size_t digits = 0;
+  while (n > 0 && where[n - 1] >= '0' && where[n - 1] <= '9') --n, ++digits;
+  return digits > 0 && n > 0 && where[n - 1] == ':';
+}
+
+}  // namespace
+
 bool limit_exhausted(HostState& host, lua_State* L) {
   if (host.memory_failed && !host.exhausted) {
-    if (host.where[0] == '\0' && L != nullptr) write_where(L, 1, host.where, sizeof(host.where));
+    // The hook's last location has no line when it fired outside a line (in
+    // a library function): then the stack, where there is one, names it.
+    if (L != nullptr && !has_line(host.where)) {
+      char here[sizeof(host.where)];
+      write_where(L, 1, here, sizeof(here));
+      if (here[0] != '\0') std::memcpy(host.where, here, sizeof(here));
+    }
     set_exhausted(host, ScriptError::Kind::kMemory, host.where,
                   "memory limit of %zu bytes exceeded", host.limits.memory_bytes);
   }

@@ -368,6 +368,91 @@ int sandbox_string_rep(lua_State* L) {
   return host.string_rep(L);
 }
 
+// ---- string patterns: a bound on backtracking
+//
+// Lua's matcher backtracks over every repetition (`*`, `+`, `-`) that more
+// pattern follows, and neither the instruction budget nor the wall-clock guard
+// can stop it inside the library: ("a"):rep(3000):find(".-.-.-b") would run
+// for hours. A search may try about (n + 1)^(r + 1) positions for a subject
+// of n characters and r such repetitions (r + 1: every start). A pattern whose
+// bound exceeds kMaxPatternSteps is refused before it runs, the same way on
+// every run; the bounds of ordinary patterns on names and log lines are far
+// below it.
+constexpr double kMaxPatternSteps = 1e9;
+
+/// The repetitions of `pattern` that more pattern follows (Lua 5.4's syntax;
+/// a malformed pattern is left to the matcher to report).
+int backtracking_repetitions(const char* pattern, std::size_t length) {
+  std::size_t i = length > 0 && pattern[0] == '^' ? 1 : 0;
+  int repeated = 0;      // repetitions so far
+  int last_counted = 0;  // of them, those followed by another item
+  while (i < length) {
+    const char c = pattern[i];
+    if (c == '(' || c == ')') {  // captures are not items
+      ++i;
+      continue;
+    }
+    if (c == '$' && i + 1 == length) break;
+    last_counted = repeated;  // an item follows every repetition before it
+    bool single = true;       // an item that a repetition can follow
+    if (c == '%' && i + 1 < length && pattern[i + 1] == 'b') {
+      i += 4, single = false;  // %bxy
+    } else if (c == '%' && i + 1 < length && pattern[i + 1] == 'f') {
+      i += 2, single = false;  // %f[set]: the set follows
+      if (i < length && pattern[i] == '[') {
+        ++i;
+        if (i < length && pattern[i] == '^') ++i;
+        if (i < length) ++i;  // a ']' first is a member
+        while (i < length && pattern[i] != ']') i += pattern[i] == '%' ? 2 : 1;
+        ++i;
+      }
+    } else if (c == '%') {
+      i += 2;  // a class or an escaped character, or a back-reference
+    } else if (c == '[') {
+      ++i;
+      if (i < length && pattern[i] == '^') ++i;
+      if (i < length) ++i;
+      while (i < length && pattern[i] != ']') i += pattern[i] == '%' ? 2 : 1;
+      ++i;
+    } else {
+      ++i;
+    }
+    if (single && i < length && (pattern[i] == '*' || pattern[i] == '+' || pattern[i] == '-')) {
+      ++repeated;
+      ++i;
+    } else if (single && i < length && pattern[i] == '?') {
+      ++i;  // at most two tries: no factor of n
+    }
+  }
+  return last_counted;
+}
+
+/// string.find, match, gmatch and gsub (upvalue 1: the library's function,
+/// upvalue 2: its name), refusing patterns whose backtracking is unbounded
+/// for the subject's length.
+int sandbox_pattern_guard(lua_State* L) {
+  std::size_t n = 0;
+  std::size_t pattern_length = 0;
+  luaL_checklstring(L, 1, &n);
+  const char* pattern = luaL_checklstring(L, 2, &pattern_length);
+  const char* name = lua_tostring(L, lua_upvalueindex(2));
+  const bool plain = std::strcmp(name, "find") == 0 && lua_toboolean(L, 4);
+  const int repetitions = plain ? 0 : backtracking_repetitions(pattern, pattern_length);
+  if (repetitions > 0 &&
+      std::pow(static_cast<double>(n) + 1.0, repetitions + 1.0) > kMaxPatternSteps) {
+    return luaL_error(
+        L,
+        "string.%s: the pattern '%s' has %d repetitions that more pattern follows; "
+        "on a subject of %I characters it could backtrack for a very long time (the sandbox "
+        "allows about 10^9 tries): shorten the subject or the pattern",
+        name, pattern, repetitions, static_cast<LUAI_UACINT>(n));
+  }
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
+  return lua_gettop(L);
+}
+
 // Names objects by serial number in '%s' and refuses '%p': both would
 // otherwise show addresses, which differ from run to run.
 int sandbox_string_format(lua_State* L) {
@@ -728,6 +813,12 @@ int open_sandbox(lua_State* L) {
   static const luaL_Reg kString[] = {
       {"rep", sandbox_string_rep}, {"format", sandbox_string_format}, {nullptr, nullptr}};
   luaL_setfuncs(L, kString, 0);
+  for (const char* name : {"find", "match", "gmatch", "gsub"}) {
+    lua_getfield(L, -1, name);
+    lua_pushstring(L, name);
+    lua_pushcclosure(L, sandbox_pattern_guard, 2);
+    lua_setfield(L, -2, name);
+  }
   lua_pushliteral(L, "");
   lua_getmetatable(L, -1);
   lua_pushvalue(L, -3);

@@ -407,6 +407,9 @@ class Loader {
         fail(where, word_name + ": missing argument '" + std::string(word->params[i].name) + "'");
       }
     }
+    if (word_name == "every" && !(clause.args[0].number > 0)) {
+      fail(where, "every: the period must be more than 0 seconds");
+    }
     return clause;
   }
 
@@ -476,6 +479,8 @@ class Loader {
       engine::ImportOptions options;
       options.merge = false;
       it->second = engine::import_file(path, options);
+      scenario_.files.insert(scenario_.files.end(), it->second.files.begin(),
+                             it->second.files.end());
     }
     const engine::ImportReport& report = it->second;
     std::vector<std::string> known;
@@ -545,6 +550,7 @@ class Loader {
 
 Scenario Loader::load() {
   scenario_.file = file_;
+  scenario_.files.push_back(file_);
   // Define the vocabulary's constructors in the sandbox.
   host_.run_string("return function(...) " + std::string(kPrelude) + " end", kPreludeName, 1);
   lua_createtable(L_, static_cast<int>(vocabulary().size()), 0);
@@ -697,7 +703,9 @@ void Loader::read_parts(int map, const SourceLocation& where) {
           loaded = select_nodes(path, nodes.given ? nodes.names : without.names, nodes.given,
                                 part.where, what);
         } else {
-          loaded = engine::import_mesh(path);
+          engine::ImportReport report = engine::import_file(path, {});
+          scenario_.files.insert(scenario_.files.end(), report.files.begin(), report.files.end());
+          loaded = std::move(report.parts.front().mesh);
         }
       } catch (const ScenarioError&) {
         throw;
@@ -839,6 +847,14 @@ void Loader::read_glove(int index, const SourceLocation& outer) {
     fail(glove.where, "glove: give either plan = \"file\" or trace = \"file\"");
   if (plan.given) glove.plan = folder_ / plan.text;
   if (trace.given) glove.trace = folder_ / trace.text;
+  const std::filesystem::path& source = plan.given ? glove.plan : glove.trace;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(source, ec)) {
+    fail(glove.where,
+         "glove: " + (plan.given ? plan.text : trace.text) +
+             (std::filesystem::exists(source, ec) ? ": not a file" : ": file not found"));
+  }
+  scenario_.files.push_back(source);
   glove.holding = field(t, word, "holding", glove.where, "glove").text;
   if (const Arg a = field(t, word, "grasp", glove.where, "glove"); a.given) {
     glove.grasp = a.text == "precision" ? interaction::GraspType::kPrecision

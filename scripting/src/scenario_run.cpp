@@ -81,6 +81,7 @@ class Runner {
   double metres_per_unit() const { return scenario_.metres_per_unit; }
 
  private:
+  void refuse_outputs();
   void build();
   void start_frame(std::uint64_t frame, double t);
   void end_frame(const engine::FrameResult& result, double previous_time);
@@ -788,12 +789,36 @@ void Runner::evaluate_expectations() {
   }
 }
 
+/// Whether two paths name one file (or would, for one not yet written).
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec) && !ec;
+  return fs::absolute(a, ec).lexically_normal() == fs::absolute(b, ec).lexically_normal();
+}
+
+void Runner::refuse_outputs() {
+  std::vector<std::filesystem::path> reads = scenario_.files;
+  if (options_.trace) reads.push_back(*options_.trace);
+  std::vector<std::filesystem::path> writes = options_.outputs;
+  if (options_.record) writes.push_back(*options_.record);
+  for (const std::filesystem::path& w : writes) {
+    for (const std::filesystem::path& r : reads) {
+      if (!same_file(w, r)) continue;
+      out_.outputs_refused = true;
+      throw ScenarioError(file_.string() + ": the output '" + w.string() + "' is '" + r.string() +
+                          "', which the run reads; it would be overwritten");
+    }
+  }
+}
+
 void Runner::run() {
   const auto start = std::chrono::steady_clock::now();
   out_.file = file_;
   out_.name = file_.stem().string();
   try {
     scenario_ = load_scenario(host_, file_);
+    refuse_outputs();
     out_.name = scenario_.name;
     out_.units = scenario_.units;
     out_.metres_per_unit = scenario_.metres_per_unit;

@@ -4,7 +4,10 @@
 #         [-DEXPECT_STDOUT=<regex>] [-DEXPECT_STDERR=<regex>] [-DREJECT_STDOUT=<regex>]
 #         [-DEXPECT_FILE=<path> -DEXPECT_FILE_CONTENT=<exact text>]
 #         [-DEXPECT_FILE=<path> -DEXPECT_FILE_MATCHES=<regex>]
-#         [-DREMOVE_FIRST=<path>] -P check_command.cmake
+#         [-DREMOVE_FIRST=<path>] [-DKEEP=<path>] -P check_command.cmake
+#
+# KEEP writes <path> with a known text before the run; the run must leave it as it was
+# (a command that fails on its inputs does not touch an existing output).
 #
 # Arguments are separated by `|`. EXPECT_STDOUT / EXPECT_STDERR / EXPECT_FILE_MATCHES
 # may hold several regexes, all required, separated by `&&` (they become a CMake list, so a
@@ -16,6 +19,11 @@ endif()
 string(REPLACE "|" ";" argv "${ARGS}")
 if(DEFINED REMOVE_FIRST)
   file(REMOVE "${REMOVE_FIRST}")
+endif()
+
+set(keep_text "written before the run; must be kept\n")
+if(DEFINED KEEP)
+  file(WRITE "${KEEP}" "${keep_text}")
 endif()
 
 execute_process(COMMAND "${PROGRAM}" ${argv}
@@ -41,6 +49,12 @@ foreach(stream stdout stderr)
     endforeach()
   endif()
 endforeach()
+if(DEFINED KEEP)
+  file(READ "${KEEP}" kept)
+  if(NOT kept STREQUAL keep_text)
+    string(APPEND problems "${KEEP} was changed; it holds:\n${kept}\n")
+  endif()
+endif()
 if(DEFINED REJECT_STDOUT AND out MATCHES "${REJECT_STDOUT}")
   string(APPEND problems "stdout matches '${REJECT_STDOUT}', which it must not\n")
 endif()

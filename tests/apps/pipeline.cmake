@@ -62,3 +62,12 @@ if(DOVETAIL_BUILD_BENCH)
     set_tests_properties(cli.pipeline_agrees_with_brute_force_${kind} PROPERTIES TIMEOUT 900)
   endforeach()
 endif()
+
+# The pairs may not overwrite a mesh the scene lists, and a scene that fails
+# before its first frame leaves an existing output as it was.
+dovetail_cli_test(pipeline_out_is_mesh EXIT 2
+                  ARGS pipeline --scene ${pl_data}/three_parts.txt --out ${data}/cube.obj
+                  STDERR "would be overwritten")
+dovetail_cli_test(pipeline_bad_scene_keeps_out EXIT 1
+                  ARGS pipeline --scene ${pl_data}/missing_mesh.txt --out ${out}/kept_pairs.txt
+                  KEEP ${out}/kept_pairs.txt)

@@ -69,3 +69,7 @@ dovetail_cli_test(inspect_lists_cameras EXIT 0
                   STDOUT "\"cameras\":\\[\"nodes\\[81\\]\"\\]")
 dovetail_cli_test(render_out_is_input EXIT 2 ARGS render ${cube} --out ${data}/../data/cube.obj
                   STDERR "would be overwritten")
+file(COPY ${CMAKE_SOURCE_DIR}/assets/glove/reach_engine.plan DESTINATION ${out})
+dovetail_cli_test(render_out_is_plan EXIT 2
+                  ARGS render ${cube} --plan ${out}/reach_engine.plan --out ${out}/reach_engine.plan
+                  STDERR "would be overwritten")

@@ -61,12 +61,45 @@ dovetail_cli_test(fails_pushed_through EXIT 3 ARGS run ${scenario_data}/failing/
 # regress: hostile scripts end with clear errors, the others still run, every report is written.
 dovetail_cli_test(regress_hostile EXIT 3
                   ARGS regress ${scenario_data}/hostile --out ${out}/hostile -j 2 --junit ${out}/hostile.xml
-                  STDOUT "PASS   well_behaved&&ERROR  infinite_loop .*instruction budget&&ERROR  string_rep .*string.rep&&ERROR  memory_bomb .*memory&&ERROR  deep_recursion .*stack overflow&&ERROR  coroutine_loop .*instruction budget&&ERROR  os_exit .*'os'&&ERROR  io_open .*'io'&&ERROR  require_module .*'require'&&ERROR  package_loadlib .*'package'&&ERROR  debug_sethook .*'debug'&&ERROR  binary_chunk .*binary chunk&&ERROR  setmetatable_G .*protected metatable&&ERROR  syntax_error .*syntax_error.lua:2:&&ERROR  pcall_swallow .*instruction budget&&ERROR  endless_custom_action .*endless_custom_action.lua:5: .*instruction budget&&1 of 16 scenarios passed"
-                  FILE ${out}/hostile.xml MATCHES "tests=\"16\" failures=\"0\" errors=\"15\"")
+                  STDOUT "PASS   well_behaved&&ERROR  infinite_loop .*instruction budget&&ERROR  string_rep .*string.rep&&ERROR  memory_bomb .*memory&&ERROR  deep_recursion .*stack overflow&&ERROR  coroutine_loop .*instruction budget&&ERROR  os_exit .*'os'&&ERROR  io_open .*'io'&&ERROR  require_module .*'require'&&ERROR  package_loadlib .*'package'&&ERROR  debug_sethook .*'debug'&&ERROR  binary_chunk .*binary chunk&&ERROR  setmetatable_G .*protected metatable&&ERROR  syntax_error .*syntax_error.lua:2:&&ERROR  pcall_swallow .*instruction budget&&ERROR  endless_custom_action .*endless_custom_action.lua:5: .*instruction budget&&ERROR  pattern_backtracking .*pattern_backtracking.lua:4: string.find: the pattern&&1 of 17 scenarios passed"
+                  FILE ${out}/hostile.xml MATCHES "tests=\"17\" failures=\"0\" errors=\"16\"")
 set_tests_properties(cli.regress_hostile PROPERTIES FIXTURES_SETUP regress_hostile)
 add_test(NAME cli.regress_hostile_reports_written
-         COMMAND ${CMAKE_COMMAND} -DDIR=${out}/hostile -DCOUNT=16 -P ${CMAKE_CURRENT_SOURCE_DIR}/count_reports.cmake)
+         COMMAND ${CMAKE_COMMAND} -DDIR=${out}/hostile -DCOUNT=17 -P ${CMAKE_CURRENT_SOURCE_DIR}/count_reports.cmake)
 set_tests_properties(cli.regress_hostile_reports_written PROPERTIES FIXTURES_REQUIRED regress_hostile)
+
+# A scenario stopped by the timeout still gets its report and a log line saying why.
+dovetail_cli_test(regress_timeout EXIT 3
+                  ARGS regress ${scenario_data}/slow --out ${out}/slow --timeout 1
+                  STDOUT "ERROR  slow .*stopped after the timeout of 1 s"
+                  FILE ${out}/slow/slow.json MATCHES "\"outcome\": \"error\"&&stopped after the timeout")
+
+# Outputs are never inputs: not a scenario, not a file a scenario reads (a
+# copy of the test data, so that a failing test cannot damage it), not each other.
+file(COPY ${scenario_data}/hostile/well_behaved.lua ${scenario_data}/plan_alias DESTINATION ${out}/alias)
+dovetail_cli_test(run_report_is_scenario EXIT 2
+                  ARGS run ${out}/alias/well_behaved.lua --report ${out}/alias/well_behaved.lua
+                  STDERR "would be overwritten")
+dovetail_cli_test(run_record_is_report EXIT 2
+                  ARGS run ${out}/alias/well_behaved.lua --report ${out}/alias/x.json
+                       --record ${out}/alias/x.json
+                  STDERR "--report and --record name the same file")
+dovetail_cli_test(run_record_is_plan EXIT 1
+                  ARGS run ${out}/alias/plan_alias/boxes.lua
+                       --record ${out}/alias/plan_alias/hand.plan --report ${out}/alias/kept.json
+                  STDERR "hand.plan', which the run reads; it would be overwritten"
+                  KEEP ${out}/alias/kept.json)
+dovetail_cli_test(regress_junit_is_scenario EXIT 2
+                  ARGS regress ${out}/alias --out ${out}/alias_out --junit ${out}/alias/well_behaved.lua
+                  STDERR "would be overwritten")
+
+# Scenarios that do not load: clear errors naming the file and line.
+dovetail_cli_test(check_every_zero EXIT 1 ARGS check ${scenario_data}/invalid/every_zero.lua
+                  STDERR "every_zero.lua:5: every: the period must be more than 0 seconds")
+dovetail_cli_test(check_missing_plan EXIT 1 ARGS check ${scenario_data}/invalid/missing_plan.lua
+                  STDERR "missing_plan.lua:5: glove: no_such.plan: file not found")
+dovetail_cli_test(check_error_nil EXIT 1 ARGS check ${scenario_data}/invalid/error_nil.lua
+                  STDERR "error_nil.lua:3: \\(error object is a nil value\\)")
 
 dovetail_cli_test(regress_bad_shard EXIT 2 ARGS regress ${scenarios} --shard 3/2 STDERR "--shard must be K/N")
 dovetail_cli_test(regress_not_a_folder EXIT 1 ARGS regress ${out}/no_such_folder STDERR "not a folder")

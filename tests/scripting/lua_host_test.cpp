@@ -314,6 +314,36 @@ TEST(LuaHostBudget, WallClockGuard) {
   expect_works(host);
 }
 
+// The guards cannot stop a library function from inside, so patterns that
+// could backtrack for very long are refused before they run, by a bound that
+// depends on the subject's length and the pattern only (the same every run).
+TEST(LuaHostBudget, BacktrackingPatternsAreRefusedByTheirBound) {
+  LuaHost host(small_limits(), 1);
+  for (const char* call : {"s:find('.-.-.-b')", "string.match(s, 'a*a*a*b')",
+                           "s:gsub('(.+)(.+)(.+)x', '')", "for w in s:gmatch('a-a-a-b') do end"}) {
+    const ScriptError error =
+        run_error(host, std::string("local s = string.rep('a', 3000)\n") + call);
+    EXPECT_EQ(error.kind(), Kind::kRuntime) << call;
+    EXPECT_EQ(error.message().rfind("script.lua:2: string.", 0), 0u) << error.message();
+    EXPECT_NE(error.message().find("3 repetitions that more pattern follows"), std::string::npos)
+        << error.message();
+    EXPECT_NE(error.message().find("a subject of 3000 characters"), std::string::npos);
+  }
+  // Ordinary patterns, on long subjects too: a final repetition, one that
+  // backtracks on a short subject, sets, anchors, captures, plain search.
+  EXPECT_EQ(run(host,
+                "local a, b = ('key=value'):match('^(%w+)=(%w+)$')\n"
+                "local t, n = string.rep('a  b ', 20000):gsub('%s+', '_')\n"
+                "local words = 0 for w in ('a,b,,c'):gmatch('[^,]+') do words = words + 1 end\n"
+                "local plain = string.rep('x', 100000):find('.-.-.-y', 1, true)\n"
+                "local trimmed = ('  hi  '):match('^%s*(.-)%s*$')\n"
+                "local set = ('[x]'):find('[]]')\n"
+                "return a .. b .. n .. words .. tostring(plain) .. trimmed .. set"),
+            "keyvalue40000"
+            "3nilhi3");
+  expect_works(host);
+}
+
 // ---- 3. memory cap
 
 TEST(LuaHostMemory, StringRepBombIsRefusedByName) {
@@ -402,7 +432,11 @@ TEST(LuaHostErrors, SyntaxErrorHasFileLine) {
 
 TEST(LuaHostErrors, ErrorObjectsThatAreNotStrings) {
   LuaHost host(small_limits(), 1);
-  EXPECT_EQ(run_error(host, "error({})").message(), "(error object is a table value)");
+  // Lua adds no position to an error object that is not a string; the host does.
+  EXPECT_EQ(run_error(host, "error({})").message(),
+            "script.lua:1: (error object is a table value)");
+  EXPECT_EQ(run_error(host, "local x = 1\nerror(nil)").message(),
+            "script.lua:2: (error object is a nil value)");
   EXPECT_EQ(run_error(host,
                       "error(setmetatable({}, {__tostring = function() return 'custom' "
                       "end}))")

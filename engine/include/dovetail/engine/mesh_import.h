@@ -66,6 +66,10 @@ struct ImportReport {
   std::vector<NamedCamera> cameras;
   std::size_t skipped_line_or_point_primitives = 0;  ///< not triangles, left out
   std::vector<std::string> notes;                    ///< things worth telling the user, not errors
+  /// Every file the import read, as normalised absolute paths: the input and
+  /// what it refers to (glTF buffers, OBJ material libraries), so that a
+  /// command can refuse an output that would overwrite one of them.
+  std::vector<std::string> files;
 };
 
 /// Imports `path`. Throws ImportError (message starts with the path) for a

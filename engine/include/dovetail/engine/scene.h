@@ -197,6 +197,7 @@ struct AssemblyReport {
   std::size_t shared_meshes = 0;  ///< parts that reuse another part's mesh
   std::size_t skipped_line_or_point_primitives = 0;
   std::vector<std::string> notes;  ///< from the importer and the loader
+  std::vector<std::string> files;  ///< every file read (ImportReport::files)
 };
 
 /// Loads `path` as a scene: one part per mesh instance of every node, named

@@ -137,6 +137,9 @@ struct Scenario {
   std::optional<engine::Camera> camera{};
   /// Things that load but look wrong (a rule that can never fire), `file:line: ...`.
   std::vector<std::string> warnings{};
+  /// Every file the scenario reads: itself, its meshes and what they refer
+  /// to, its glove's plan or trace. A run refuses to write over any of them.
+  std::vector<std::filesystem::path> files{};
 };
 
 /// Loads the scenario at `file` in `host` (which must stay alive while

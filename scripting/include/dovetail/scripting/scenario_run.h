@@ -48,6 +48,10 @@ struct RunOptions {
   std::optional<collision::Method> method{};
   /// Overrides the scenario's accuracy: metres, 0 exact.
   std::optional<double> tolerance_m{};
+  /// Files the caller writes after the run (the report). The run refuses to
+  /// start, as it does for `record`, when one of them is a file the scenario
+  /// reads (Scenario::files) or the trace: it would be overwritten.
+  std::vector<std::filesystem::path> outputs{};
 };
 
 /// One expectation's verdict.
@@ -97,6 +101,9 @@ struct RunOutcome {
   /// The frame loop alone (simulation, rules, steps, penetration), for benchmarks.
   double loop_seconds = 0;
   std::optional<std::filesystem::path> final_frame{};  ///< the PNG written, if any
+  /// The run did not start because an output is a file it reads (`error`
+  /// says which); the caller must not write its outputs either.
+  bool outputs_refused = false;
   /// With RunOptions::capture_dir: the capture files written, and how many
   /// suspect queries there were (repeats of one capture write one file).
   /// Not in the JSON report.
