@@ -336,7 +336,7 @@ int poses_protocol(const Args& args) {
   collision::ContactPoseSettings settings;
   settings.directions = static_cast<int>(args.integer("directions", 1, 100000).value_or(100));
   settings.seed = args.unsigned_integer("seed").value_or(1);
-  if (const auto gaps = args.number_list("gaps")) settings.gaps.assign(gaps->begin(), gaps->end());
+  if (const auto gaps = contact_gaps(args)) settings.gaps.assign(gaps->begin(), gaps->end());
   const int runs = static_cast<int>(args.integer("runs", 1, 1000).value_or(5));
   check_table(args);
   const ProtocolPair pair = protocol_pair(args, [](collision::Mesh m) { return m; });

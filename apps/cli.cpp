@@ -193,6 +193,19 @@ void refuse_overwriting_input(const std::string& command, const std::string& out
   }
 }
 
+std::optional<std::vector<double>> contact_gaps(const Args& args) {
+  std::optional<std::vector<double>> gaps = args.number_list("gaps");
+  for (const double g : gaps.value_or(std::vector<double>{})) {
+    if (!(std::abs(g) <= 1000)) {
+      char text[32];
+      std::snprintf(text, sizeof text, "%g", g);
+      throw UsageError(args.command() + ": --gaps must be between -1000 and 1000 (fractions of " +
+                       "the larger bounding-box diagonal), not " + text);
+    }
+  }
+  return gaps;
+}
+
 void check_writable(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;

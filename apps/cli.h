@@ -95,6 +95,11 @@ void refuse_overwriting_input(const std::string& command, const std::string& out
 /// leave an existing file as it was when the run fails on its inputs.
 void check_writable(const std::string& path);
 
+/// --gaps of the contact-distance poses: fractions of the larger bounding-box
+/// diagonal, each in [-1000, 1000] (farther poses are not contact poses, and
+/// far enough ones overflow); UsageError otherwise.
+std::optional<std::vector<double>> contact_gaps(const Args& args);
+
 /// "boxtree, dop6, ..., brute".
 std::string method_list();
 /// The broad phases' names, "brute, sap, ...".

@@ -118,6 +118,9 @@ int convert(std::span<const std::string> argv) {
   return kExitOk;
 }
 
+/// The most samples `glove plan` writes: 31 hours at 90 Hz, about 4 GB while sampled.
+constexpr double kMaxPlanSamples = 1e7;
+
 int plan(std::span<const std::string> argv) {
   const Args args("glove plan", argv, {"out", "rate", "seed"}, {"noise"});
   if (args.help()) {
@@ -127,7 +130,7 @@ int plan(std::span<const std::string> argv) {
   args.expect_positional(1, "one plan file PLAN");
   const std::string& path = args.positional()[0];
   const std::string out = args.required("out");
-  const double rate = args.number("rate", 1e-3).value_or(90);
+  const double rate = args.number("rate", 0).value_or(90);
   if (!(rate > 0) || rate > 1e5) throw UsageError("glove plan: --rate must be in (0, 100000] Hz");
   const std::string inputs[] = {path};
   refuse_overwriting_input("glove plan", out, inputs);
@@ -144,7 +147,15 @@ int plan(std::span<const std::string> argv) {
   }
   const double end = source->end_time();
   // Checked as a double first: a plan of 1e300 s would not fit any integer.
-  if (!(end * rate < 1e8)) throw UsageError("glove plan: more than 10^8 samples; lower --rate");
+  // Every sample is held until the trace is written (about 400 bytes each).
+  if (!(end * rate < kMaxPlanSamples)) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  ": the plan lasts %g s, %g samples at %g Hz; a trace holds at most 10^7 "
+                  "(lower --rate or shorten the plan)",
+                  end, std::floor(end * rate) + 1, rate);
+    throw InputError(path + text);
+  }
   const auto count = static_cast<std::uint64_t>(std::floor(end * rate + 1e-9)) + 1;
   std::vector<GloveSample> samples;
   samples.reserve(count);

@@ -77,7 +77,7 @@ int poses_command(std::span<const std::string> argv) {
   settings.directions =
       static_cast<int>(args.integer("directions", 1, 10'000'000).value_or(settings.directions));
   settings.seed = args.unsigned_integer("seed").value_or(settings.seed);
-  if (std::optional<std::vector<double>> gaps = args.number_list("gaps")) settings.gaps = *gaps;
+  if (std::optional<std::vector<double>> gaps = contact_gaps(args)) settings.gaps = *gaps;
 
   const std::string inputs[] = {args.positional()[0], args.positional()[1]};
   refuse_overwriting_input("poses", out_path, inputs);

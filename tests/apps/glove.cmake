@@ -91,8 +91,8 @@ dovetail_cli_test(glove_plan_seed_without_noise EXIT 2
                        --out ${out}/x.csv --seed 3
                   STDERR "--seed needs --noise")
 file(WRITE ${out}/endless.plan "wait 1e300\n")
-dovetail_cli_test(glove_plan_endless EXIT 2 ARGS glove plan ${out}/endless.plan --out ${out}/x.csv
-                  STDERR "more than 10\\^8 samples")
+dovetail_cli_test(glove_plan_endless EXIT 1 ARGS glove plan ${out}/endless.plan --out ${out}/x.csv
+                  STDERR "endless.plan: the plan lasts 1e\\+300 s&&at most 10\\^7")
 dovetail_cli_test(glove_plan_bad_plan EXIT 1
                   ARGS glove plan ${glove}/trace_three_samples.csv --out ${out}/x.csv
                   STDERR "trace_three_samples.csv:1: ")
@@ -117,3 +117,12 @@ dovetail_cli_test(render_hand_unknown_size EXIT 2
                   STDERR "unknown size 'giant'")
 dovetail_cli_test(render_time_without_trace EXIT 2
                   ARGS render ${cube} --time 1 --out ${out}/x.png STDERR "--time needs --trace or --plan")
+
+# A plan too long to sample is an input error naming it, and writes nothing.
+dovetail_cli_test(glove_plan_too_long EXIT 1
+                  ARGS glove plan ${data}/glove/too_long.plan --out ${out}/too_long.csv
+                  STDERR "too_long.plan: the plan lasts 1e\\+12 s&&at most 10\\^7"
+                  REMOVE ${out}/too_long.csv)
+dovetail_cli_test(glove_plan_rate_zero EXIT 2
+                  ARGS glove plan ${data}/glove/too_long.plan --out ${out}/too_long.csv --rate 0
+                  STDERR "--rate must be in \\(0, 100000\\] Hz")
