@@ -10,6 +10,7 @@
 #include <cstring>
 #include <system_error>
 
+#include "dovetail/collision/mesh.h"
 #include "dovetail/collision/pose_sampling.h"
 
 namespace dovetail::engine {
@@ -81,6 +82,12 @@ std::optional<Transform> parse_pose_line(std::string_view text, std::string_view
     if (!std::isfinite(*number)) {
       bad_line(where, "column " + std::to_string(column + 1) + " (" + kColumns[column] + ") '" +
                           shown(token) + "' is not finite");
+    }
+    // The bound of mesh coordinates (MeshLimits): beyond it the exact
+    // predicates and distances would overflow.
+    if (column < 3 && !(std::abs(*number) <= collision::MeshLimits{}.max_abs_coordinate)) {
+      bad_line(where, "column " + std::to_string(column + 1) + " (" + kColumns[column] + ") '" +
+                          shown(token) + "' is beyond the coordinate limit of 1e30");
     }
     v[column++] = *number;
   }

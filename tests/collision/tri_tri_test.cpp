@@ -384,6 +384,35 @@ TEST(TrianglesIntersect, AllCoplanarPairsOnSmallGridsMatchReference) {
   }
 }
 
+// A triangle rounded flat (a far pose can do that to a mesh's triangle) is
+// the segment or point it spans: exact verdicts against a proper triangle,
+// in every vertex order and either argument order. Before, a flat triangle
+// high above the base was "coplanar" with it and met its shadow.
+TEST(TrianglesIntersect, AFlatTriangleIsTheSegmentItSpans) {
+  const struct {
+    const char* name;
+    Tri flat;
+    bool expected;
+  } cases[] = {
+      {"segment above the base", {Vec3(1, 1, 5), Vec3(2, 1, 5), Vec3(3, 1, 5)}, false},
+      {"far segment above the base", {Vec3(1, 1, 1e16), Vec3(1, 1, 1e16), Vec3(2, 1, 1e16)}, false},
+      {"segment through the base", {Vec3(1, 1, -1), Vec3(1, 1, 1), Vec3(1, 1, 3)}, true},
+      {"segment through the plane outside", {Vec3(5, 5, -1), Vec3(5, 5, 2), Vec3(5, 5, 1)}, false},
+      {"segment ending on the base", {Vec3(1, 1, 0), Vec3(1, 1, 1), Vec3(1, 1, 2)}, true},
+      {"segment ending on an edge", {Vec3(2, 0, 0), Vec3(2, -1, 1), Vec3(2, -2, 2)}, true},
+      {"segment ending beside the base", {Vec3(2, -0.5, 0), Vec3(2, -1, 1), Vec3(2, -2, 3)}, false},
+      {"slanted segment through an edge", {Vec3(2, -1, -1), Vec3(2, 1, 1), Vec3(2, 0, 0)}, true},
+      {"point inside the base", {Vec3(1, 1, 0), Vec3(1, 1, 0), Vec3(1, 1, 0)}, true},
+      {"point in the plane outside", {Vec3(3, 3, 0), Vec3(3, 3, 0), Vec3(3, 3, 0)}, false},
+      {"segment in the plane across", {Vec3(-1, 1, 0), Vec3(1, 1, 0), Vec3(3, 1, 0)}, true},
+      {"segment in the plane outside", {Vec3(3, 3, 0), Vec3(4, 4, 0), Vec3(5, 5, 0)}, false},
+  };
+  for (const auto& c : cases) {
+    ASSERT_TRUE(is_degenerate_triangle(c.flat.a, c.flat.b, c.flat.c)) << c.name;
+    EXPECT_EQ(verdict_in_all_orders(kBase, c.flat, c.name), c.expected) << c.name;
+  }
+}
+
 TEST(TrianglesIntersect, DegenerateInputDoesNotCrash) {
   const std::vector<Tri> degenerate = {
       {Vec3(0, 0, 0), Vec3(0, 0, 0), Vec3(0, 0, 0)},

@@ -114,6 +114,7 @@ TEST(PoseList, BadLinesNameFileAndLine) {
       {"nan 2 3 1 0 0 0\n", ":1: ", "not finite"},
       {"1 2 3 inf 0 0 0\n", ":1: ", "not finite"},
       {"1 2 3 1 0 0 1e999\n", ":1: ", "not finite"},
+      {"1 -2e30 3 1 0 0 0\n", ":1: ", "column 2 (ty) '-2e30' is beyond the coordinate limit"},
       {"1,2,3,1,0,0,0\n", ":1: ", "not a number"},
       {"\n\n\n\n\n\n\n\n\n\n\n1 2 3 1 0 0\n", ":12: ", "expected 7 columns"},
   };

@@ -131,6 +131,32 @@ bool coplanar_triangles_intersect(const Triangle& t1, const Triangle& t2, const 
   return no_separating_edge(a, b) && no_separating_edge(b, a);
 }
 
+/// Whether degenerate triangle `line` (its points on one line, with `sides`
+/// against `t`'s plane neither all zero nor strictly one-sided) meets
+/// triangle `t`: the line crosses t's plane at one point, which lies inside
+/// `line`'s extent, and it meets t when that point is in t (closed): the
+/// line through two of its points with different sides passes through t.
+bool line_meets_triangle(const Triangle& line, const Signs& sides, const Triangle& t) {
+  int u = 0;
+  while (sides[u] == 0) ++u;
+  int v = -1;
+  for (int k = 0; k < 3; ++k) {
+    if (sides[k] == -sides[u]) v = k;
+  }
+  if (v < 0) {
+    for (int k = 0; k < 3; ++k) {
+      if (sides[k] == 0) v = k;
+    }
+  }
+  int positive = 0, negative = 0;
+  for (int k = 0; k < 3; ++k) {
+    const int o = detail::orient3d_filtered(*line[u], *line[v], *t[k], *t[(k + 1) % 3]);
+    positive += o > 0;
+    negative += o < 0;
+  }
+  return positive == 0 || negative == 0;
+}
+
 }  // namespace
 
 bool triangles_intersect(const Vec3& p1, const Vec3& q1, const Vec3& r1, const Vec3& p2,
@@ -140,18 +166,25 @@ bool triangles_intersect(const Vec3& p1, const Vec3& q1, const Vec3& r1, const V
   detail::TrianglePlane(p2, q2, r2).sides(p1, q1, r1, s1.data());
   if (strictly_one_side(s1)) return false;
 
-  // T1 in T2's plane: both in one plane (T2 being non-degenerate).
+  // Sides of T2's vertices against T1's plane; the same rejection.
   const detail::TrianglePlane plane1(p1, q1, r1);
   Triangle t1 = {&p1, &q1, &r1};
   Triangle t2 = {&p2, &q2, &r2};
-  if (all_on_plane(s1)) return coplanar_triangles_intersect(t1, t2, plane1.approximate_normal());
-
-  // Sides of T2's vertices against T1's plane; the same rejection.
   Signs s2;
   plane1.sides(p2, q2, r2, s2.data());
   if (strictly_one_side(s2)) return false;
-  // Only a degenerate T1 gets here with all of T2 on its plane.
-  if (all_on_plane(s2)) return coplanar_triangles_intersect(t1, t2, plane1.approximate_normal());
+
+  // Every point lies on a degenerate triangle's "plane", so all-zero sides
+  // mean: both triangles in one plane (or both degenerate), or one triangle
+  // degenerate, its points on a line that crosses the other's plane. (A mesh
+  // has no degenerate triangles, but a far pose can round one flat.)
+  const bool t1_on_plane2 = all_on_plane(s1);
+  const bool t2_on_plane1 = all_on_plane(s2);
+  if (t1_on_plane2 && t2_on_plane1) {
+    return coplanar_triangles_intersect(t1, t2, plane1.approximate_normal());
+  }
+  if (t1_on_plane2) return line_meets_triangle(t2, s2, t1);
+  if (t2_on_plane1) return line_meets_triangle(t1, s1, t2);
 
   // Canonical T1: apex first, on the positive side of T2's plane.
   const Apex apex1 = find_apex(s1);
