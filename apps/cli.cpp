@@ -103,8 +103,9 @@ std::optional<std::int64_t> Args::integer(const std::string& name, std::int64_t 
   std::int64_t v = 0;
   const auto [ptr, ec] = std::from_chars(text->data(), text->data() + text->size(), v);
   if (ec != std::errc() || ptr != text->data() + text->size() || v < min || v > max) {
-    throw UsageError(command_ + ": --" + name + " must be an integer from " + std::to_string(min) +
-                     " to " + std::to_string(max) + ", not '" + *text + "'");
+    throw UsageError(command_ + ": " + (name.size() == 1 ? "-" : "--") + name +
+                     " must be an integer from " + std::to_string(min) + " to " +
+                     std::to_string(max) + ", not '" + *text + "'");
   }
   return v;
 }

@@ -31,12 +31,6 @@ bool is_blank(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0;
   throw PoseListError(std::string(where) + ": " + what);
 }
 
-std::string shown(std::string_view token) {
-  constexpr std::size_t kMax = 40;
-  if (token.size() <= kMax) return std::string(token);
-  return std::string(token.substr(0, kMax)) + "...";
-}
-
 std::string format_number(Real value) {
   char buffer[40];
   std::snprintf(buffer, sizeof buffer, "%.17g", value);
@@ -63,6 +57,23 @@ std::optional<Real> parse_real(std::string_view token) {
   return value;
 }
 
+std::string shown_token(std::string_view token) {
+  constexpr std::size_t kMax = 40;
+  std::string text;
+  for (const char c : token.substr(0, kMax)) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte == 0x7f) {
+      char escaped[5];
+      std::snprintf(escaped, sizeof escaped, "\\x%02X", byte);
+      text += escaped;
+    } else {
+      text += c;
+    }
+  }
+  if (token.size() > kMax) text += "...";
+  return text;
+}
+
 std::optional<Transform> parse_pose_line(std::string_view text, std::string_view where) {
   std::array<Real, 7> v{};
   std::size_t column = 0;
@@ -77,17 +88,17 @@ std::optional<Transform> parse_pose_line(std::string_view text, std::string_view
     const std::optional<Real> number = parse_real(token);
     if (!number) {
       bad_line(where, "column " + std::to_string(column + 1) + " (" + kColumns[column] + ") '" +
-                          shown(token) + "' is not a number");
+                          shown_token(token) + "' is not a number");
     }
     if (!std::isfinite(*number)) {
       bad_line(where, "column " + std::to_string(column + 1) + " (" + kColumns[column] + ") '" +
-                          shown(token) + "' is not finite");
+                          shown_token(token) + "' is not finite");
     }
     // The bound of mesh coordinates (MeshLimits): beyond it the exact
     // predicates and distances would overflow.
     if (column < 3 && !(std::abs(*number) <= collision::MeshLimits{}.max_abs_coordinate)) {
       bad_line(where, "column " + std::to_string(column + 1) + " (" + kColumns[column] + ") '" +
-                          shown(token) + "' is beyond the coordinate limit of 1e30");
+                          shown_token(token) + "' is beyond the coordinate limit of 1e30");
     }
     v[column++] = *number;
   }

@@ -39,7 +39,10 @@ std::optional<std::string_view> LineReader::next() {
   if (length > kMaxTraceLineBytes) {
     fail("line longer than " + std::to_string(kMaxTraceLineBytes) + " bytes");
   }
-  return std::string_view(buffer_.data(), length);
+  std::string_view text(buffer_.data(), length);
+  // A UTF-8 byte-order mark, as some editors and spreadsheets write, is not text.
+  if (line_ == 1 && text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+  return text;
 }
 
 std::optional<std::string_view> LineReader::next_content() {
@@ -77,10 +80,9 @@ void split_commas(std::string_view line, std::vector<std::string_view>& fields) 
 std::optional<Real> parse_number(std::string_view token) { return engine::parse_real(token); }
 
 std::string quoted(std::string_view token) {
-  constexpr std::size_t kMax = 40;
   std::string text = "'";
-  text.append(token.substr(0, kMax));
-  text.append(token.size() > kMax ? "...'" : "'");
+  text += engine::shown_token(token);
+  text += '\'';
   return text;
 }
 

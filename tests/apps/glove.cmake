@@ -126,3 +126,10 @@ dovetail_cli_test(glove_plan_too_long EXIT 1
 dovetail_cli_test(glove_plan_rate_zero EXIT 2
                   ARGS glove plan ${data}/glove/too_long.plan --out ${out}/too_long.csv --rate 0
                   STDERR "--rate must be in \\(0, 100000\\] Hz")
+
+# A byte-order mark before the header is not part of the first column's name,
+# and a control byte in a bad field is shown escaped, not sent to the terminal.
+dovetail_cli_test(glove_check_bom EXIT 0 ARGS glove check ${glove}/trace_with_bom.csv
+                  STDOUT "\"samples\":3")
+dovetail_cli_test(glove_check_control_byte EXIT 1 ARGS glove check ${glove}/bad_control_byte.csv
+                  STDERR "bad_control_byte.csv:2: column y \\(field 3\\): '0.\\\\x0F1' is not a number")

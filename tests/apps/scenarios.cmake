@@ -101,6 +101,7 @@ dovetail_cli_test(check_missing_plan EXIT 1 ARGS check ${scenario_data}/invalid/
 dovetail_cli_test(check_error_nil EXIT 1 ARGS check ${scenario_data}/invalid/error_nil.lua
                   STDERR "error_nil.lua:3: \\(error object is a nil value\\)")
 
+dovetail_cli_test(regress_bad_jobs EXIT 2 ARGS regress ${scenarios} -j 0 STDERR "regress: -j must be an integer from 1 to 256")
 dovetail_cli_test(regress_bad_shard EXIT 2 ARGS regress ${scenarios} --shard 3/2 STDERR "--shard must be K/N")
 dovetail_cli_test(regress_not_a_folder EXIT 1 ARGS regress ${out}/no_such_folder STDERR "not a folder")
 

@@ -53,6 +53,11 @@ struct PoseEntry {
 /// zero. The one number parser of the project's text formats.
 std::optional<collision::Real> parse_real(std::string_view token);
 
+/// A token of a text file as an error message shows it: its first 40 bytes
+/// ("..." after more), control bytes as \xNN so that a message never drives
+/// the terminal.
+std::string shown_token(std::string_view token);
+
 /// Parses one line of a pose list. Returns nullopt for a blank or comment
 /// line; throws PoseListError with message `where: what` for a bad line.
 std::optional<collision::Transform> parse_pose_line(std::string_view text, std::string_view where);
