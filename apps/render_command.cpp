@@ -42,7 +42,7 @@ Draws a mesh or assembly file off-screen and writes the picture as PNG.
                  input is then loaded as an assembly in metres, like a simulation
   --plan PLAN    the same with a simulated-glove plan (docs/interaction.md)
   --hand-size S  adult_m50 (default), adult_f50, adult_m95, adult_f05
-  --hand-length M  scale the size to this hand length in metres
+  --hand-length M  scale the size to this hand length in metres (0: its own)
 
 Flat shading with a light at the camera, depth-tested, no anti-aliasing; the
 same input and options give the same PNG bytes. Prints a one-line JSON summary
