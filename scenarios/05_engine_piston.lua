@@ -2,11 +2,11 @@
 -- and put back, beside the two-cylinder engine of assimp's test models
 -- (2CylinderEngine.glb from Debian's assimp-testmodels, in millimetres).
 --
--- What is a stand-in: the loader makes one part of a whole mesh file, so the
--- engine is one fixed part, and its own pistons, pins and rods are merged into
--- it, inside its cylinders. The piston and rod the hand moves cannot be the
--- file's (there is no way yet to take a single node of a file as a part), and
--- they cannot go into the engine's bores, which the file's own pistons fill.
+-- What is a stand-in: the engine is one fixed part, and its own pistons, pins
+-- and rods are merged into it, inside its cylinders. The piston and rod the
+-- hand moves are not the file's: a part could take single nodes of the file
+-- (`nodes = { ... }`), but the file's own pistons fill the engine's bores, so
+-- no bore would be free for a piston taken out of it.
 -- So the piston and rod are one stand-in part (a 93 mm piston, the size of the
 -- file's, and a rod with a big-end eye: assets/parts/make_parts.py), and they
 -- work in a spare cylinder, a fixed block with a 93.6 mm blind bore, standing

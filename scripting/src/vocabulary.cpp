@@ -82,7 +82,7 @@ std::vector<Word> make_vocabulary() {
                  "glove noise: { position = length, angle = deg, joints = deg, seed = n }"},
                 {"hand_length", kLength, kOptional, "wrist to middle fingertip (default 190 mm)"}},
                "The hand, driven by a simulated glove (a plan) or a recorded trace.",
-               "hand = glove { plan = \"../assets/glove/peg.plan\", holding = \"peg\" }"});
+               "hand = glove { plan = \"../assets/glove/peg_in_hole.plan\", holding = \"peg\" }"});
   w.push_back(
       {"step",
        WordKind::kDeclaration,
@@ -197,11 +197,12 @@ std::vector<Word> make_vocabulary() {
                {{"seconds", kSeconds, kRequired, "simulated seconds from the start"}},
                "Once, in the first frame at or after the time.",
                "after(30)"});
-  w.push_back({"every",
-               WordKind::kEvent,
-               {{"seconds", kSeconds, kRequired, "the period, > 0"}},
-               "In the first frame at or after each multiple of the period.",
-               "every(1)"});
+  w.push_back(
+      {"every",
+       WordKind::kEvent,
+       {{"seconds", kSeconds, kRequired, "the period, > 0"}},
+       "In the first frame at or after each multiple of the period, t = p, 2p, ... (not at 0).",
+       "every(1)"});
   w.push_back({"completed",
                WordKind::kEvent,
                {{"step", kStep, kRequired, "the step"}},
