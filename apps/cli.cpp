@@ -210,11 +210,17 @@ std::optional<std::vector<double>> contact_gaps(const Args& args) {
 void check_writable(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
+  if (path.empty()) throw InputError("'': cannot be written: the path is empty");
   if (fs::is_directory(path, ec)) throw InputError(path + ": cannot be written: is a directory");
   if (fs::exists(path, ec)) {
-    // Appending opens the file for writing without changing it.
-    std::ofstream probe(path, std::ios::binary | std::ios::app);
-    if (!probe) throw InputError(path + ": cannot be written: " + std::strerror(errno));
+    if (fs::is_regular_file(path, ec)) {
+      // Appending opens the file for writing without changing it.
+      std::ofstream probe(path, std::ios::binary | std::ios::app);
+      if (!probe) throw InputError(path + ": cannot be written: " + std::strerror(errno));
+    } else if (::access(path.c_str(), W_OK) != 0) {
+      // A pipe or a device is not opened twice: a reader would see the end.
+      throw InputError(path + ": cannot be written: " + std::strerror(errno));
+    }
     return;
   }
   const fs::path folder = fs::path(path).parent_path();

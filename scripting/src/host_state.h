@@ -66,6 +66,10 @@ struct HostState {
   lua_CFunction base_rawset = nullptr;
   lua_CFunction string_rep = nullptr;
   lua_CFunction string_format = nullptr;
+  lua_CFunction string_find = nullptr;
+  lua_CFunction string_match = nullptr;
+  lua_CFunction string_gmatch = nullptr;
+  lua_CFunction string_gsub = nullptr;
   lua_CFunction table_move = nullptr;
   lua_CFunction coroutine_close = nullptr;
 

@@ -373,84 +373,110 @@ int sandbox_string_rep(lua_State* L) {
 // Lua's matcher backtracks over every repetition (`*`, `+`, `-`) that more
 // pattern follows, and neither the instruction budget nor the wall-clock guard
 // can stop it inside the library: ("a"):rep(3000):find(".-.-.-b") would run
-// for hours. A search may try about (n + 1)^(r + 1) positions for a subject
-// of n characters and r such repetitions (r + 1: every start). A pattern whose
-// bound exceeds kMaxPatternSteps is refused before it runs, the same way on
-// every run; the bounds of ordinary patterns on names and log lines are far
-// below it.
+// for hours. A search may try about (n + 1)^(r + 1) * 2^q positions for a
+// subject of n characters, r such repetitions (a final `$` and a balance `%b`
+// count: both can fail after scanning) and q optional items (`?`) that more
+// pattern follows; the + 1 is every start. A pattern whose bound exceeds
+// kMaxPatternSteps is refused before it runs, the same way on every run; the
+// bounds of ordinary patterns on names and log lines are far below it.
 constexpr double kMaxPatternSteps = 1e9;
 
-/// The repetitions of `pattern` that more pattern follows (Lua 5.4's syntax;
-/// a malformed pattern is left to the matcher to report).
-int backtracking_repetitions(const char* pattern, std::size_t length) {
+/// What makes a pattern's search long (see above).
+struct PatternCost {
+  int repetitions = 0;  ///< r
+  int optionals = 0;    ///< q
+};
+
+/// Index just past the set that starts at pattern[i] == '[' (Lua 5.4's
+/// syntax: a ']' or an escape right after '[' or '[^' is a member).
+std::size_t skip_set(const char* pattern, std::size_t length, std::size_t i) {
+  ++i;
+  if (i < length && pattern[i] == '^') ++i;
+  do {
+    i += i < length && pattern[i] == '%' ? 2 : 1;
+  } while (i < length && pattern[i] != ']');
+  return i + 1;
+}
+
+/// A malformed pattern is left to the matcher to report; the scan never
+/// reads beyond `length`.
+PatternCost pattern_cost(const char* pattern, std::size_t length) {
   std::size_t i = length > 0 && pattern[0] == '^' ? 1 : 0;
-  int repeated = 0;      // repetitions so far
-  int last_counted = 0;  // of them, those followed by another item
+  PatternCost seen;     // so far
+  PatternCost counted;  // of them, those another item follows
   while (i < length) {
     const char c = pattern[i];
     if (c == '(' || c == ')') {  // captures are not items
       ++i;
       continue;
     }
-    if (c == '$' && i + 1 == length) break;
-    last_counted = repeated;  // an item follows every repetition before it
-    bool single = true;       // an item that a repetition can follow
+    counted = seen;                          // an item follows everything before it
+    if (c == '$' && i + 1 == length) break;  // the anchor can fail: counted
+    bool single = true;                      // an item a repetition can follow
     if (c == '%' && i + 1 < length && pattern[i + 1] == 'b') {
-      i += 4, single = false;  // %bxy
+      i += 4, single = false;  // %bxy scans like a repetition and can fail at the end
+      ++seen.repetitions;
+      counted.repetitions = seen.repetitions;
     } else if (c == '%' && i + 1 < length && pattern[i + 1] == 'f') {
-      i += 2, single = false;  // %f[set]: the set follows
-      if (i < length && pattern[i] == '[') {
-        ++i;
-        if (i < length && pattern[i] == '^') ++i;
-        if (i < length) ++i;  // a ']' first is a member
-        while (i < length && pattern[i] != ']') i += pattern[i] == '%' ? 2 : 1;
-        ++i;
-      }
+      i += 2, single = false;  // %f[set]
+      if (i < length && pattern[i] == '[') i = skip_set(pattern, length, i);
+    } else if (c == '%' && i + 1 < length && pattern[i + 1] >= '0' && pattern[i + 1] <= '9') {
+      i += 2, single = false;  // a back-reference: a following '*' is a literal
     } else if (c == '%') {
-      i += 2;  // a class or an escaped character, or a back-reference
+      i += 2;  // a class or an escaped character
     } else if (c == '[') {
-      ++i;
-      if (i < length && pattern[i] == '^') ++i;
-      if (i < length) ++i;
-      while (i < length && pattern[i] != ']') i += pattern[i] == '%' ? 2 : 1;
-      ++i;
+      i = skip_set(pattern, length, i);
     } else {
       ++i;
     }
     if (single && i < length && (pattern[i] == '*' || pattern[i] == '+' || pattern[i] == '-')) {
-      ++repeated;
+      ++seen.repetitions;
       ++i;
     } else if (single && i < length && pattern[i] == '?') {
-      ++i;  // at most two tries: no factor of n
+      ++seen.optionals;
+      ++i;
     }
   }
-  return last_counted;
+  return counted;
 }
 
-/// string.find, match, gmatch and gsub (upvalue 1: the library's function,
-/// upvalue 2: its name), refusing patterns whose backtracking is unbounded
-/// for the subject's length.
-int sandbox_pattern_guard(lua_State* L) {
+/// Raises the refusal when `pattern` (argument 2) on the subject (argument 1)
+/// could search for very long.
+void check_pattern(lua_State* L, const char* name) {
   std::size_t n = 0;
   std::size_t pattern_length = 0;
   luaL_checklstring(L, 1, &n);
   const char* pattern = luaL_checklstring(L, 2, &pattern_length);
-  const char* name = lua_tostring(L, lua_upvalueindex(2));
-  const bool plain = std::strcmp(name, "find") == 0 && lua_toboolean(L, 4);
-  const int repetitions = plain ? 0 : backtracking_repetitions(pattern, pattern_length);
-  if (repetitions > 0 &&
-      std::pow(static_cast<double>(n) + 1.0, repetitions + 1.0) > kMaxPatternSteps) {
-    return luaL_error(
-        L,
-        "string.%s: the pattern '%s' has %d repetitions that more pattern follows; "
-        "on a subject of %I characters it could backtrack for a very long time (the sandbox "
-        "allows about 10^9 tries): shorten the subject or the pattern",
-        name, pattern, repetitions, static_cast<LUAI_UACINT>(n));
+  const PatternCost cost = pattern_cost(pattern, pattern_length);
+  const double log_tries = (cost.repetitions + 1.0) * std::log(static_cast<double>(n) + 1.0) +
+                           cost.optionals * std::log(2.0);
+  if (cost.repetitions + cost.optionals > 0 && log_tries > std::log(kMaxPatternSteps)) {
+    luaL_error(L,
+               "string.%s: the pattern '%s' has %d repetitions and %d optional items that "
+               "more pattern follows; on a subject of %I characters it could search for a "
+               "very long time (the sandbox allows about 10^9 tries): shorten the subject "
+               "or the pattern",
+               name, pattern, cost.repetitions, cost.optionals, static_cast<LUAI_UACINT>(n));
   }
-  lua_pushvalue(L, lua_upvalueindex(1));
-  lua_insert(L, 1);
-  lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
-  return lua_gettop(L);
+}
+
+// The library's functions are called directly, in this function's own call,
+// so their errors name the function and the caller's line as they would.
+int sandbox_string_find(lua_State* L) {
+  if (!lua_toboolean(L, 4)) check_pattern(L, "find");  // a plain search has no pattern
+  return host_of(L).string_find(L);
+}
+int sandbox_string_match(lua_State* L) {
+  check_pattern(L, "match");
+  return host_of(L).string_match(L);
+}
+int sandbox_string_gmatch(lua_State* L) {
+  check_pattern(L, "gmatch");
+  return host_of(L).string_gmatch(L);
+}
+int sandbox_string_gsub(lua_State* L) {
+  check_pattern(L, "gsub");
+  return host_of(L).string_gsub(L);
 }
 
 // Names objects by serial number in '%s' and refuses '%p': both would
@@ -776,6 +802,10 @@ int open_sandbox(lua_State* L) {
   host.base_rawset = library_function(L, base, "rawset");
   host.string_rep = library_function(L, string, "rep");
   host.string_format = library_function(L, string, "format");
+  host.string_find = library_function(L, string, "find");
+  host.string_match = library_function(L, string, "match");
+  host.string_gmatch = library_function(L, string, "gmatch");
+  host.string_gsub = library_function(L, string, "gsub");
   host.table_move = library_function(L, table, "move");
   host.coroutine_close = library_function(L, coroutine, "close");
 
@@ -810,15 +840,14 @@ int open_sandbox(lua_State* L) {
   // copy itself: the string metatable is protected, so scripts cannot reach
   // it to change it.
   push_copy(L, string, "dump");
-  static const luaL_Reg kString[] = {
-      {"rep", sandbox_string_rep}, {"format", sandbox_string_format}, {nullptr, nullptr}};
+  static const luaL_Reg kString[] = {{"rep", sandbox_string_rep},
+                                     {"format", sandbox_string_format},
+                                     {"find", sandbox_string_find},
+                                     {"match", sandbox_string_match},
+                                     {"gmatch", sandbox_string_gmatch},
+                                     {"gsub", sandbox_string_gsub},
+                                     {nullptr, nullptr}};
   luaL_setfuncs(L, kString, 0);
-  for (const char* name : {"find", "match", "gmatch", "gsub"}) {
-    lua_getfield(L, -1, name);
-    lua_pushstring(L, name);
-    lua_pushcclosure(L, sandbox_pattern_guard, 2);
-    lua_setfield(L, -2, name);
-  }
   lua_pushliteral(L, "");
   lua_getmetatable(L, -1);
   lua_pushvalue(L, -3);

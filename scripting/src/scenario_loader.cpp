@@ -98,8 +98,13 @@ const std::map<std::string, std::array<float, 3>, std::less<>>& color_names() {
 
 class Loader {
  public:
-  Loader(LuaHost& host, const std::filesystem::path& file)
-      : host_(host), L_(host.state()), file_(file.string()), folder_(file.parent_path()) {}
+  Loader(LuaHost& host, const std::filesystem::path& file,
+         std::vector<std::filesystem::path>* files_read)
+      : host_(host),
+        L_(host.state()),
+        file_(file.string()),
+        folder_(file.parent_path()),
+        files_read_(files_read) {}
 
   Scenario load();
 
@@ -479,8 +484,7 @@ class Loader {
       engine::ImportOptions options;
       options.merge = false;
       it->second = engine::import_file(path, options);
-      scenario_.files.insert(scenario_.files.end(), it->second.files.begin(),
-                             it->second.files.end());
+      for (const std::string& f : it->second.files) note_file(f);
     }
     const engine::ImportReport& report = it->second;
     std::vector<std::string> known;
@@ -543,14 +547,21 @@ class Loader {
   LuaHost& host_;
   lua_State* L_;
   std::string file_;
+  /// A file the scenario reads, also into *files_read_ (kept when loading fails).
+  void note_file(const std::filesystem::path& path) {
+    scenario_.files.push_back(path);
+    if (files_read_ != nullptr) files_read_->push_back(path);
+  }
+
   std::filesystem::path folder_;
   Scenario scenario_;
+  std::vector<std::filesystem::path>* files_read_ = nullptr;
   std::map<std::string, engine::ImportReport> imports_;  ///< mesh files read by node
 };
 
 Scenario Loader::load() {
   scenario_.file = file_;
-  scenario_.files.push_back(file_);
+  note_file(file_);
   // Define the vocabulary's constructors in the sandbox.
   host_.run_string("return function(...) " + std::string(kPrelude) + " end", kPreludeName, 1);
   lua_createtable(L_, static_cast<int>(vocabulary().size()), 0);
@@ -698,13 +709,14 @@ void Loader::read_parts(int map, const SourceLocation& where) {
     if (mesh.given) {
       const std::filesystem::path path = folder_ / mesh.text;
       collision::Mesh loaded;
+      note_file(path);  // named by the scenario, read or not: never to be overwritten
       try {
         if (nodes.given || without.given) {
           loaded = select_nodes(path, nodes.given ? nodes.names : without.names, nodes.given,
                                 part.where, what);
         } else {
           engine::ImportReport report = engine::import_file(path, {});
-          scenario_.files.insert(scenario_.files.end(), report.files.begin(), report.files.end());
+          for (const std::string& f : report.files) note_file(f);
           loaded = std::move(report.parts.front().mesh);
         }
       } catch (const ScenarioError&) {
@@ -847,14 +859,8 @@ void Loader::read_glove(int index, const SourceLocation& outer) {
     fail(glove.where, "glove: give either plan = \"file\" or trace = \"file\"");
   if (plan.given) glove.plan = folder_ / plan.text;
   if (trace.given) glove.trace = folder_ / trace.text;
-  const std::filesystem::path& source = plan.given ? glove.plan : glove.trace;
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(source, ec)) {
-    fail(glove.where,
-         "glove: " + (plan.given ? plan.text : trace.text) +
-             (std::filesystem::exists(source, ec) ? ": not a file" : ": file not found"));
-  }
-  scenario_.files.push_back(source);
+  // Read by the run unless it replays another trace; never to be overwritten.
+  note_file(plan.given ? glove.plan : glove.trace);
   glove.holding = field(t, word, "holding", glove.where, "glove").text;
   if (const Arg a = field(t, word, "grasp", glove.where, "glove"); a.given) {
     glove.grasp = a.text == "precision" ? interaction::GraspType::kPrecision
@@ -1133,8 +1139,9 @@ void Loader::resolve() {
 
 }  // namespace
 
-Scenario load_scenario(LuaHost& host, const std::filesystem::path& file) {
-  Loader loader(host, file);
+Scenario load_scenario(LuaHost& host, const std::filesystem::path& file,
+                       std::vector<std::filesystem::path>* files_read) {
+  Loader loader(host, file, files_read);
   return loader.load();
 }
 

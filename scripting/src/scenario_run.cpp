@@ -7,6 +7,7 @@
 #include <cstring>
 #include <lua.hpp>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "dovetail/collision/contacts.h"
@@ -81,6 +82,9 @@ class Runner {
   double metres_per_unit() const { return scenario_.metres_per_unit; }
 
  private:
+  /// Why an output (the recording, RunOptions::outputs) may not be written:
+  /// it is a file the run reads.
+  std::optional<std::string> output_read() const;
   void refuse_outputs();
   void build();
   void start_frame(std::uint64_t frame, double t);
@@ -102,6 +106,7 @@ class Runner {
   RunOutcome& out_;
   LuaHost host_;
   Scenario scenario_;
+  std::vector<std::filesystem::path> files_read_;    ///< by the loader, even when it fails
   std::unique_ptr<collision::CaptureSink> capture_;  ///< outlives the simulation's world
   std::unique_ptr<engine::Simulation> sim_;
   std::unique_ptr<interaction::Hand> hand_;
@@ -797,18 +802,26 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
   return fs::absolute(a, ec).lexically_normal() == fs::absolute(b, ec).lexically_normal();
 }
 
-void Runner::refuse_outputs() {
-  std::vector<std::filesystem::path> reads = scenario_.files;
+std::optional<std::string> Runner::output_read() const {
+  std::vector<std::filesystem::path> reads = files_read_;
   if (options_.trace) reads.push_back(*options_.trace);
   std::vector<std::filesystem::path> writes = options_.outputs;
   if (options_.record) writes.push_back(*options_.record);
   for (const std::filesystem::path& w : writes) {
     for (const std::filesystem::path& r : reads) {
-      if (!same_file(w, r)) continue;
-      out_.outputs_refused = true;
-      throw ScenarioError(file_.string() + ": the output '" + w.string() + "' is '" + r.string() +
-                          "', which the run reads; it would be overwritten");
+      if (same_file(w, r)) {
+        return "the output '" + w.string() + "' is '" + r.string() +
+               "', which the run reads; it would be overwritten";
+      }
     }
+  }
+  return std::nullopt;
+}
+
+void Runner::refuse_outputs() {
+  if (const std::optional<std::string> clash = output_read()) {
+    out_.outputs_refused = true;
+    throw ScenarioError(file_.string() + ": " + *clash);
   }
 }
 
@@ -817,7 +830,7 @@ void Runner::run() {
   out_.file = file_;
   out_.name = file_.stem().string();
   try {
-    scenario_ = load_scenario(host_, file_);
+    scenario_ = load_scenario(host_, file_, &files_read_);
     refuse_outputs();
     out_.name = scenario_.name;
     out_.units = scenario_.units;
@@ -833,6 +846,11 @@ void Runner::run() {
   } catch (const std::exception& e) {
     out_.status = RunOutcome::Status::kError;
     out_.error = e.what();
+    // Loading may have failed after reading files an output would overwrite.
+    if (const std::optional<std::string> clash = output_read(); clash && !out_.outputs_refused) {
+      out_.outputs_refused = true;
+      out_.error += "\n" + file_.string() + ": nothing written: " + *clash;
+    }
     out_.wall_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return;
@@ -976,7 +994,20 @@ RunOutcome run_scenario(const std::filesystem::path& file, const RunOptions& opt
 
 Scenario check_scenario(const std::filesystem::path& file, const SandboxLimits& limits) {
   LuaHost host(limits, 1);
-  return load_scenario(host, file);
+  Scenario scenario = load_scenario(host, file);
+  // The glove's plan or trace is read when the run starts (unless it replays
+  // another trace); a check finds it missing now.
+  if (scenario.glove) {
+    const GloveSpec& glove = *scenario.glove;
+    const std::filesystem::path& source = glove.plan.empty() ? glove.trace : glove.plan;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(source, ec)) {
+      throw ScenarioError(
+          glove.where.str() + ": glove: " + source.lexically_relative(file.parent_path()).string() +
+          (std::filesystem::exists(source, ec) ? ": not a file" : ": file not found"));
+    }
+  }
+  return scenario;
 }
 
 }  // namespace dovetail::scripting

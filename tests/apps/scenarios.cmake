@@ -89,6 +89,19 @@ dovetail_cli_test(run_record_is_plan EXIT 1
                        --record ${out}/alias/plan_alias/hand.plan --report ${out}/alias/kept.json
                   STDERR "hand.plan', which the run reads; it would be overwritten"
                   KEEP ${out}/alias/kept.json)
+# The report is not written over a mesh the scenario names, even when the
+# scenario fails to load, and even when the mesh cannot be read.
+file(COPY ${scenario_data}/invalid/mesh_then_error.lua ${data}/cube.obj DESTINATION ${out}/mesh_alias)
+dovetail_cli_test(run_report_is_mesh EXIT 1
+                  ARGS run ${out}/mesh_alias/mesh_then_error.lua --report ${out}/mesh_alias/cube.obj
+                  STDERR "nothing written: the output .*cube.obj' is .*which the run reads"
+                  KEEP ${out}/mesh_alias/cube.obj)
+# A scenario whose own plan is missing still replays a recorded trace; check says it is missing.
+file(COPY ${scenario_data}/plan_alias/boxes.lua DESTINATION ${out}/no_plan)
+dovetail_cli_test(run_trace_without_the_plan EXIT 0
+                  ARGS run ${out}/no_plan/boxes.lua --trace ${data}/glove/trace_three_samples.csv --quiet)
+dovetail_cli_test(check_without_the_plan EXIT 1 ARGS check ${out}/no_plan/boxes.lua
+                  STDERR "boxes.lua:6: glove: hand.plan: file not found")
 dovetail_cli_test(regress_junit_is_scenario EXIT 2
                   ARGS regress ${out}/alias --out ${out}/alias_out --junit ${out}/alias/well_behaved.lua
                   STDERR "would be overwritten")

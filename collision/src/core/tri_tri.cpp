@@ -175,9 +175,11 @@ bool triangles_intersect(const Vec3& p1, const Vec3& q1, const Vec3& r1, const V
   if (strictly_one_side(s2)) return false;
 
   // Every point lies on a degenerate triangle's "plane", so all-zero sides
-  // mean: both triangles in one plane (or both degenerate), or one triangle
-  // degenerate, its points on a line that crosses the other's plane. (A mesh
-  // has no degenerate triangles, but a far pose can round one flat.)
+  // mean: both triangles in one plane, or one triangle degenerate, its points
+  // on a line that crosses the other's plane (a mesh has no degenerate
+  // triangles, but a far pose can round one flat), or both degenerate. The
+  // last gets the coplanar test: a defined verdict, but not an exact one
+  // (two skew segments can be found to meet).
   const bool t1_on_plane2 = all_on_plane(s1);
   const bool t2_on_plane1 = all_on_plane(s2);
   if (t1_on_plane2 && t2_on_plane1) {

@@ -145,7 +145,10 @@ struct Scenario {
 /// Loads the scenario at `file` in `host` (which must stay alive while
 /// custom actions may run). Throws ScenarioError for anything wrong with
 /// the scenario, and ScriptError (lua_host.h) for a script that fails.
-Scenario load_scenario(LuaHost& host, const std::filesystem::path& file);
+/// `files_read`, when given, gets Scenario::files as they are read, so that
+/// they are known when loading fails part-way.
+Scenario load_scenario(LuaHost& host, const std::filesystem::path& file,
+                       std::vector<std::filesystem::path>* files_read = nullptr);
 
 /// A commented starting scenario named `name`, for `dovetail new`.
 std::string starting_scenario(const std::string& name);
