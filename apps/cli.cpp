@@ -12,6 +12,8 @@
 #include <fstream>
 #include <utility>
 
+#include "dovetail/engine/paths.h"
+
 namespace dovetail::cli {
 
 namespace {
@@ -175,19 +177,10 @@ collision::Method Args::method(collision::Method fallback) const {
   return *m;
 }
 
-bool same_file(const std::string& a, const std::string& b) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const bool same = fs::exists(a, ec) ? fs::equivalent(a, b, ec)
-                                      : fs::absolute(a, ec).lexically_normal() ==
-                                            fs::absolute(b, ec).lexically_normal();
-  return same && !ec;
-}
-
 void refuse_overwriting_input(const std::string& command, const std::string& output,
                               std::span<const std::string> inputs) {
   for (const std::string& input : inputs) {
-    if (same_file(output, input)) {
+    if (engine::same_file(output, input)) {
       throw UsageError(command + ": the output '" + output + "' is the input '" + input +
                        "'; it would be overwritten");
     }

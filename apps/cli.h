@@ -81,9 +81,6 @@ class Args {
   std::set<std::string> flags_set_;
 };
 
-/// Whether two paths name one file (or would, when `a` does not exist yet).
-bool same_file(const std::string& a, const std::string& b);
-
 /// UsageError when `output` names the same file as one of `inputs`: writing
 /// it would destroy an input before it is read.
 void refuse_overwriting_input(const std::string& command, const std::string& output,

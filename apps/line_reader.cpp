@@ -117,7 +117,6 @@ void FramePairsOutput::refuse(std::span<const std::string> inputs) const {
 }
 
 void FramePairsOutput::frame(std::uint64_t k, std::size_t count) {
-  framed_ = true;
   if (text_.size() > (std::size_t{1} << 20)) flush();
   text_ += "frame " + std::to_string(k) + " count " + std::to_string(count) + "\n";
 }
@@ -143,7 +142,7 @@ void FramePairsOutput::flush() {
 }
 
 void FramePairsOutput::close(bool failed) {
-  if (failed && !framed_) return;
+  if (failed && text_.empty() && !out_.is_open()) return;  // no frame yet
   flush();
   if (!path_) return;
   out_.close();

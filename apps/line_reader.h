@@ -90,7 +90,6 @@ class FramePairsOutput {
   std::optional<std::string> path_;
   std::ofstream out_;
   std::string text_;
-  bool framed_ = false;  ///< a frame was written
 };
 
 }  // namespace dovetail::cli

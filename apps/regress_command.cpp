@@ -24,6 +24,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "dovetail/engine/paths.h"
 
 extern char** environ;
 
@@ -56,8 +57,7 @@ struct Job {
   std::chrono::steady_clock::time_point start;
   double seconds = 0;
   int exit_code = -1;
-  bool timed_out = false;
-  std::string stopped;  ///< why the run was stopped from outside, if it was
+  std::string stopped;  ///< why the run was stopped from outside (its timeout, a signal), if it was
   std::string status;   ///< passed, failed, error
   std::string log;      ///< what the run wrote on stderr
   nlohmann::json report;
@@ -162,7 +162,7 @@ void start(Job& job, const std::filesystem::path& out, int threads) {
 void finish(Job& job, int wait_status, const std::filesystem::path& out) {
   job.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - job.start).count();
   job.exit_code = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : 128 + WTERMSIG(wait_status);
-  if (WIFSIGNALED(wait_status) && !job.timed_out) {
+  if (WIFSIGNALED(wait_status) && job.stopped.empty()) {
     job.stopped = "the run ended with signal " + std::to_string(WTERMSIG(wait_status));
   }
   job.status = job.exit_code == kExitOk            ? "passed"
@@ -384,9 +384,8 @@ void run_jobs(std::vector<Job>& jobs, const std::filesystem::path& out, std::siz
     }
     const auto now = std::chrono::steady_clock::now();
     for (Job& job : jobs) {
-      if (job.pid > 0 && !job.timed_out &&
+      if (job.pid > 0 && job.stopped.empty() &&
           std::chrono::duration<double>(now - job.start).count() > timeout) {
-        job.timed_out = true;
         char reason[96];
         std::snprintf(reason, sizeof reason, "stopped after the timeout of %g s", timeout);
         job.stopped = reason;
@@ -426,7 +425,7 @@ int regress_command(std::span<const std::string> argv) {
     refuse_overwriting_input("regress", *summary, scenarios);
     check_writable(*summary);
   }
-  if (junit && html && same_file(*junit, *html)) {
+  if (junit && html && engine::same_file(*junit, *html)) {
     throw UsageError("regress: --junit and --html name the same file '" + *junit + "'");
   }
   std::vector<Job> jobs = shard_jobs(folder, shard_k, shard_n);

@@ -11,6 +11,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "dovetail/engine/paths.h"
 #include "dovetail/scripting/scenario_run.h"
 
 namespace dovetail::cli {
@@ -183,7 +184,7 @@ void check_outputs(const Args& args, const std::filesystem::path& scenario,
     refuse_overwriting_input(args.command(), *out, inputs);
     check_writable(*out);
   }
-  if (report && record && same_file(*report, *record)) {
+  if (report && record && engine::same_file(*report, *record)) {
     throw UsageError(args.command() + ": --report and --record name the same file '" + *report +
                      "'");
   }

@@ -547,9 +547,8 @@ class Loader {
   LuaHost& host_;
   lua_State* L_;
   std::string file_;
-  /// A file the scenario reads, also into *files_read_ (kept when loading fails).
+  /// A file the scenario names, into *files_read_ (kept when loading fails).
   void note_file(const std::filesystem::path& path) {
-    scenario_.files.push_back(path);
     if (files_read_ != nullptr) files_read_->push_back(path);
   }
 

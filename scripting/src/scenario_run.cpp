@@ -13,6 +13,7 @@
 #include "dovetail/collision/contacts.h"
 #include "dovetail/collision/model.h"
 #include "dovetail/engine/json.h"
+#include "dovetail/engine/paths.h"
 #include "dovetail/engine/render.h"
 #include "dovetail/engine/scene_render.h"
 #include "dovetail/interaction/glove_plan.h"
@@ -794,14 +795,6 @@ void Runner::evaluate_expectations() {
   }
 }
 
-/// Whether two paths name one file (or would, for one not yet written).
-bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec) && !ec;
-  return fs::absolute(a, ec).lexically_normal() == fs::absolute(b, ec).lexically_normal();
-}
-
 std::optional<std::string> Runner::output_read() const {
   std::vector<std::filesystem::path> reads = files_read_;
   if (options_.trace) reads.push_back(*options_.trace);
@@ -809,7 +802,7 @@ std::optional<std::string> Runner::output_read() const {
   if (options_.record) writes.push_back(*options_.record);
   for (const std::filesystem::path& w : writes) {
     for (const std::filesystem::path& r : reads) {
-      if (same_file(w, r)) {
+      if (engine::same_file(w, r)) {
         return "the output '" + w.string() + "' is '" + r.string() +
                "', which the run reads; it would be overwritten";
       }

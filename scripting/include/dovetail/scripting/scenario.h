@@ -137,16 +137,14 @@ struct Scenario {
   std::optional<engine::Camera> camera{};
   /// Things that load but look wrong (a rule that can never fire), `file:line: ...`.
   std::vector<std::string> warnings{};
-  /// Every file the scenario reads: itself, its meshes and what they refer
-  /// to, its glove's plan or trace. A run refuses to write over any of them.
-  std::vector<std::filesystem::path> files{};
 };
 
 /// Loads the scenario at `file` in `host` (which must stay alive while
 /// custom actions may run). Throws ScenarioError for anything wrong with
 /// the scenario, and ScriptError (lua_host.h) for a script that fails.
-/// `files_read`, when given, gets Scenario::files as they are read, so that
-/// they are known when loading fails part-way.
+/// `files_read`, when given, gets every file the scenario names as it goes:
+/// itself, its meshes and what they refer to, its glove's plan or trace (a
+/// run refuses to write over any of them), also when loading fails part-way.
 Scenario load_scenario(LuaHost& host, const std::filesystem::path& file,
                        std::vector<std::filesystem::path>* files_read = nullptr);
 

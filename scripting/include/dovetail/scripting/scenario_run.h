@@ -50,7 +50,7 @@ struct RunOptions {
   std::optional<double> tolerance_m{};
   /// Files the caller writes after the run (the report). The run refuses to
   /// start, as it does for `record`, when one of them is a file the scenario
-  /// reads (Scenario::files) or the trace: it would be overwritten.
+  /// reads (load_scenario's files_read) or the trace: it would be overwritten.
   std::vector<std::filesystem::path> outputs{};
 };
 
