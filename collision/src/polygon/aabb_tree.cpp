@@ -4,8 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "polygon/box_fit.h"
 #include "polygon/pair_traversal.h"
-#include "polygon/principal_axes.h"
 
 namespace dovetail::collision {
 
@@ -121,14 +121,12 @@ ObbTree::ObbTree(const Mesh& mesh, int max_leaf_size) {
   leaves_ = layout.leaves;
   depth_ = layout.depth;
   const std::size_t n = layout.nodes.size();
-  const std::vector<detail::Moments> moments = detail::node_moments(layout, mesh);
+  const std::vector<Mat3> axes = detail::fit_box_axes(layout, mesh);
   nodes_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const detail::LayoutNode& node = layout.nodes[i];
     Node& out = nodes_[i];
-    out.axes = node.end - node.begin == 1
-                   ? detail::triangle_axes(mesh, layout.triangles[node.begin].index)
-                   : detail::covariance_axes(moments[i]);
+    out.axes = axes[i];
     const Mat3 to_box = out.axes.transpose();
     Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
     Vec3 hi = -lo;

@@ -1,0 +1,167 @@
+#include "polygon/box_fit.h"
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <limits>
+
+#include "polygon/principal_axes.h"
+
+namespace dovetail::collision::detail {
+
+namespace {
+
+/// The 26-DOP's directions, one of each opposite pair.
+const std::array<Vec3, 13> kDirections = {
+    Vec3(1, 0, 0),  Vec3(0, 1, 0),  Vec3(0, 0, 1),  Vec3(1, 1, 0),  Vec3(1, -1, 0),
+    Vec3(1, 0, 1),  Vec3(1, 0, -1), Vec3(0, 1, 1),  Vec3(0, 1, -1), Vec3(1, 1, 1),
+    Vec3(1, 1, -1), Vec3(1, -1, 1), Vec3(1, -1, -1)};
+
+constexpr int kSupportMax = 2 * static_cast<int>(kDirections.size());
+
+/// Vertex indices that stand for a node in the search: all of a small
+/// node's vertices, or a large node's extremes along kDirections. Either
+/// way the search's box in the mesh's frame is the node's own.
+struct Support {
+  std::array<std::uint32_t, 2 * kSupportMax> vertex{};
+  int count = 0;
+};
+
+/// Nodes with fewer triangles keep their covariance frame: searching them
+/// too saved 2% of the bunny's volume tests and doubled the fitting time.
+constexpr int kSearchMinTriangles = 9;
+
+/// Turns tried about each axis, largest first, each from the best frame so far.
+constexpr std::array<Real, 4> kTurns = {0.3, 0.1, 0.03, 0.01};
+
+/// Steps of one turn size at most, while each still shrinks the box.
+constexpr int kMaxSteps = 4;
+
+class BoxFitter {
+ public:
+  BoxFitter(const BinaryLayout& layout, const Mesh& mesh, std::vector<Mat3>& axes)
+      : layout_(layout), mesh_(mesh), axes_(axes), moments_(node_moments(layout, mesh)) {}
+
+  /// Fits the axes of `node` and its subtree (children first); returns the
+  /// node's support.
+  Support fit(std::uint32_t node) {
+    const LayoutNode& n = layout_.nodes[node];
+    Support s;
+    if (n.is_leaf()) {
+      for (std::uint32_t slot = n.begin; slot < n.end; ++slot) {
+        for (std::uint32_t v : mesh_.triangles[layout_.triangles[slot].index]) add_unique(s, v);
+      }
+    } else {
+      const Support left = fit(n.first_child);
+      const Support right = fit(n.first_child + 1);
+      for (int k = 0; k < left.count; ++k) s.vertex[s.count++] = left.vertex[k];
+      for (int k = 0; k < right.count; ++k) s.vertex[s.count++] = right.vertex[k];
+      if (s.count > kSupportMax) s = extremes(s);
+    }
+    axes_[node] = search(node, s);
+    return s;
+  }
+
+ private:
+  static void add_unique(Support& s, std::uint32_t v) {
+    for (int k = 0; k < s.count; ++k)
+      if (s.vertex[k] == v) return;
+    s.vertex[s.count++] = v;
+  }
+
+  /// The extreme vertices of `s` along each direction, both ways.
+  Support extremes(const Support& s) const {
+    Support out;
+    for (const Vec3& d : kDirections) {
+      int lo = 0, hi = 0;
+      Real min = std::numeric_limits<Real>::infinity(), max = -min;
+      for (int k = 0; k < s.count; ++k) {
+        const Real x = d.dot(mesh_.vertices[s.vertex[k]]);
+        if (x < min) min = x, lo = k;
+        if (x > max) max = x, hi = k;
+      }
+      add_unique(out, s.vertex[lo]);
+      add_unique(out, s.vertex[hi]);
+    }
+    return out;
+  }
+
+  /// The cost of the box of `s` with the given axes: its volume, plus a
+  /// little of its surface area times its edge sum so that a flat node (no
+  /// volume in any frame that holds its plane) still prefers the tighter
+  /// rectangle.
+  Real cost(const Mat3& axes, const Support& s) const {
+    const Mat3 to_box = axes.transpose();
+    Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
+    Vec3 hi = -lo;
+    for (int k = 0; k < s.count; ++k) {
+      const Vec3 p = to_box * mesh_.vertices[s.vertex[k]];
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    const Vec3 e = hi - lo;
+    const Real area = e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+    return e.x() * e.y() * e.z() + 0.01 * area * e.sum();
+  }
+
+  Mat3 search(std::uint32_t node, const Support& s) const {
+    const LayoutNode& n = layout_.nodes[node];
+    const auto count = static_cast<int>(n.end - n.begin);
+    Mat3 best = count == 1 ? triangle_axes(mesh_, layout_.triangles[n.begin].index)
+                           : covariance_axes(moments_[node]);
+    if (count < kSearchMinTriangles) return best;
+    Real best_cost = cost(best, s);
+    const auto consider = [&](const Mat3& candidate) {
+      const Real c = cost(candidate, s);
+      if (c < best_cost) best_cost = c, best = candidate;
+    };
+    consider(Mat3::Identity());
+    if (!n.is_leaf()) {
+      consider(axes_[n.first_child]);
+      consider(axes_[n.first_child + 1]);
+    }
+    for (const std::array<Mat3, 6>& turns : turns_) {
+      for (int step = 0; step < kMaxSteps; ++step) {
+        const Real before = best_cost;
+        for (const Mat3& turn : turns) consider(best * turn);
+        if (!(best_cost < before)) break;
+      }
+    }
+    // The products of rotations drift from orthonormal by rounding.
+    best.col(0).normalize();
+    best.col(1) = (best.col(1) - best.col(1).dot(best.col(0)) * best.col(0)).normalized();
+    best.col(2) = best.col(0).cross(best.col(1));
+    return best;
+  }
+
+  /// Per size in kTurns, the turns about each axis both ways.
+  static std::array<std::array<Mat3, 6>, kTurns.size()> make_turns() {
+    std::array<std::array<Mat3, 6>, kTurns.size()> out;
+    for (std::size_t k = 0; k < kTurns.size(); ++k) {
+      for (int axis = 0; axis < 3; ++axis) {
+        for (int sign = 0; sign < 2; ++sign) {
+          const Real angle = sign == 0 ? -kTurns[k] : kTurns[k];
+          out[k][2 * axis + sign] =
+              Eigen::AngleAxis<Real>(angle, Vec3::Unit(axis)).toRotationMatrix();
+        }
+      }
+    }
+    return out;
+  }
+
+  const std::array<std::array<Mat3, 6>, kTurns.size()> turns_ = make_turns();
+  const BinaryLayout& layout_;
+  const Mesh& mesh_;
+  std::vector<Mat3>& axes_;
+  std::vector<Moments> moments_;
+};
+
+}  // namespace
+
+std::vector<Mat3> fit_box_axes(const BinaryLayout& layout, const Mesh& mesh) {
+  std::vector<Mat3> axes(layout.nodes.size(), Mat3::Identity());
+  if (!layout.nodes.empty()) BoxFitter(layout, mesh, axes).fit(0);
+  return axes;
+}
+
+}  // namespace dovetail::collision::detail
