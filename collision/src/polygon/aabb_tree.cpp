@@ -197,6 +197,12 @@ class ObbPolicy {
                                           e.half, margin_);
   }
 
+  /// Squared distance between the box centres: near contact, the pair of
+  /// boxes more nearly concentric more often holds crossing triangles.
+  Real nearness(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
+    return (a_.nodes_[n].centre - e.centre).squaredNorm();
+  }
+
   Real gap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
     const ObbTree::Node& node = a_.nodes_[n];
     return detail::oriented_boxes_gap(node.axes, node.centre, node.half, e.axes, e.centre, e.half,

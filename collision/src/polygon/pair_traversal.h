@@ -38,6 +38,14 @@ concept HasDiameter = requires(const Policy& p) {
   { p.small_pair(0u, 0u, Real{0}) } -> std::same_as<bool>;
 };
 
+/// Policies that rank overlapping pairs for a first-hit query:
+/// nearness(a, b) is smaller for a pair likelier to hold an intersection.
+template <typename Policy>
+concept HasNearness = requires(const Policy& p, const typename Policy::EncA& ea,
+                               const typename Policy::EncB& eb) {
+  { p.nearness(0u, ea, 0u, eb) } -> std::same_as<Real>;
+};
+
 template <typename Policy>
 class PairTraversal {
  public:
@@ -88,6 +96,11 @@ class PairTraversal {
   }
 
   void run_from(const Entry& e) { visit(e.a, e.enc_a, e.b, e.enc_b, 0); }
+
+  /// For a first-hit query with a policy that has nearness(): of two
+  /// overlapping child pairs, enter the nearer first. It changes which hit is
+  /// found, never whether one is.
+  void enter_nearer_first() { nearer_first_ = true; }
 
   /// Records, for a first-hit query, the node pair `levels` above the leaf
   /// pair where the hit is found (or the highest pair visited, if fewer).
@@ -198,7 +211,22 @@ class PairTraversal {
       }
       return;
     }
-    if (!la.is_leaf() && (lb.is_leaf() || p_.size_a(a) >= p_.size_b(b))) {
+    const bool down_a = !la.is_leaf() && (lb.is_leaf() || p_.size_a(a) >= p_.size_b(b));
+    if constexpr (HasNearness<Policy>) {
+      if (nearer_first_) {
+        const std::uint32_t c = down_a ? la.first_child() : lb.first_child();
+        if (down_a) {
+          visit_nearer_first(c, p_.enclose_a(c), b, enc_b, c + 1, p_.enclose_a(c + 1), b, enc_b,
+                             depth + 1);
+        } else {
+          visit_nearer_first(a, enc_a, c, p_.enclose_b(c), a, enc_a, c + 1, p_.enclose_b(c + 1),
+                             depth + 1);
+        }
+        if (tester_.done()) unwind(a, b);
+        return;
+      }
+    }
+    if (down_a) {
       for (std::uint32_t c = la.first_child(); c < la.first_child() + 2; ++c) {
         const EncA enc_c = p_.enclose_a(c);
         if (overlapping(c, enc_c, b, enc_b)) visit(c, enc_c, b, enc_b, depth + 1);
@@ -211,6 +239,21 @@ class PairTraversal {
         if (tester_.done()) return unwind(a, b);
       }
     }
+  }
+
+  /// Tests two child pairs, then visits those that overlap, the nearer first.
+  void visit_nearer_first(std::uint32_t a0, const EncA& ea0, std::uint32_t b0, const EncB& eb0,
+                          std::uint32_t a1, const EncA& ea1, std::uint32_t b1, const EncB& eb1,
+                          int depth) {
+    const bool overlap0 = overlapping(a0, ea0, b0, eb0);
+    const bool overlap1 = overlapping(a1, ea1, b1, eb1);
+    if (overlap0 && overlap1 && p_.nearness(a1, ea1, b1, eb1) < p_.nearness(a0, ea0, b0, eb0)) {
+      visit(a1, ea1, b1, eb1, depth);
+      if (!tester_.done()) visit(a0, ea0, b0, eb0, depth);
+      return;
+    }
+    if (overlap0) visit(a0, ea0, b0, eb0, depth);
+    if (overlap1 && !tester_.done()) visit(a1, ea1, b1, eb1, depth);
   }
 
   /// On the way back up from a first hit: the hint climbs to (a, b) until it
@@ -228,6 +271,7 @@ class PairTraversal {
   std::vector<SeparationFront::Entry>* front_out_ = nullptr;
   int hint_levels_ = 0;
   int hint_countdown_ = 0;
+  bool nearer_first_ = false;
   int max_depth_ = -1;  ///< negative: exact
   Real max_size_ = 0;   ///< 0: exact
 };
@@ -277,7 +321,10 @@ CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh
     }
     traversal.run();
   };
-  if (!request.all_pairs) traversal.cut_at_size(request.max_size);
+  if (!request.all_pairs) {
+    traversal.cut_at_size(request.max_size);
+    traversal.enter_nearer_first();
+  }
   if (request.max_depth >= 0 && !request.all_pairs) {
     traversal.cut_at_depth(request.max_depth);
     traversal.run();
