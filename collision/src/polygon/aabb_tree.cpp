@@ -75,6 +75,14 @@ class AabbPolicy {
                                  margin_);
   }
 
+  /// Squared distance between the box centres (as the OBB tree's).
+  Real nearness(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
+    const AabbTree::Node& node = a_.nodes_[n];
+    const Vec3 lo(node.lo[0], node.lo[1], node.lo[2]);
+    const Vec3 hi(node.hi[0], node.hi[1], node.hi[2]);
+    return ((lo + hi) * 0.5 - e.centre).squaredNorm();
+  }
+
   detail::NodeLink link_a(std::uint32_t n) const { return a_.nodes_[n].link; }
   detail::NodeLink link_b(std::uint32_t n) const { return b_.nodes_[n].link; }
   Real size_a(std::uint32_t n) const { return size(a_.nodes_[n]); }

@@ -190,6 +190,7 @@ class DopPolicy {
   DopPolicy(const DopTree& a, const DopTree& b, const Transform& X_AB)
       : a_(a),
         b_(b),
+        X_AB_(X_AB),
         axes_(a.basis_.axes),
         margin_(detail::query_margin(a.max_abs_, b.max_abs_, X_AB)),
         b_in_a_(b.basis_, a.basis_, X_AB.R, X_AB.t, margin_),
@@ -202,6 +203,12 @@ class DopPolicy {
     return b_in_a_.overlaps(dop(a_, a), enc_b) && a_in_b_.overlaps(dop(b_, b), enc_a);
   }
 
+  /// Squared distance between the centres of the two DOPs' boxes (their
+  /// first three axes are x, y, z), B's brought into A's frame.
+  Real nearness(std::uint32_t a, const EncA&, std::uint32_t b, const EncB&) const {
+    return (centre(dop(a_, a)) - X_AB_.apply(centre(dop(b_, b)))).squaredNorm();
+  }
+
   detail::NodeLink link_a(std::uint32_t n) const { return a_.links_[n]; }
   detail::NodeLink link_b(std::uint32_t n) const { return b_.links_[n]; }
   Real size_a(std::uint32_t n) const { return size(dop(a_, n)); }
@@ -211,12 +218,16 @@ class DopPolicy {
 
  private:
   const float* dop(const DopTree& t, std::uint32_t n) const { return &t.bounds_[n * 2 * axes_]; }
+  Vec3 centre(const float* d) const {
+    return Vec3(Real{d[0]} + d[axes_], Real{d[1]} + d[axes_ + 1], Real{d[2]} + d[axes_ + 2]) * 0.5;
+  }
   Real size(const float* d) const {
     return (d[axes_] - d[0]) + (d[axes_ + 1] - d[1]) + (d[axes_ + 2] - d[2]);
   }
 
   const DopTree& a_;
   const DopTree& b_;
+  const Transform& X_AB_;
   int axes_;
   Real margin_;
   TumbleTable b_in_a_;
