@@ -113,7 +113,10 @@ std::optional<Hit> first_hit(const collision::CollisionModel& part, const Transf
     const Transform X_OP = engine::compose(o.X_WO.inverse(), X_WP);
     if (queries) ++*queries;
     collision::SeparationFront* front = fronts ? &fronts->of(o.model, part_shared) : nullptr;
-    const collision::CollideResult r = o.model->collide(part, X_OP, {.front = front});
+    // The fixed order: the first hit, which guides the contact search, is
+    // then the same with fronts and without.
+    const collision::CollideResult r =
+        o.model->collide(part, X_OP, {.front = front, .nearer_first = false});
     if (r.colliding) return Hit{i, r.pairs.front()};
   }
   return std::nullopt;

@@ -223,6 +223,32 @@ TEST(Hierarchies, ModelsRejectMixedMethods) {
   EXPECT_THROW(a->collide(*b, Transform::identity()), std::invalid_argument);
 }
 
+TEST(Hierarchies, ModelsRefuseMeshesMakeMeshWouldRefuseNamingTheSource) {
+  // A Mesh can be filled by hand, past make_mesh's checks; a NaN vertex
+  // used to crash the partition.
+  for (const Method m : all_methods()) {
+    Mesh nan = make_box(Vec3(1, 1, 1));
+    nan.source = "hand-made.mesh";
+    nan.vertices[3].y() = std::numeric_limits<Real>::quiet_NaN();
+    Mesh far = make_box(Vec3(1, 1, 1));
+    far.source = "hand-made.mesh";
+    far.vertices[0].x() = 1e31;
+    Mesh bad_index = make_box(Vec3(1, 1, 1));
+    bad_index.source = "hand-made.mesh";
+    bad_index.triangles[5][1] = 99;
+    Mesh empty;
+    empty.source = "hand-made.mesh";
+    for (const Mesh* mesh : {&nan, &far, &bad_index, &empty}) {
+      try {
+        build_model(m, share(*mesh));
+        ADD_FAILURE() << method_name(m) << " built a model of a bad mesh";
+      } catch (const MeshError& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("hand-made.mesh: ", 0), 0u) << e.what();
+      }
+    }
+  }
+}
+
 TEST(Hierarchies, InfoReportsShapeAndMemory) {
   const auto mesh = share(make_sphere(1.0, 4));  // 5120 triangles
   for (Method m : all_methods()) {
@@ -303,11 +329,13 @@ TEST(Hierarchies, TraversalHintsNeverChangeTheVerdict) {
 }
 
 /// One query with a SeparationFront against the same query without: the same
-/// verdict, and for all pairs the same pairs. A first hit may differ: a
-/// first-hit query enters the nearer of two child pairs first, and the front
-/// replays its entries in the order they were recorded at an earlier pose
-/// (with `hinted`, the hints differ too: the front's is set nearer the
-/// leaves), so both first pairs need only intersect.
+/// verdict and the same pairs. A query with a front keeps the fixed order,
+/// so it is compared with the query without in that order; with `hinted`,
+/// first hits carry a hint too, with and without the front, and their hints
+/// may then differ (the front's is set nearer the leaves), so their first
+/// pairs need only both intersect. The query without a front in the
+/// default, nearer-first order gives the same verdict and an intersecting
+/// pair.
 struct FrontCheck {
   std::shared_ptr<const CollisionModel> a, b;
   bool hinted = false;
@@ -321,16 +349,25 @@ struct FrontCheck {
     TraversalHint* without_hint = hinted ? &hint_plain : nullptr;
     const CollideResult with =
         a->collide(*b, X, {.all_pairs = all_pairs, .hint = with_hint, .front = &front});
-    const CollideResult without = a->collide(*b, X, {.all_pairs = all_pairs, .hint = without_hint});
+    const CollideResult without =
+        a->collide(*b, X, {.all_pairs = all_pairs, .hint = without_hint, .nearer_first = false});
+    const CollideResult nearer = a->collide(*b, X, {.all_pairs = all_pairs});
     ASSERT_EQ(with.colliding, without.colliding) << where;
+    ASSERT_EQ(nearer.colliding, without.colliding) << where;
     if (!all_pairs && with.colliding) {
       const CollideResult all = a->collide(*b, X, {.all_pairs = true});
-      ASSERT_TRUE(std::binary_search(all.pairs.begin(), all.pairs.end(), with.pairs.front()))
-          << where;
-      ASSERT_TRUE(std::binary_search(all.pairs.begin(), all.pairs.end(), without.pairs.front()))
-          << where;
-    } else {
+      const auto found = [&](const CollideResult& r) {
+        return r.pairs.size() == 1 &&
+               std::binary_search(all.pairs.begin(), all.pairs.end(), r.pairs.front());
+      };
+      ASSERT_TRUE(found(with)) << where;
+      ASSERT_TRUE(found(nearer)) << where;
+    }
+    if (!(hinted && !all_pairs && with.colliding)) {
       ASSERT_EQ(with.pairs, without.pairs) << where;
+    }
+    if (all_pairs) {
+      ASSERT_EQ(nearer.pairs, without.pairs) << where;
     }
     tests_front += with.stats.volume_tests;
     tests_plain += without.stats.volume_tests;
@@ -379,12 +416,13 @@ TEST(Hierarchies, SeparationFrontsChangeOnlyTheWork) {
   EXPECT_GT(sweep.colliding, 20);
   EXPECT_GT(sweep.free, 20);
 
-  // A front of other trees is not read: the answer is the plain one. A hit
-  // leaves the front as it was; a query that finds none rewrites it.
+  // A front of other trees is not read: the answer is the plain one (in
+  // the fixed order a front implies). A hit leaves the front as it was; a
+  // query that finds none rewrites it.
   const void* block_tree = slide.front.tree_a;
   const CollideResult hit = sweep.a->collide(*sweep.b, Transform{}, {.front = &slide.front});
   EXPECT_TRUE(hit.colliding);
-  EXPECT_EQ(hit.pairs, sweep.a->collide(*sweep.b, Transform{}).pairs);
+  EXPECT_EQ(hit.pairs, sweep.a->collide(*sweep.b, Transform{}, {.nearer_first = false}).pairs);
   EXPECT_EQ(slide.front.tree_a, block_tree);
   Transform apart;
   apart.t = Vec3(3, 0, 0);

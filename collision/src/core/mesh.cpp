@@ -14,7 +14,39 @@ namespace {
   throw MeshError(source + ": " + what);
 }
 
+void check_vertices(const std::vector<Vec3>& vertices, const std::string& source,
+                    const MeshLimits& limits) {
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const Real c = vertices[i][k];
+      if (!std::isfinite(c)) fail(source, "vertex " + std::to_string(i) + " is not finite");
+      if (std::abs(c) > limits.max_abs_coordinate) {
+        fail(source, "vertex " + std::to_string(i) + " has a coordinate beyond " +
+                         std::to_string(limits.max_abs_coordinate));
+      }
+    }
+  }
+}
+
+void check_indices(std::size_t i, const TriangleIndices& t, std::size_t vertices,
+                   const std::string& source) {
+  for (std::uint32_t v : t) {
+    if (v >= vertices) {
+      fail(source, "triangle " + std::to_string(i) + " references vertex " + std::to_string(v) +
+                       " of " + std::to_string(vertices));
+    }
+  }
+}
+
 }  // namespace
+
+void check_mesh(const Mesh& mesh, const MeshLimits& limits) {
+  if (mesh.triangles.empty()) fail(mesh.source, "mesh has no triangles");
+  check_vertices(mesh.vertices, mesh.source, limits);
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    check_indices(i, mesh.triangles[i], mesh.vertices.size(), mesh.source);
+  }
+}
 
 Mesh make_mesh(std::vector<Vec3> vertices, std::vector<TriangleIndices> triangles,
                std::string source, const MeshLimits& limits, MeshValidation* validation) {
@@ -32,27 +64,13 @@ Mesh make_mesh(std::vector<Vec3> vertices, std::vector<TriangleIndices> triangle
     fail(source, std::to_string(triangles.size()) + " triangles exceed the limit of " +
                      std::to_string(limits.max_triangles));
   }
-  for (std::size_t i = 0; i < vertices.size(); ++i) {
-    for (int k = 0; k < 3; ++k) {
-      const Real c = vertices[i][k];
-      if (!std::isfinite(c)) fail(source, "vertex " + std::to_string(i) + " is not finite");
-      if (std::abs(c) > limits.max_abs_coordinate) {
-        fail(source, "vertex " + std::to_string(i) + " has a coordinate beyond " +
-                         std::to_string(limits.max_abs_coordinate));
-      }
-    }
-  }
+  check_vertices(vertices, source, limits);
 
   std::vector<bool> used(vertices.size(), false);
   std::size_t kept = 0;
   for (std::size_t i = 0; i < triangles.size(); ++i) {
     const TriangleIndices& t = triangles[i];
-    for (std::uint32_t v : t) {
-      if (v >= vertices.size()) {
-        fail(source, "triangle " + std::to_string(i) + " references vertex " + std::to_string(v) +
-                         " of " + std::to_string(vertices.size()));
-      }
-    }
+    check_indices(i, t, vertices.size(), source);
     if (is_degenerate_triangle(vertices[t[0]], vertices[t[1]], vertices[t[2]])) {
       ++found.degenerate_removed;
       continue;

@@ -129,24 +129,15 @@ ObbTree::ObbTree(const Mesh& mesh, int max_leaf_size) {
   leaves_ = layout.leaves;
   depth_ = layout.depth;
   const std::size_t n = layout.nodes.size();
-  const std::vector<Mat3> axes = detail::fit_box_axes(layout, mesh);
+  const std::vector<detail::FittedBox> boxes = detail::fit_boxes(layout, mesh);
   nodes_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const detail::LayoutNode& node = layout.nodes[i];
+    const detail::FittedBox& box = boxes[i];
     Node& out = nodes_[i];
-    out.axes = axes[i];
-    const Mat3 to_box = out.axes.transpose();
-    Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
-    Vec3 hi = -lo;
-    for (std::uint32_t s = node.begin; s < node.end; ++s) {
-      for (std::uint32_t v : mesh.triangles[layout.triangles[s].index]) {
-        const Vec3 p = to_box * mesh.vertices[v];
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-      }
-    }
-    out.centre = out.axes * ((lo + hi) * 0.5);
-    out.half = (hi - lo) * 0.5;
+    out.axes = box.axes;
+    out.centre = box.axes * ((box.lo + box.hi) * 0.5);
+    out.half = (box.hi - box.lo) * 0.5;
     out.link = detail::NodeLink::from(node);
   }
   for (const detail::BuildTriangle& t : layout.triangles) order_.push_back(t.index);

@@ -17,7 +17,13 @@ const std::array<Vec3, 13> kDirections = {
     Vec3(1, 0, 1),  Vec3(1, 0, -1), Vec3(0, 1, 1),  Vec3(0, 1, -1), Vec3(1, 1, 1),
     Vec3(1, 1, -1), Vec3(1, -1, 1), Vec3(1, -1, -1)};
 
+/// A node's support holds at most this many vertices; its array has room
+/// for two children's before they are reduced to their extremes.
 constexpr int kSupportMax = 2 * static_cast<int>(kDirections.size());
+// A leaf's vertices (up to three per triangle) fit without a reduction.
+static_assert(3 * ((1 << NodeLink::kCountBits) - 1) <= kSupportMax);
+// A node that is searched is no leaf: it has children whose frames to try.
+static_assert(kBoxSearchMinTriangles > (1 << NodeLink::kCountBits) - 1);
 
 /// Vertex indices that stand for a node in the search: all of a small
 /// node's vertices, or a large node's extremes along kDirections. Either
@@ -27,10 +33,6 @@ struct Support {
   int count = 0;
 };
 
-/// Nodes with fewer triangles keep their covariance frame: searching them
-/// too saved 2% of the bunny's volume tests and doubled the fitting time.
-constexpr int kSearchMinTriangles = 9;
-
 /// Turns tried about each axis, largest first, each from the best frame so far.
 constexpr std::array<Real, 4> kTurns = {0.3, 0.1, 0.03, 0.01};
 
@@ -39,10 +41,10 @@ constexpr int kMaxSteps = 4;
 
 class BoxFitter {
  public:
-  BoxFitter(const BinaryLayout& layout, const Mesh& mesh, std::vector<Mat3>& axes)
-      : layout_(layout), mesh_(mesh), axes_(axes), moments_(node_moments(layout, mesh)) {}
+  BoxFitter(const BinaryLayout& layout, const Mesh& mesh, std::vector<FittedBox>& boxes)
+      : layout_(layout), mesh_(mesh), boxes_(boxes), moments_(node_moments(layout, mesh)) {}
 
-  /// Fits the axes of `node` and its subtree (children first); returns the
+  /// Fits the boxes of `node` and its subtree (children first); returns the
   /// node's support.
   Support fit(std::uint32_t node) {
     const LayoutNode& n = layout_.nodes[node];
@@ -58,7 +60,20 @@ class BoxFitter {
       for (int k = 0; k < right.count; ++k) s.vertex[s.count++] = right.vertex[k];
       if (s.count > kSupportMax) s = extremes(s);
     }
-    axes_[node] = search(node, s);
+    const auto count = static_cast<int>(n.end - n.begin);
+    const Mat3 start = count == 1 ? triangle_axes(mesh_, layout_.triangles[n.begin].index)
+                                  : covariance_axes(moments_[node]);
+    if (count < kBoxSearchMinTriangles) {
+      boxes_[node] = boxes_in(std::array{start}, n)[0];
+    } else {
+      // The support can miss a vertex that a turned frame brings to the
+      // fore: the searched box is kept only if, on all the node's vertices,
+      // it is smaller than the starting one.
+      const std::array<FittedBox, 2> fitted = boxes_in(std::array{start, search(start, n, s)}, n);
+      const bool searched_smaller =
+          box_cost(fitted[1].hi - fitted[1].lo) < box_cost(fitted[0].hi - fitted[0].lo);
+      boxes_[node] = fitted[searched_smaller ? 1 : 0];
+    }
     return s;
   }
 
@@ -86,10 +101,16 @@ class BoxFitter {
     return out;
   }
 
-  /// The cost of the box of `s` with the given axes: its volume, plus a
+  /// What the search minimises for a box of edges `e`: its volume, plus a
   /// little of its surface area times its edge sum so that a flat node (no
   /// volume in any frame that holds its plane) still prefers the tighter
   /// rectangle.
+  static Real box_cost(const Vec3& e) {
+    const Real area = e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+    return e.x() * e.y() * e.z() + 0.01 * area * e.sum();
+  }
+
+  /// The cost of the box of `s` with the given axes.
   Real cost(const Mat3& axes, const Support& s) const {
     const Mat3 to_box = axes.transpose();
     Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
@@ -99,27 +120,43 @@ class BoxFitter {
       lo = lo.cwiseMin(p);
       hi = hi.cwiseMax(p);
     }
-    const Vec3 e = hi - lo;
-    const Real area = e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
-    return e.x() * e.y() * e.z() + 0.01 * area * e.sum();
+    return box_cost(hi - lo);
   }
 
-  Mat3 search(std::uint32_t node, const Support& s) const {
-    const LayoutNode& n = layout_.nodes[node];
-    const auto count = static_cast<int>(n.end - n.begin);
-    Mat3 best = count == 1 ? triangle_axes(mesh_, layout_.triangles[n.begin].index)
-                           : covariance_axes(moments_[node]);
-    if (count < kSearchMinTriangles) return best;
+  /// The boxes with the given frames around all the node's vertices, in one
+  /// pass over them.
+  template <std::size_t N>
+  std::array<FittedBox, N> boxes_in(const std::array<Mat3, N>& frames, const LayoutNode& n) const {
+    std::array<FittedBox, N> box;
+    std::array<Mat3, N> to_box;
+    for (std::size_t f = 0; f < N; ++f) {
+      box[f] = {frames[f], Vec3::Constant(std::numeric_limits<Real>::infinity()),
+                Vec3::Constant(-std::numeric_limits<Real>::infinity())};
+      to_box[f] = frames[f].transpose();
+    }
+    for (std::uint32_t slot = n.begin; slot < n.end; ++slot) {
+      for (std::uint32_t v : mesh_.triangles[layout_.triangles[slot].index]) {
+        for (std::size_t f = 0; f < N; ++f) {
+          const Vec3 p = to_box[f] * mesh_.vertices[v];
+          box[f].lo = box[f].lo.cwiseMin(p);
+          box[f].hi = box[f].hi.cwiseMax(p);
+        }
+      }
+    }
+    return box;
+  }
+
+  /// The frame `start` turned while that shrinks the box of the support.
+  Mat3 search(const Mat3& start, const LayoutNode& n, const Support& s) const {
+    Mat3 best = start;
     Real best_cost = cost(best, s);
     const auto consider = [&](const Mat3& candidate) {
       const Real c = cost(candidate, s);
       if (c < best_cost) best_cost = c, best = candidate;
     };
     consider(Mat3::Identity());
-    if (!n.is_leaf()) {
-      consider(axes_[n.first_child]);
-      consider(axes_[n.first_child + 1]);
-    }
+    consider(boxes_[n.first_child].axes);
+    consider(boxes_[n.first_child + 1].axes);
     for (const std::array<Mat3, 6>& turns : turns_) {
       for (int step = 0; step < kMaxSteps; ++step) {
         const Real before = best_cost;
@@ -152,16 +189,16 @@ class BoxFitter {
   const std::array<std::array<Mat3, 6>, kTurns.size()> turns_ = make_turns();
   const BinaryLayout& layout_;
   const Mesh& mesh_;
-  std::vector<Mat3>& axes_;
+  std::vector<FittedBox>& boxes_;
   std::vector<Moments> moments_;
 };
 
 }  // namespace
 
-std::vector<Mat3> fit_box_axes(const BinaryLayout& layout, const Mesh& mesh) {
-  std::vector<Mat3> axes(layout.nodes.size(), Mat3::Identity());
-  if (!layout.nodes.empty()) BoxFitter(layout, mesh, axes).fit(0);
-  return axes;
+std::vector<FittedBox> fit_boxes(const BinaryLayout& layout, const Mesh& mesh) {
+  std::vector<FittedBox> boxes(layout.nodes.size());
+  if (!layout.nodes.empty()) BoxFitter(layout, mesh, boxes).fit(0);
+  return boxes;
 }
 
 }  // namespace dovetail::collision::detail

@@ -2,13 +2,14 @@
 // Box frames for the OBB tree. The covariance frame (Gottschalk, Lin,
 // Manocha) is a good start but not the tightest box, and near contact a
 // traversal tests every pair of boxes that the gap cannot separate, so each
-// box's size counts. Every node of nine or more triangles starts from the
+// box's size counts. Every node of 16 or more triangles starts from the
 // best of its covariance frame, its children's frames and the mesh's frame,
 // then turns the frame about its own axes while that shrinks the box (its
 // volume, with a little of its area for flat nodes). The search measures
 // boxes on a node's support set (its extreme vertices along the 26-DOP's
 // directions), which keeps it cheap; the tree then fits each box to all the
-// node's vertices in the frame found.
+// node's vertices in the frame found, and the searched frame is kept only
+// where that box is smaller than the covariance frame's.
 
 #include <vector>
 
@@ -17,8 +18,23 @@
 
 namespace dovetail::collision::detail {
 
-/// Axes (columns: orthonormal, right-handed) of every node's box, in the
-/// layout's node order.
-std::vector<Mat3> fit_box_axes(const BinaryLayout& layout, const Mesh& mesh);
+/// Nodes with fewer triangles keep their covariance frame (a single
+/// triangle, its own). Searching from nine triangles up saved 1% more of the
+/// bunny's volume tests (159 instead of 161 a query) and took the OBB
+/// tree's build from about 1.1 to 1.7 times its time without a search.
+inline constexpr int kBoxSearchMinTriangles = 16;
+
+/// A node's box: its axes (columns: orthonormal, right-handed) and the
+/// extent of the node's vertices along them.
+struct FittedBox {
+  Mat3 axes = Mat3::Identity();
+  Vec3 lo = Vec3::Zero();  ///< in the box's frame
+  Vec3 hi = Vec3::Zero();
+};
+
+/// Every node's box, in the layout's node order. A searched box is kept only
+/// where it is smaller than the covariance frame's, measured on all the
+/// node's vertices.
+std::vector<FittedBox> fit_boxes(const BinaryLayout& layout, const Mesh& mesh);
 
 }  // namespace dovetail::collision::detail

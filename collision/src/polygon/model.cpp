@@ -91,6 +91,7 @@ std::span<const Method> all_methods() { return kMethods; }
 
 std::shared_ptr<const CollisionModel> build_model(Method method, std::shared_ptr<const Mesh> mesh) {
   if (!mesh) throw std::invalid_argument("build_model: no mesh");
+  check_mesh(*mesh);  // a mesh built by hand may hold what the hierarchies cannot
   switch (method) {
     case Method::kBoxtree:
       return std::make_shared<StructureModel<Boxtree>>(method, std::move(mesh));

@@ -21,6 +21,8 @@ namespace dovetail::collision::detail {
 ///   NodeLink link_a(uint32_t), link_b(uint32_t) const;
 ///   Real size_a(uint32_t), size_b(uint32_t) const;
 ///   const uint32_t* slots_a(), *slots_b() const;  leaf slot -> triangle index
+/// optionally, for first-hit queries to enter the likelier pair first (HasNearness):
+///   Real nearness(uint32_t a, const EncA&, uint32_t b, const EncB&) const;
 /// and, for policies that keep a SeparationFront (HasGap):
 ///   Real gap(uint32_t a, const EncA&, uint32_t b, const EncB&) const;
 ///                                          > 0 exactly when overlap() is false
@@ -323,7 +325,8 @@ CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh
   };
   if (!request.all_pairs) {
     traversal.cut_at_size(request.max_size);
-    traversal.enter_nearer_first();
+    // A front replays the order of the pose it was recorded at.
+    if (request.nearer_first && !request.front) traversal.enter_nearer_first();
   }
   if (request.max_depth >= 0 && !request.all_pairs) {
     traversal.cut_at_depth(request.max_depth);

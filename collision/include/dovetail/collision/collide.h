@@ -108,6 +108,13 @@ struct CollideRequest {
   /// Coherence across queries of the same two models (see SeparationFront):
   /// read where valid, rewritten by a query that visits all of it.
   SeparationFront* front = nullptr;
+  /// First-hit queries on the AABB, OBB and DOP trees without a `front`:
+  /// where both child pairs of a node pair overlap, enter first the one
+  /// whose volumes' centres are nearer (fewer volume tests near contact).
+  /// The pair reported then depends on the pose. false, or a front, keeps
+  /// the fixed depth-first order, whose first hit is the same with a front
+  /// and without (sliding relies on it). The verdict is the same either way.
+  bool nearer_first = true;
 };
 
 /// Work a query did; the cost model is volume_tests * C_bv + triangle_tests * C_p.

@@ -92,7 +92,8 @@ class CollisionModel {
   std::shared_ptr<const Mesh> mesh_;
 };
 
-/// Builds the hierarchy of `method` for `mesh` (top-down, once).
+/// Builds the hierarchy of `method` for `mesh` (top-down, once). Throws
+/// MeshError for a mesh that check_mesh refuses (a non-finite vertex, say).
 std::shared_ptr<const CollisionModel> build_model(Method method, std::shared_ptr<const Mesh> mesh);
 
 }  // namespace dovetail::collision
