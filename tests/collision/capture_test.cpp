@@ -132,6 +132,8 @@ TEST(Capture, BadFilesNameTheFileAndLine) {
   bad_vertex.replace(bad_vertex.find("mesh a"), 0, "");
   const std::size_t v = good.find('\n', good.find("mesh a")) + 1;  // first vertex of a
   bad_vertex.replace(v, good.find('\n', v) - v, "0x1p0 zebra 3");
+  std::string nan_vertex = good;
+  nan_vertex.replace(v, good.find('\n', v) - v, "0 nan 3");
   std::string bad_index = good;
   const std::size_t t = good.rfind("\nend\n");
   const std::size_t last = good.rfind('\n', t - 1) + 1;  // last triangle of b
@@ -141,6 +143,7 @@ TEST(Capture, BadFilesNameTheFileAndLine) {
       {"kind.capture", "dovetail-capture 1\nkind overheated\n", ":2: unknown kind 'overheated'"},
       {"short.capture", good.substr(0, good.find("mesh b")), "ends early, expecting a mesh"},
       {"vertex.capture", bad_vertex, "expected a vertex: x y z, found '0x1p0 zebra 3'"},
+      {"nan.capture", nan_vertex, "a vertex is not finite"},
       {"index.capture", bad_index, "vertex index 99 is past the mesh's 8 vertices"},
       {"end.capture", good.substr(0, t + 1) + "more\n", "expected 'end'"},
   };

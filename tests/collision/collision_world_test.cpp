@@ -136,6 +136,23 @@ TEST(CollisionWorld, IdenticalResultsForOneTwoAndEightThreads) {
   EXPECT_GT(contacts, 0u);
 }
 
+TEST(CollisionWorld, APartWithAMeshTheHierarchiesCannotTakeIsRefusedWhenAdded) {
+  // A hand-made mesh with a NaN vertex: refused by add_part on the caller's
+  // thread, not later inside a worker building its hierarchy; the world
+  // stays usable.
+  Mesh nan = make_box(Vec3(0.5, 0.5, 0.5));
+  nan.source = "hand-made.mesh";
+  nan.vertices[2].z() = std::numeric_limits<Real>::quiet_NaN();
+  CollisionWorld world;
+  EXPECT_THROW(world.add_part({.mesh = share(nan), .X_WP = {}, .name = "bad"}), MeshError);
+  const auto box = share(make_box(Vec3(0.5, 0.5, 0.5)));
+  const PartId a = world.add_part({.mesh = box, .X_WP = {}, .name = "a"});
+  const PartId b = world.add_part({.mesh = box, .X_WP = {}, .name = "b"});
+  EXPECT_EQ(a.index, 0u);  // the refused part took no slot
+  EXPECT_EQ(b.index, 1u);
+  EXPECT_EQ(world.step().colliding.size(), 1u);  // the two boxes overlap
+}
+
 TEST(CollisionWorld, BeginAndEndInTheRightFrames) {
   const auto box = share(make_box(Vec3(0.5, 0.5, 0.5)));
   CollisionWorld world;

@@ -230,15 +230,15 @@ TEST(Hierarchies, ModelsRefuseMeshesMakeMeshWouldRefuseNamingTheSource) {
     Mesh nan = make_box(Vec3(1, 1, 1));
     nan.source = "hand-made.mesh";
     nan.vertices[3].y() = std::numeric_limits<Real>::quiet_NaN();
-    Mesh far = make_box(Vec3(1, 1, 1));
-    far.source = "hand-made.mesh";
-    far.vertices[0].x() = 1e31;
+    Mesh inf = make_box(Vec3(1, 1, 1));
+    inf.source = "hand-made.mesh";
+    inf.vertices[0].x() = std::numeric_limits<Real>::infinity();
     Mesh bad_index = make_box(Vec3(1, 1, 1));
     bad_index.source = "hand-made.mesh";
     bad_index.triangles[5][1] = 99;
     Mesh empty;
     empty.source = "hand-made.mesh";
-    for (const Mesh* mesh : {&nan, &far, &bad_index, &empty}) {
+    for (const Mesh* mesh : {&nan, &inf, &bad_index, &empty}) {
       try {
         build_model(m, share(*mesh));
         ADD_FAILURE() << method_name(m) << " built a model of a bad mesh";
@@ -246,6 +246,14 @@ TEST(Hierarchies, ModelsRefuseMeshesMakeMeshWouldRefuseNamingTheSource) {
         EXPECT_EQ(std::string(e.what()).rfind("hand-made.mesh: ", 0), 0u) << e.what();
       }
     }
+    // What make_mesh would keep or drop is no reason to refuse: an unused
+    // vertex, a degenerate triangle, a coordinate beyond the default limit
+    // (an importer may raise it).
+    Mesh odd = make_box(Vec3(1, 1, 1));
+    odd.vertices.push_back(Vec3(5, 5, 5));
+    odd.triangles.push_back({0, 0, 1});
+    odd.vertices[0].x() = -2e30;
+    EXPECT_NO_THROW(build_model(m, share(odd))) << method_name(m);
   }
 }
 
@@ -342,6 +350,7 @@ struct FrontCheck {
   SeparationFront front{};
   TraversalHint hint_front{}, hint_plain{};
   std::uint64_t tests_front = 0, tests_plain = 0;
+  std::uint64_t tests_fixed_order = 0, tests_nearer_first = 0;  ///< first hits, no front
   int colliding = 0, free = 0;
 
   void query(const Transform& X, bool all_pairs, const std::string& where) {
@@ -361,7 +370,12 @@ struct FrontCheck {
                std::binary_search(all.pairs.begin(), all.pairs.end(), r.pairs.front());
       };
       ASSERT_TRUE(found(with)) << where;
+      ASSERT_TRUE(found(without)) << where;
       ASSERT_TRUE(found(nearer)) << where;
+    }
+    if (!all_pairs) {
+      tests_fixed_order += without.stats.volume_tests;
+      tests_nearer_first += nearer.stats.volume_tests;
     }
     if (!(hinted && !all_pairs && with.colliding)) {
       ASSERT_EQ(with.pairs, without.pairs) << where;
@@ -415,6 +429,9 @@ TEST(Hierarchies, SeparationFrontsChangeOnlyTheWork) {
   }
   EXPECT_GT(sweep.colliding, 20);
   EXPECT_GT(sweep.free, 20);
+  std::printf("first hits without a front: volume tests nearer first %llu, fixed order %llu\n",
+              static_cast<unsigned long long>(slide.tests_nearer_first + sweep.tests_nearer_first),
+              static_cast<unsigned long long>(slide.tests_fixed_order + sweep.tests_fixed_order));
 
   // A front of other trees is not read: the answer is the plain one (in
   // the fixed order a front implies). A hit leaves the front as it was; a

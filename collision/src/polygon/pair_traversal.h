@@ -326,7 +326,7 @@ CollideResult collide_with_policy(const Tree& a, const Tree& b, const Mesh& mesh
   if (!request.all_pairs) {
     traversal.cut_at_size(request.max_size);
     // A front replays the order of the pose it was recorded at.
-    if (request.nearer_first && !request.front) traversal.enter_nearer_first();
+    if (request.nearer_first && !front) traversal.enter_nearer_first();
   }
   if (request.max_depth >= 0 && !request.all_pairs) {
     traversal.cut_at_depth(request.max_depth);

@@ -135,6 +135,9 @@ std::shared_ptr<const Mesh> read_mesh(LineReader& reader, char name) {
   mesh->vertices.reserve(nv);
   for (std::uint64_t i = 0; i < nv; ++i) {
     const std::vector<Real> x = reader.reals(reader.next("a vertex"), 3, "a vertex: x y z");
+    if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2])) {
+      reader.fail("a vertex is not finite");
+    }
     mesh->vertices.emplace_back(x[0], x[1], x[2]);
   }
   mesh->triangles.reserve(nt);

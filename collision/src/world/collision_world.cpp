@@ -131,6 +131,14 @@ struct CollisionWorld::Impl {
   std::shared_ptr<Shape> shape_for(const std::shared_ptr<const Mesh>& mesh) {
     std::shared_ptr<Shape>& shape = shapes[mesh.get()];
     if (!shape) {
+      // Here, on the caller's thread, rather than when a worker first builds
+      // the mesh's hierarchy.
+      try {
+        check_mesh(*mesh, {.max_abs_coordinate = std::numeric_limits<Real>::max()});
+      } catch (...) {
+        shapes.erase(mesh.get());
+        throw;
+      }
       shape = std::make_shared<Shape>();
       shape->mesh = mesh;
       const Bounds bounds = mesh_bounds(*mesh);
@@ -706,6 +714,7 @@ PartId CollisionWorld::add_part(const PartDef& def) {
   if (!def.mesh)
     throw std::invalid_argument("collision world: part '" + def.name + "' has no mesh");
   Impl& w = *impl_;
+  std::shared_ptr<Shape> shape = w.shape_for(def.mesh);  // may refuse the mesh
   std::uint32_t index;
   if (!w.free_slots.empty()) {
     const auto smallest = std::min_element(w.free_slots.begin(), w.free_slots.end());
@@ -719,7 +728,7 @@ PartId CollisionWorld::add_part(const PartDef& def) {
   const std::uint32_t generation = p.id.generation + (p.id.valid() ? 1 : 0);
   p = Part{};
   p.id = {index, generation};
-  p.shape = w.shape_for(def.mesh);
+  p.shape = std::move(shape);
   p.X_WP = def.X_WP;
   p.movable = def.movable;
   p.level = def.level;

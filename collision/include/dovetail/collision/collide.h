@@ -46,7 +46,8 @@ struct TraversalHint {
 /// without a test, and tests and descends only the rest. The entries are kept
 /// in depth-first order and a skipped entry holds no intersecting triangles,
 /// so the query finds the very pairs, and the very first hit, of a traversal
-/// from the roots; only the work differs. (With a TraversalHint as well, the
+/// from the roots in the fixed order (CollideRequest::nearer_first = false);
+/// only the work differs. (With a TraversalHint as well, the
 /// hint is read and rewritten as usual, but a hit found below a front entry
 /// sets it no higher than that entry; the next first hit may then be another
 /// intersecting pair than with the hint alone.)
@@ -108,12 +109,14 @@ struct CollideRequest {
   /// Coherence across queries of the same two models (see SeparationFront):
   /// read where valid, rewritten by a query that visits all of it.
   SeparationFront* front = nullptr;
-  /// First-hit queries on the AABB, OBB and DOP trees without a `front`:
+  /// First-hit queries on the AABB, OBB and DOP trees that use no `front`:
   /// where both child pairs of a node pair overlap, enter first the one
   /// whose volumes' centres are nearer (fewer volume tests near contact).
-  /// The pair reported then depends on the pose. false, or a front, keeps
-  /// the fixed depth-first order, whose first hit is the same with a front
-  /// and without (sliding relies on it). The verdict is the same either way.
+  /// The pair reported then depends on the pose. false, or a front the
+  /// query uses (an exact query on the OBB tree), keeps the fixed
+  /// depth-first order, whose first hit (without a hint) is the same with a
+  /// front and without; sliding relies on it. The verdict is the same
+  /// either way.
   bool nearer_first = true;
 };
 

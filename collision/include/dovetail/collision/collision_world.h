@@ -216,7 +216,9 @@ class CollisionWorld {
   CollisionWorld(const CollisionWorld&) = delete;
   CollisionWorld& operator=(const CollisionWorld&) = delete;
 
-  /// Adds a part; throws std::invalid_argument without a mesh.
+  /// Adds a part; throws std::invalid_argument without a mesh, MeshError
+  /// for a mesh with no triangles, a non-finite vertex or an index out of
+  /// range (check_mesh; meshes from make_mesh have none of these).
   PartId add_part(const PartDef& def);
   /// Removes a part; its pairs end (reported by the next step).
   void remove_part(PartId id);

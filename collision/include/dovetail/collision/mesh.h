@@ -57,9 +57,11 @@ Mesh make_mesh(std::vector<Vec3> vertices, std::vector<TriangleIndices> triangle
                std::string source, const MeshLimits& limits = {},
                MeshValidation* validation = nullptr);
 
-/// Throws MeshError (message starts with mesh.source) for a mesh that
-/// make_mesh would have refused: no triangles, non-finite or over-limit
-/// coordinates, out-of-range indices. Degenerate triangles are allowed.
+/// Throws MeshError (message starts with mesh.source) for a mesh with no
+/// triangles, a coordinate that is not finite or beyond
+/// limits.max_abs_coordinate, or an index out of range: what make_mesh
+/// checks of a mesh's data, short of the size limits. Degenerate triangles
+/// are allowed.
 void check_mesh(const Mesh& mesh, const MeshLimits& limits = {});
 
 /// Axis-aligned bounds of all vertices.

@@ -93,7 +93,8 @@ class CollisionModel {
 };
 
 /// Builds the hierarchy of `method` for `mesh` (top-down, once). Throws
-/// MeshError for a mesh that check_mesh refuses (a non-finite vertex, say).
+/// MeshError for a mesh with no triangles, a non-finite vertex or an index
+/// out of range (check_mesh).
 std::shared_ptr<const CollisionModel> build_model(Method method, std::shared_ptr<const Mesh> mesh);
 
 }  // namespace dovetail::collision
