@@ -1,6 +1,7 @@
 #include "dovetail/collision/mesh.h"
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -40,9 +41,10 @@ void check_indices(std::size_t i, const TriangleIndices& t, std::size_t vertices
 
 }  // namespace
 
-void check_mesh(const Mesh& mesh, const MeshLimits& limits) {
+void check_mesh(const Mesh& mesh) {
   if (mesh.triangles.empty()) fail(mesh.source, "mesh has no triangles");
-  check_vertices(mesh.vertices, mesh.source, limits);
+  check_vertices(mesh.vertices, mesh.source,
+                 {.max_abs_coordinate = std::numeric_limits<Real>::max()});
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
     check_indices(i, mesh.triangles[i], mesh.vertices.size(), mesh.source);
   }

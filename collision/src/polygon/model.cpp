@@ -1,7 +1,6 @@
 #include "dovetail/collision/model.h"
 
 #include <array>
-#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -92,9 +91,7 @@ std::span<const Method> all_methods() { return kMethods; }
 
 std::shared_ptr<const CollisionModel> build_model(Method method, std::shared_ptr<const Mesh> mesh) {
   if (!mesh) throw std::invalid_argument("build_model: no mesh");
-  // A mesh built by hand may hold what the hierarchies cannot; the
-  // coordinate limit is the importer's to choose (ImportOptions::limits).
-  check_mesh(*mesh, {.max_abs_coordinate = std::numeric_limits<Real>::max()});
+  check_mesh(*mesh);  // a mesh built by hand may hold what the hierarchies cannot
   switch (method) {
     case Method::kBoxtree:
       return std::make_shared<StructureModel<Boxtree>>(method, std::move(mesh));

@@ -129,23 +129,18 @@ struct CollisionWorld::Impl {
   }
 
   std::shared_ptr<Shape> shape_for(const std::shared_ptr<const Mesh>& mesh) {
-    std::shared_ptr<Shape>& shape = shapes[mesh.get()];
-    if (!shape) {
-      // Here, on the caller's thread, rather than when a worker first builds
-      // the mesh's hierarchy.
-      try {
-        check_mesh(*mesh, {.max_abs_coordinate = std::numeric_limits<Real>::max()});
-      } catch (...) {
-        shapes.erase(mesh.get());
-        throw;
-      }
-      shape = std::make_shared<Shape>();
-      shape->mesh = mesh;
-      const Bounds bounds = mesh_bounds(*mesh);
-      shape->local_min = bounds.min;
-      shape->local_max = bounds.max;
-      shape->max_abs = detail::max_abs_coordinate(*mesh);
-    }
+    const auto known = shapes.find(mesh.get());
+    if (known != shapes.end()) return known->second;
+    // Checked here, on the caller's thread, rather than when a worker first
+    // builds the mesh's hierarchy.
+    check_mesh(*mesh);
+    auto shape = std::make_shared<Shape>();
+    shape->mesh = mesh;
+    const Bounds bounds = mesh_bounds(*mesh);
+    shape->local_min = bounds.min;
+    shape->local_max = bounds.max;
+    shape->max_abs = detail::max_abs_coordinate(*mesh);
+    shapes.emplace(mesh.get(), shape);
     return shape;
   }
 

@@ -57,12 +57,12 @@ Mesh make_mesh(std::vector<Vec3> vertices, std::vector<TriangleIndices> triangle
                std::string source, const MeshLimits& limits = {},
                MeshValidation* validation = nullptr);
 
-/// Throws MeshError (message starts with mesh.source) for a mesh with no
-/// triangles, a coordinate that is not finite or beyond
-/// limits.max_abs_coordinate, or an index out of range: what make_mesh
-/// checks of a mesh's data, short of the size limits. Degenerate triangles
-/// are allowed.
-void check_mesh(const Mesh& mesh, const MeshLimits& limits = {});
+/// Throws MeshError (message starts with mesh.source) for a mesh the
+/// hierarchies cannot take: no triangles, a coordinate that is not finite,
+/// or an index out of range. For a mesh built by hand rather than by
+/// make_mesh; no coordinate or size limit is applied (the importer chooses
+/// those), and degenerate triangles are allowed.
+void check_mesh(const Mesh& mesh);
 
 /// Axis-aligned bounds of all vertices.
 struct Bounds {
