@@ -1,5 +1,6 @@
 #include "polygon/boxtree.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <deque>
@@ -8,10 +9,14 @@
 #include <string>
 
 #include "polygon/hierarchy_common.h"
+#include "polygon/principal_axes.h"
 
 namespace dovetail::collision {
 
 namespace {
+
+/// A frame's quaternion parts in 16-bit fixed point.
+constexpr Real kQuaternionScale = 32767;
 
 /// An axis-aligned box as [lo, hi] per axis; during traversal the same layout
 /// holds a tree's box in its own frame or its enclosure in the other's.
@@ -30,10 +35,11 @@ double half_area(const Box& b) {
 class BoxtreeBuilder {
  public:
   BoxtreeBuilder(Boxtree& tree, const Mesh& mesh, const BoxtreeSettings& settings)
-      : tree_(tree), settings_(settings), prims_(detail::build_triangles(mesh)) {
+      : tree_(tree), mesh_(mesh), settings_(settings), prims_(detail::build_triangles(mesh)) {
     if (settings.max_leaf_size < 1 || settings.max_leaf_size > 4) {
       throw std::invalid_argument("Boxtree: max_leaf_size must be 1..4");
     }
+    if (settings.frame_step < 2) throw std::invalid_argument("Boxtree: frame_step must be >= 2");
     if (prims_.size() > BoxtreeNode::kMaxIndex) {
       throw std::invalid_argument(mesh.source + ": too many triangles for a Boxtree");
     }
@@ -45,25 +51,31 @@ class BoxtreeBuilder {
       tree_.root_lo_[k] = static_cast<float>(root.lo[k]);
       tree_.root_hi_[k] = static_cast<float>(root.hi[k]);
     }
-    tree_.order_.resize(prims_.size());
+    tree_.order_.reserve(prims_.size() / 2);
     tree_.nodes_.reserve(prims_.size() * 2);
     tree_.nodes_.emplace_back();
     build_node(0, root, 0, prims_.size(), 1);
     tree_.nodes_.shrink_to_fit();
+    tree_.order_.shrink_to_fit();
+    tree_.frames_.shrink_to_fit();
   }
 
  private:
   /// Bounds of prims [begin, end) rounded outwards to floats.
   Box tight_bounds(std::size_t begin, std::size_t end) const {
+    return tight_bounds(prims_.data() + begin, prims_.data() + end);
+  }
+
+  static Box tight_bounds(const detail::BuildTriangle* begin, const detail::BuildTriangle* end) {
     Box b;
     for (int k = 0; k < 3; ++k) {
       b.lo[k] = std::numeric_limits<double>::infinity();
       b.hi[k] = -std::numeric_limits<double>::infinity();
     }
-    for (std::size_t i = begin; i < end; ++i) {
+    for (const detail::BuildTriangle* p = begin; p != end; ++p) {
       for (int k = 0; k < 3; ++k) {
-        b.lo[k] = std::min(b.lo[k], prims_[i].lo[k]);
-        b.hi[k] = std::max(b.hi[k], prims_[i].hi[k]);
+        b.lo[k] = std::min(b.lo[k], p->lo[k]);
+        b.hi[k] = std::max(b.hi[k], p->hi[k]);
       }
     }
     for (int k = 0; k < 3; ++k) {
@@ -85,13 +97,29 @@ class BoxtreeBuilder {
     tree_.depth_ = std::max(tree_.depth_, depth);
     const std::size_t n = end - begin;
     if (n <= static_cast<std::size_t>(settings_.max_leaf_size)) {
-      for (std::size_t i = begin; i < end; ++i) tree_.order_[i] = prims_[i].index;
-      tree_.nodes_[node].bits = BoxtreeNode::kLeafAxis | static_cast<std::uint32_t>(n - 1) << 2 |
-                                static_cast<std::uint32_t>(begin) << 4;
+      BoxtreeNode& leaf = tree_.nodes_[node];
+      for (std::size_t i = 0; i < n && i < 2; ++i) leaf.word[i] = prims_[begin + i].index;
+      const auto rest = static_cast<std::uint32_t>(tree_.order_.size());
+      if (rest > BoxtreeNode::kMaxIndex) throw std::length_error("Boxtree: too many triangles");
+      for (std::size_t i = begin + 2; i < end; ++i) tree_.order_.push_back(prims_[i].index);
+      leaf.bits = BoxtreeNode::kLeafAxis | static_cast<std::uint32_t>(n - 1) << 2 | rest << 4;
       ++tree_.leaves_;
       return;
     }
+    if (n <= frame_limit_ && n >= static_cast<std::size_t>(settings_.frame_min_triangles)) {
+      // Tried here; next in subtrees frame_step times smaller.
+      const std::size_t limit = frame_limit_;
+      frame_limit_ = n / static_cast<std::size_t>(settings_.frame_step);
+      if (!frame_node(node, begin, end, depth)) split_node(node, box, begin, end, depth);
+      frame_limit_ = limit;
+      return;
+    }
+    split_node(node, box, begin, end, depth);
+  }
 
+  /// An inner node: an empty slab split off, or two children.
+  void split_node(std::uint32_t node, const Box& box, std::size_t begin, std::size_t end,
+                  std::size_t depth) {
     // Split off the widest empty slab when it is a large part of the box.
     const Box tight = tight_bounds(begin, end);
     int slab_axis = -1;
@@ -110,11 +138,11 @@ class BoxtreeBuilder {
       BoxtreeNode& slab = tree_.nodes_[node];
       Box inner = box;
       if (slab_high) {
-        slab.split_left = static_cast<float>(tight.hi[slab_axis]);
+        slab.word[0] = std::bit_cast<std::uint32_t>(static_cast<float>(tight.hi[slab_axis]));
         slab.bits = slab_axis | BoxtreeNode::kLeftOnly << 2 | child << 4;
         inner.hi[slab_axis] = tight.hi[slab_axis];
       } else {
-        slab.split_right = static_cast<float>(tight.lo[slab_axis]);
+        slab.word[1] = std::bit_cast<std::uint32_t>(static_cast<float>(tight.lo[slab_axis]));
         slab.bits = slab_axis | BoxtreeNode::kRightOnly << 2 | child << 4;
         inner.lo[slab_axis] = tight.lo[slab_axis];
       }
@@ -131,11 +159,71 @@ class BoxtreeBuilder {
 
     const std::uint32_t child = new_children(2);
     BoxtreeNode& inner = tree_.nodes_[node];
-    inner.split_left = static_cast<float>(left.hi[axis]);
-    inner.split_right = static_cast<float>(right.lo[axis]);
+    inner.word[0] = std::bit_cast<std::uint32_t>(static_cast<float>(left.hi[axis]));
+    inner.word[1] = std::bit_cast<std::uint32_t>(static_cast<float>(right.lo[axis]));
     inner.bits = static_cast<std::uint32_t>(axis) | BoxtreeNode::kBothChildren << 2 | child << 4;
     build_node(child, left, begin, mid, depth + 1);
     build_node(child + 1, right, mid, end, depth + 1);
+  }
+
+  static double box_cost(const Box& b) {
+    const double x = b.hi[0] - b.lo[0], y = b.hi[1] - b.lo[1], z = b.hi[2] - b.lo[2];
+    return x * y * z + 0.01 * half_area(b) * (x + y + z);
+  }
+
+  /// Gives prims [begin, end) a frame of their own, their principal axes,
+  /// when their box in it is enough smaller: `node` becomes a frame node and
+  /// its child's subtree is built in the new frame. Returns false (prims
+  /// unchanged) otherwise.
+  bool frame_node(std::uint32_t node, std::size_t begin, std::size_t end, std::size_t depth) {
+    detail::Moments moments;
+    for (std::size_t i = begin; i < end; ++i) {
+      const TriangleIndices& t = mesh_.triangles[prims_[i].index];
+      moments.add(detail::triangle_moments(mesh_.vertices[t[0]], mesh_.vertices[t[1]],
+                                           mesh_.vertices[t[2]]));
+    }
+    BoxtreeNode head;
+    head.word[0] = head.word[1] = 0;
+    const Eigen::Quaternion<Real> q(detail::covariance_axes(moments));
+    const Real parts[4] = {q.w(), q.x(), q.y(), q.z()};
+    for (int k = 0; k < 4; ++k) {
+      const auto fixed = static_cast<std::int16_t>(std::lround(parts[k] * kQuaternionScale));
+      head.word[k / 2] |= static_cast<std::uint32_t>(static_cast<std::uint16_t>(fixed))
+                          << (16 * (k % 2));
+    }
+    const Mat3 to_frame = head.rotation().transpose();
+
+    local_.assign(prims_.begin() + begin, prims_.begin() + end);
+    for (detail::BuildTriangle& p : local_) {
+      const TriangleIndices& t = mesh_.triangles[p.index];
+      const Vec3 a = to_frame * mesh_.vertices[t[0]];
+      const Vec3 b = to_frame * mesh_.vertices[t[1]];
+      const Vec3 c = to_frame * mesh_.vertices[t[2]];
+      p.lo = a.cwiseMin(b).cwiseMin(c);
+      p.hi = a.cwiseMax(b).cwiseMax(c);
+      p.centroid = (a + b + c) / 3.0;
+    }
+    const Box frame_box = tight_bounds(local_.data(), local_.data() + local_.size());
+    if (!(box_cost(frame_box) < settings_.frame_gain * box_cost(tight_bounds(begin, end)))) {
+      return false;
+    }
+    std::copy(local_.begin(), local_.end(), prims_.begin() + begin);
+    if (tree_.frames_.size() > BoxtreeNode::kMaxIndex) {
+      throw std::length_error("Boxtree: too many frames");
+    }
+    const std::uint32_t child = new_children(1);
+    BoxtreeFrame frame;
+    for (int k = 0; k < 3; ++k) {
+      frame.lo[k] = static_cast<float>(frame_box.lo[k]);
+      frame.hi[k] = static_cast<float>(frame_box.hi[k]);
+    }
+    frame.child = child;
+    const auto index = static_cast<std::uint32_t>(tree_.frames_.size());
+    tree_.frames_.push_back(frame);
+    head.bits = BoxtreeNode::kFrame << 2 | index << 4;
+    tree_.nodes_[node] = head;
+    build_node(child, frame_box, begin, end, depth + 1);
+    return true;
   }
 
   /// Chooses axis and split by a binned surface-area cost of the two child
@@ -225,9 +313,27 @@ class BoxtreeBuilder {
   }
 
   Boxtree& tree_;
+  const Mesh& mesh_;
   const BoxtreeSettings& settings_;
   std::vector<detail::BuildTriangle> prims_;
+  std::vector<detail::BuildTriangle> local_;
+  /// A subtree of at most this many triangles is tried for a frame next.
+  std::size_t frame_limit_ = settings_.frames ? std::numeric_limits<std::size_t>::max() : 0;
 };
+
+Mat3 BoxtreeNode::rotation() const {
+  Real q[4];
+  for (int k = 0; k < 4; ++k) {
+    q[k] = static_cast<std::int16_t>(static_cast<std::uint16_t>(word[k / 2] >> (16 * (k % 2))));
+  }
+  const Real w = q[0], x = q[1], y = q[2], z = q[3];
+  const Real s = 2 / (w * w + x * x + y * y + z * z);
+  Mat3 R;
+  R << 1 - s * (y * y + z * z), s * (x * y - w * z), s * (x * z + w * y),  //
+      s * (x * y + w * z), 1 - s * (x * x + z * z), s * (y * z - w * x),   //
+      s * (x * z - w * y), s * (y * z + w * x), 1 - s * (x * x + y * y);
+  return R;
+}
 
 Boxtree::Boxtree(const Mesh& mesh, const BoxtreeSettings& settings) {
   max_abs_ = detail::max_abs_coordinate(mesh);
@@ -236,7 +342,7 @@ Boxtree::Boxtree(const Mesh& mesh, const BoxtreeSettings& settings) {
 
 std::size_t Boxtree::bytes() const {
   return sizeof(*this) + nodes_.capacity() * sizeof(BoxtreeNode) +
-         order_.capacity() * sizeof(std::uint32_t);
+         order_.capacity() * sizeof(std::uint32_t) + frames_.capacity() * sizeof(BoxtreeFrame);
 }
 
 /// Simultaneous traversal of two boxtrees.
@@ -244,24 +350,21 @@ class BoxtreeTraversal {
  public:
   BoxtreeTraversal(const Boxtree& a, const Boxtree& b, const Transform& X_AB,
                    detail::LeafTester& tester)
-      : a_(a),
-        b_(b),
-        R_AB_(X_AB.R),
-        R_BA_(X_AB.R.transpose()),
-        split_AB_(R_AB_),
-        split_BA_(R_BA_),
-        tester_(tester) {
-    t_AB_ = X_AB.t;
-    t_BA_ = -(R_BA_ * X_AB.t);
+      : a_(a), b_(b), X_AB_(X_AB), root_pose_(pose(0, 0)), tester_(tester) {
     margin_ = detail::query_margin(a.max_abs_, b.max_abs_, X_AB);
+    // Subtree frames are rotations rounded to doubles: widen the margin by
+    // the size of the rounding in expressing a box in another frame.
+    margin_ += 0x1.0p-40 * (a.max_abs_ + b.max_abs_);
   }
 
-  /// One tree's current node: its box in its own frame and the enclosure of
-  /// that box in the other tree's frame.
+  /// One tree's current node: its box in its own frame (0: the mesh's, k:
+  /// the tree's frame k - 1) and the enclosure of that box in the other
+  /// tree's current frame.
   struct Side {
     Box box;
     Box enc;
     std::uint32_t node;
+    std::uint32_t frame;
   };
   /// A pair of overlapping nodes.
   struct Entry {
@@ -271,7 +374,7 @@ class BoxtreeTraversal {
 
   void run() {
     const Entry e = root_entry();
-    if (roots_overlap(e)) visit(e.a, e.b);
+    if (full_overlap(e.a, e.b)) visit(e.a, e.b, root_pose_);
   }
 
   /// Overlapping node pairs breadth-first from the roots, until there are at
@@ -279,36 +382,103 @@ class BoxtreeTraversal {
   std::vector<Entry> frontier(std::size_t target) {
     std::deque<Entry> queue;
     const Entry root = root_entry();
-    if (roots_overlap(root)) queue.push_back(root);
+    if (full_overlap(root.a, root.b)) queue.push_back(root);
     for (std::size_t leaf_pairs = 0; queue.size() < target && leaf_pairs < queue.size();) {
       const Entry e = queue.front();
       queue.pop_front();
-      const BoxtreeNode& na = a_.nodes_[e.a.node];
-      const BoxtreeNode& nb = b_.nodes_[e.b.node];
-      if (na.is_leaf() && nb.is_leaf()) {
+      if (a_.nodes_[e.a.node].is_leaf() && b_.nodes_[e.b.node].is_leaf()) {
         queue.push_back(e);
         ++leaf_pairs;
         continue;
       }
       leaf_pairs = 0;
-      if (descends_a(na, nb, e.a, e.b)) {
-        descend(na, e.a, split_BA_, e.b, [&](const Side& child) { queue.push_back({child, e.b}); });
-      } else {
-        descend(nb, e.b, split_AB_, e.a, [&](const Side& child) { queue.push_back({e.a, child}); });
-      }
+      const Pose p = e.a.frame == 0 && e.b.frame == 0 ? root_pose_ : pose(e.a.frame, e.b.frame);
+      expand(e.a, e.b, p, [&](const Side& a, const Side& b, const Pose&) {
+        queue.push_back({a, b});
+      });
     }
     return {queue.begin(), queue.end()};
   }
 
-  void run_from(const Entry& e) { visit(e.a, e.b); }
+  void run_from(const Entry& e) {
+    if (e.a.frame == 0 && e.b.frame == 0) {
+      visit(e.a, e.b, root_pose_);
+    } else {
+      visit(e.a, e.b, pose(e.a.frame, e.b.frame));
+    }
+  }
 
  private:
-  Entry root_entry() const { return {root(a_, R_BA_, t_BA_), root(b_, R_AB_, t_AB_)}; }
+  /// The pose between the two trees' current frames. The rotations are
+  /// stored by column: ab[k] is B's axis k in A's frame, ba[k] A's in B's.
+  struct Pose {
+    double ab[3][3], ba[3][3];
+    Vec3 t_AB, t_BA;
+    Pose(const Mat3& R, const Vec3& t) : t_AB(t), t_BA(-(R.transpose() * t)) {
+      for (int k = 0; k < 3; ++k) {
+        for (int i = 0; i < 3; ++i) {
+          ab[k][i] = R(i, k);
+          ba[k][i] = R(k, i);
+        }
+      }
+    }
+  };
 
-  bool roots_overlap(const Entry& e) const {
+  static Mat3 frame_rotation(const Boxtree& tree, std::uint32_t frame) {
+    return frame == 0 ? Mat3::Identity() : tree.nodes_[frame - 1].rotation();
+  }
+
+  Pose pose(std::uint32_t frame_a, std::uint32_t frame_b) const {
+    if (frame_a == 0 && frame_b == 0) return Pose(X_AB_.R, X_AB_.t);
+    if (frame_b == 0) {
+      const Mat3 to_a = a_.nodes_[frame_a - 1].rotation().transpose();
+      return Pose(to_a * X_AB_.R, to_a * X_AB_.t);
+    }
+    const Mat3 R_b = X_AB_.R * b_.nodes_[frame_b - 1].rotation();
+    if (frame_a == 0) return Pose(R_b, X_AB_.t);
+    const Mat3 to_a = a_.nodes_[frame_a - 1].rotation().transpose();
+    return Pose(to_a * R_b, to_a * X_AB_.t);
+  }
+
+  Entry root_entry() const {
+    Entry e;
+    e.a = root(a_);
+    e.b = root(b_);
+    e.a.enc = enclose(e.a.box, root_pose_.ba, root_pose_.t_BA);
+    e.b.enc = enclose(e.b.box, root_pose_.ab, root_pose_.t_AB);
+    return e;
+  }
+
+  static Side root(const Boxtree& tree) {
+    Side s;
+    s.node = 0;
+    s.frame = 0;
+    for (int k = 0; k < 3; ++k) {
+      s.box.lo[k] = tree.root_lo_[k];
+      s.box.hi[k] = tree.root_hi_[k];
+    }
+    return s;
+  }
+
+  /// The box `box` maps into by x -> M x + t, as a box (M by column).
+  static Box enclose(const Box& box, const double (&M)[3][3], const Vec3& t) {
+    Box enc;
+    for (int i = 0; i < 3; ++i) {
+      enc.lo[i] = enc.hi[i] = t[i];
+      for (int j = 0; j < 3; ++j) {
+        const double u = M[j][i] * box.lo[j], v = M[j][i] * box.hi[j];
+        enc.lo[i] += std::min(u, v);
+        enc.hi[i] += std::max(u, v);
+      }
+    }
+    return enc;
+  }
+
+  /// Both boxes against the other's enclosure on every axis.
+  bool full_overlap(const Side& a, const Side& b) const {
     tester_.count_volume_test();
     for (int k = 0; k < 3; ++k) {
-      if (!overlap(e.a.box, e.b.enc, k) || !overlap(e.b.box, e.a.enc, k)) return false;
+      if (!overlap(a.box, b.enc, k) || !overlap(b.box, a.enc, k)) return false;
     }
     return true;
   }
@@ -318,43 +488,9 @@ class BoxtreeTraversal {
     return !na.is_leaf() && (nb.is_leaf() || size(a.box) >= size(b.box));
   }
 
-  static Side root(const Boxtree& tree, const Mat3& M, const Vec3& t) {
-    Side s;
-    s.node = 0;
-    for (int k = 0; k < 3; ++k) {
-      s.box.lo[k] = tree.root_lo_[k];
-      s.box.hi[k] = tree.root_hi_[k];
-    }
-    for (int i = 0; i < 3; ++i) {
-      s.enc.lo[i] = s.enc.hi[i] = t[i];
-      for (int j = 0; j < 3; ++j) {
-        const double u = M(i, j) * s.box.lo[j], v = M(i, j) * s.box.hi[j];
-        s.enc.lo[i] += std::min(u, v);
-        s.enc.hi[i] += std::max(u, v);
-      }
-    }
-    return s;
-  }
-
   bool overlap(const Box& x, const Box& y, int k) const {
     return x.lo[k] <= y.hi[k] + margin_ && y.lo[k] - margin_ <= x.hi[k];
   }
-
-  /// The rotation from one tree's frame to the other's, split into its
-  /// positive and negative parts so that moving a face updates the enclosure
-  /// without branches.
-  struct SplitRotation {
-    double pos[3][3];  ///< pos[axis][i] = max(M(i, axis), 0)
-    double neg[3][3];  ///< neg[axis][i] = min(M(i, axis), 0)
-    explicit SplitRotation(const Mat3& M) {
-      for (int k = 0; k < 3; ++k) {
-        for (int i = 0; i < 3; ++i) {
-          pos[k][i] = std::max(M(i, k), 0.0);
-          neg[k][i] = std::min(M(i, k), 0.0);
-        }
-      }
-    }
-  };
 
   /// The child of `s` whose upper face on `axis` moved down to `split`: the
   /// enclosure's upper bounds drop where the axis maps positively, its lower
@@ -362,24 +498,24 @@ class BoxtreeTraversal {
   /// read back from the child being written (a partial store followed by a
   /// wide load of the same bytes would stall).
   static void move_upper(Side& child, const Side& s, int axis, double split,
-                         const SplitRotation& M) {
+                         const double (&M)[3][3]) {
     const double d = s.box.hi[axis] - split;
     child.box = s.box;
     child.box.hi[axis] = split;
     for (int i = 0; i < 3; ++i) {
-      child.enc.hi[i] = s.enc.hi[i] - M.pos[axis][i] * d;
-      child.enc.lo[i] = s.enc.lo[i] - M.neg[axis][i] * d;
+      child.enc.hi[i] = s.enc.hi[i] - std::max(M[axis][i], 0.0) * d;
+      child.enc.lo[i] = s.enc.lo[i] - std::min(M[axis][i], 0.0) * d;
     }
   }
 
   static void move_lower(Side& child, const Side& s, int axis, double split,
-                         const SplitRotation& M) {
+                         const double (&M)[3][3]) {
     const double d = split - s.box.lo[axis];
     child.box = s.box;
     child.box.lo[axis] = split;
     for (int i = 0; i < 3; ++i) {
-      child.enc.lo[i] = s.enc.lo[i] + M.pos[axis][i] * d;
-      child.enc.hi[i] = s.enc.hi[i] + M.neg[axis][i] * d;
+      child.enc.lo[i] = s.enc.lo[i] + std::max(M[axis][i], 0.0) * d;
+      child.enc.hi[i] = s.enc.hi[i] + std::min(M[axis][i], 0.0) * d;
     }
   }
 
@@ -399,23 +535,61 @@ class BoxtreeTraversal {
     return (b.hi[0] - b.lo[0]) + (b.hi[1] - b.lo[1]) + (b.hi[2] - b.lo[2]);
   }
 
-  void visit(const Side& a, const Side& b) {
+  void visit(const Side& a, const Side& b, const Pose& p) {
     const BoxtreeNode& na = a_.nodes_[a.node];
     const BoxtreeNode& nb = b_.nodes_[b.node];
     if (na.is_leaf() && nb.is_leaf()) {
-      tester_.test_leaves(&a_.order_[na.index()], na.leaf_count(), &b_.order_[nb.index()],
-                          nb.leaf_count());
+      std::uint32_t tris_a[4], tris_b[4];
+      leaf_triangles(a_, na, tris_a);
+      leaf_triangles(b_, nb, tris_b);
+      tester_.test_leaves(tris_a, na.leaf_count(), tris_b, nb.leaf_count());
+      return;
+    }
+    expand(a, b, p, [&](const Side& a2, const Side& b2, const Pose& p2) { visit(a2, b2, p2); });
+  }
+
+  /// Calls next(a', b', pose') for each overlapping pair one step below
+  /// (a, b): a frame node's child in its frame (both enclosures recomputed),
+  /// or the children of the node descended.
+  template <typename Next>
+  void expand(const Side& a, const Side& b, const Pose& p, Next&& next) {
+    const BoxtreeNode& na = a_.nodes_[a.node];
+    const BoxtreeNode& nb = b_.nodes_[b.node];
+    if (na.is_frame() || nb.is_frame()) {
+      Side a2 = a, b2 = b;
+      if (na.is_frame()) enter_frame(a_, a.node, a2);
+      if (nb.is_frame()) enter_frame(b_, b.node, b2);
+      const Pose p2 = pose(a2.frame, b2.frame);
+      a2.enc = enclose(a2.box, p2.ba, p2.t_BA);
+      b2.enc = enclose(b2.box, p2.ab, p2.t_AB);
+      if (full_overlap(a2, b2)) next(a2, b2, p2);
       return;
     }
     if (descends_a(na, nb, a, b)) {
-      descend(na, a, split_BA_, b, [&](const Side& child) { visit(child, b); });
+      descend(na, a, p.ba, b, [&](const Side& child) { next(child, b, p); });
     } else {
-      descend(nb, b, split_AB_, a, [&](const Side& child) { visit(a, child); });
+      descend(nb, b, p.ab, a, [&](const Side& child) { next(a, child, p); });
+    }
+  }
+
+  static void leaf_triangles(const Boxtree& tree, const BoxtreeNode& n, std::uint32_t* out) {
+    out[0] = n.word[0];
+    out[1] = n.word[1];
+    for (int k = 2; k < n.leaf_count(); ++k) out[k] = tree.order_[n.index() + k - 2];
+  }
+
+  static void enter_frame(const Boxtree& tree, std::uint32_t node, Side& s) {
+    const BoxtreeFrame& f = tree.frames_[tree.nodes_[node].index()];
+    s.node = f.child;
+    s.frame = node + 1;
+    for (int k = 0; k < 3; ++k) {
+      s.box.lo[k] = f.lo[k];
+      s.box.hi[k] = f.hi[k];
     }
   }
 
   template <typename Visit>
-  void descend(const BoxtreeNode& n, const Side& s, const SplitRotation& M, const Side& other,
+  void descend(const BoxtreeNode& n, const Side& s, const double (&M)[3][3], const Side& other,
                Visit&& next) {
     const int axis = static_cast<int>(n.axis());
     const std::uint32_t kind = n.kind();
@@ -423,7 +597,8 @@ class BoxtreeTraversal {
     if (kind != BoxtreeNode::kRightOnly) {
       Side left;
       left.node = child++;
-      const double split = n.split_left;
+      left.frame = s.frame;
+      const double split = n.split_left();
       move_upper(left, s, axis, split, M);
       if (child_overlaps(left, true, split, axis, other)) next(left);
       if (tester_.done()) return;
@@ -431,7 +606,8 @@ class BoxtreeTraversal {
     if (kind != BoxtreeNode::kLeftOnly) {
       Side right;
       right.node = child;
-      const double split = n.split_right;
+      right.frame = s.frame;
+      const double split = n.split_right();
       move_lower(right, s, axis, split, M);
       if (child_overlaps(right, false, split, axis, other)) next(right);
     }
@@ -439,9 +615,8 @@ class BoxtreeTraversal {
 
   const Boxtree& a_;
   const Boxtree& b_;
-  Mat3 R_AB_, R_BA_;
-  SplitRotation split_AB_, split_BA_;
-  Vec3 t_AB_, t_BA_;
+  const Transform& X_AB_;
+  const Pose root_pose_;
   double margin_ = 0;
   detail::LeafTester& tester_;
 };

@@ -8,7 +8,18 @@
 // its parent's transformed extents: descending one tree changes one face, so
 // the child's enclosure in the other tree's frame costs three multiply-adds,
 // and in its own frame only the moved face has to be compared.
+//
+// Subtree frames: boxes aligned with the mesh's axes are loose wherever the
+// surface is slanted, and near contact a traversal tests every pair of boxes
+// that the gap cannot separate. A subtree whose box in its principal axes is
+// much smaller gets a frame of its own: a frame node (12 bytes, the rotation
+// in 16-bit fixed point) and its box (28 bytes). Below it the tree is an
+// ordinary restricted boxtree in the new frame; entering it costs the
+// traversal one full enclosure of each side. On the bunny this halves the
+// volume tests a query (1,286 to 563) and takes the memory from 15.5 to 14.2
+// bytes a triangle, since a leaf keeps two of its triangles in its own node.
 
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -23,16 +34,26 @@ struct BoxtreeSettings {
   int max_leaf_size = 4;        ///< triangles per leaf, 1..4
   double slab_threshold = 0.1;  ///< split off an empty slab wider than this fraction of the box
   int bins = 16;                ///< candidate split positions per axis
+  /// Subtree frames: a subtree gets a frame of its own, its principal axes,
+  /// where its box in that frame is smaller than `frame_gain` times its box
+  /// in the frame it is in. Tried at the root, then in subtrees `frame_step`
+  /// times smaller than the last one tried, down to `frame_min_triangles`.
+  bool frames = true;
+  int frame_step = 3;  ///< >= 2
+  int frame_min_triangles = 8;
+  double frame_gain = 0.7;
 };
 
-/// One node. Inner node: children at `child()` (and `child() + 1` when both
-/// exist); the left child's box is the parent's with its upper face on `axis`
-/// moved to `split_left`, the right child's with its lower face moved to
-/// `split_right`. A node with one child splits off an empty slab. Leaf: up to
-/// four consecutive entries of Boxtree::triangle_order.
+/// One node, 12 bytes. Inner node: children at `child()` (and `child() + 1`
+/// when both exist); the left child's box is the parent's with its upper face
+/// on `axis` moved to `split_left`, the right child's with its lower face
+/// moved to `split_right`. A node with one child splits off an empty slab.
+/// Leaf: up to four triangles, the first two in the node itself, the others
+/// at Boxtree::triangle_order()[index()]. Frame node: one child, whose box
+/// and subtree are in a frame of their own, the rotation in the node (a unit
+/// quaternion in 16-bit fixed point) and the box at Boxtree::frames()[index()].
 struct BoxtreeNode {
-  float split_left = 0;
-  float split_right = 0;
+  std::uint32_t word[2] = {0, 0};
   /// axis (2 bits, 3 = leaf) | kind, or leaf count - 1 (2 bits) | index (28 bits)
   std::uint32_t bits = 0;
 
@@ -40,13 +61,26 @@ struct BoxtreeNode {
   static constexpr std::uint32_t kBothChildren = 0;
   static constexpr std::uint32_t kLeftOnly = 1;
   static constexpr std::uint32_t kRightOnly = 2;
+  static constexpr std::uint32_t kFrame = 3;
   static constexpr std::uint32_t kMaxIndex = (1u << 28) - 1;
 
   std::uint32_t axis() const { return bits & 3u; }
   bool is_leaf() const { return axis() == kLeafAxis; }
+  bool is_frame() const { return !is_leaf() && kind() == kFrame; }
   std::uint32_t kind() const { return (bits >> 2) & 3u; }
   int leaf_count() const { return static_cast<int>(kind()) + 1; }
   std::uint32_t index() const { return bits >> 4; }
+  float split_left() const { return std::bit_cast<float>(word[0]); }
+  float split_right() const { return std::bit_cast<float>(word[1]); }
+  /// A frame node's rotation, from its frame to the mesh's.
+  Mat3 rotation() const;
+};
+
+/// A frame node's box in its frame, and its child.
+struct BoxtreeFrame {
+  float lo[3] = {0, 0, 0};
+  float hi[3] = {0, 0, 0};
+  std::uint32_t child = 0;
 };
 
 /// Restricted boxtree over one mesh; immutable after construction.
@@ -69,13 +103,15 @@ class Boxtree {
 
   const std::vector<BoxtreeNode>& nodes() const { return nodes_; }
   const std::vector<std::uint32_t>& triangle_order() const { return order_; }
+  const std::vector<BoxtreeFrame>& frames() const { return frames_; }
 
  private:
   friend class BoxtreeBuilder;
   friend class BoxtreeTraversal;
 
   std::vector<BoxtreeNode> nodes_;    ///< root at 0
-  std::vector<std::uint32_t> order_;  ///< leaf slots -> Mesh::triangles index
+  std::vector<std::uint32_t> order_;  ///< leaves' third and fourth triangles
+  std::vector<BoxtreeFrame> frames_;
   float root_lo_[3] = {0, 0, 0};
   float root_hi_[3] = {0, 0, 0};
   Real max_abs_ = 0;  ///< largest absolute vertex coordinate
