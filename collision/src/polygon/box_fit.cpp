@@ -4,6 +4,8 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <span>
+#include <type_traits>
 
 #include "polygon/principal_axes.h"
 
@@ -11,33 +13,22 @@ namespace dovetail::collision::detail {
 
 namespace {
 
-/// The 26-DOP's directions, one of each opposite pair.
-const std::array<Vec3, 13> kDirections = {
-    Vec3(1, 0, 0),  Vec3(0, 1, 0),  Vec3(0, 0, 1),  Vec3(1, 1, 0),  Vec3(1, -1, 0),
-    Vec3(1, 0, 1),  Vec3(1, 0, -1), Vec3(0, 1, 1),  Vec3(0, 1, -1), Vec3(1, 1, 1),
-    Vec3(1, 1, -1), Vec3(1, -1, 1), Vec3(1, -1, -1)};
-
 /// A node's support holds at most this many vertices; its array has room
 /// for two children's before they are reduced to their extremes.
-constexpr int kSupportMax = 2 * static_cast<int>(kDirections.size());
+constexpr int kSupportMax =
+    2 * static_cast<int>(std::tuple_size_v<std::remove_cv_t<decltype(kBoxSearchDirections)>>);
 // A leaf's vertices (up to three per triangle) fit without a reduction.
 static_assert(3 * ((1 << NodeLink::kCountBits) - 1) <= kSupportMax);
 // A node that is searched is no leaf: it has children whose frames to try.
 static_assert(kBoxSearchMinTriangles > (1 << NodeLink::kCountBits) - 1);
 
 /// Vertex indices that stand for a node in the search: all of a small
-/// node's vertices, or a large node's extremes along kDirections. Either
+/// node's vertices, or a large node's extremes along kBoxSearchDirections. Either
 /// way the search's box in the mesh's frame is the node's own.
 struct Support {
   std::array<std::uint32_t, 2 * kSupportMax> vertex{};
   int count = 0;
 };
-
-/// Turns tried about each axis, largest first, each from the best frame so far.
-constexpr std::array<Real, 4> kTurns = {0.3, 0.1, 0.03, 0.01};
-
-/// Steps of one turn size at most, while each still shrinks the box.
-constexpr int kMaxSteps = 4;
 
 class BoxFitter {
  public:
@@ -70,8 +61,8 @@ class BoxFitter {
       // fore: the searched box is kept only if, on all the node's vertices,
       // it is smaller than the starting one.
       const std::array<FittedBox, 2> fitted = boxes_in(std::array{start, search(start, n, s)}, n);
-      const bool searched_smaller =
-          box_cost(fitted[1].hi - fitted[1].lo) < box_cost(fitted[0].hi - fitted[0].lo);
+      const bool searched_smaller = box_search_cost(fitted[1].hi - fitted[1].lo) <
+                                    box_search_cost(fitted[0].hi - fitted[0].lo);
       boxes_[node] = fitted[searched_smaller ? 1 : 0];
     }
     return s;
@@ -87,7 +78,7 @@ class BoxFitter {
   /// The extreme vertices of `s` along each direction, both ways.
   Support extremes(const Support& s) const {
     Support out;
-    for (const Vec3& d : kDirections) {
+    for (const Vec3& d : kBoxSearchDirections) {
       int lo = 0, hi = 0;
       Real min = std::numeric_limits<Real>::infinity(), max = -min;
       for (int k = 0; k < s.count; ++k) {
@@ -99,28 +90,6 @@ class BoxFitter {
       add_unique(out, s.vertex[hi]);
     }
     return out;
-  }
-
-  /// What the search minimises for a box of edges `e`: its volume, plus a
-  /// little of its surface area times its edge sum so that a flat node (no
-  /// volume in any frame that holds its plane) still prefers the tighter
-  /// rectangle.
-  static Real box_cost(const Vec3& e) {
-    const Real area = e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
-    return e.x() * e.y() * e.z() + 0.01 * area * e.sum();
-  }
-
-  /// The cost of the box of `s` with the given axes.
-  Real cost(const Mat3& axes, const Support& s) const {
-    const Mat3 to_box = axes.transpose();
-    Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
-    Vec3 hi = -lo;
-    for (int k = 0; k < s.count; ++k) {
-      const Vec3 p = to_box * mesh_.vertices[s.vertex[k]];
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    return box_cost(hi - lo);
   }
 
   /// The boxes with the given frames around all the node's vertices, in one
@@ -148,45 +117,12 @@ class BoxFitter {
 
   /// The frame `start` turned while that shrinks the box of the support.
   Mat3 search(const Mat3& start, const LayoutNode& n, const Support& s) const {
-    Mat3 best = start;
-    Real best_cost = cost(best, s);
-    const auto consider = [&](const Mat3& candidate) {
-      const Real c = cost(candidate, s);
-      if (c < best_cost) best_cost = c, best = candidate;
-    };
-    consider(Mat3::Identity());
-    consider(boxes_[n.first_child].axes);
-    consider(boxes_[n.first_child + 1].axes);
-    for (const std::array<Mat3, 6>& turns : turns_) {
-      for (int step = 0; step < kMaxSteps; ++step) {
-        const Real before = best_cost;
-        for (const Mat3& turn : turns) consider(best * turn);
-        if (!(best_cost < before)) break;
-      }
-    }
-    // The products of rotations drift from orthonormal by rounding.
-    best.col(0).normalize();
-    best.col(1) = (best.col(1) - best.col(1).dot(best.col(0)) * best.col(0)).normalized();
-    best.col(2) = best.col(0).cross(best.col(1));
-    return best;
+    const std::array<Mat3, 3> others = {Mat3::Identity(), boxes_[n.first_child].axes,
+                                        boxes_[n.first_child + 1].axes};
+    return search_box_frame(mesh_, start, others,
+                            std::span<const std::uint32_t>(s.vertex.data(), s.count));
   }
 
-  /// Per size in kTurns, the turns about each axis both ways.
-  static std::array<std::array<Mat3, 6>, kTurns.size()> make_turns() {
-    std::array<std::array<Mat3, 6>, kTurns.size()> out;
-    for (std::size_t k = 0; k < kTurns.size(); ++k) {
-      for (int axis = 0; axis < 3; ++axis) {
-        for (int sign = 0; sign < 2; ++sign) {
-          const Real angle = sign == 0 ? -kTurns[k] : kTurns[k];
-          out[k][2 * axis + sign] =
-              Eigen::AngleAxis<Real>(angle, Vec3::Unit(axis)).toRotationMatrix();
-        }
-      }
-    }
-    return out;
-  }
-
-  const std::array<std::array<Mat3, 6>, kTurns.size()> turns_ = make_turns();
   const BinaryLayout& layout_;
   const Mesh& mesh_;
   std::vector<FittedBox>& boxes_;
@@ -194,6 +130,78 @@ class BoxFitter {
 };
 
 }  // namespace
+
+const std::array<Vec3, 13> kBoxSearchDirections = {
+    Vec3(1, 0, 0),  Vec3(0, 1, 0),  Vec3(0, 0, 1),  Vec3(1, 1, 0),  Vec3(1, -1, 0),
+    Vec3(1, 0, 1),  Vec3(1, 0, -1), Vec3(0, 1, 1),  Vec3(0, 1, -1), Vec3(1, 1, 1),
+    Vec3(1, 1, -1), Vec3(1, -1, 1), Vec3(1, -1, -1)};
+
+Real box_search_cost(const Vec3& e) {
+  const Real area = e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+  return e.x() * e.y() * e.z() + 0.01 * area * e.sum();
+}
+
+namespace {
+
+/// Turns tried about each axis, largest first, each from the best frame so far.
+constexpr std::array<Real, 4> kTurns = {0.3, 0.1, 0.03, 0.01};
+
+/// Steps of one turn size at most, while each still shrinks the box.
+constexpr int kMaxSteps = 4;
+
+/// Per size in kTurns, the turns about each axis both ways.
+std::array<std::array<Mat3, 6>, kTurns.size()> make_turns() {
+  std::array<std::array<Mat3, 6>, kTurns.size()> out;
+  for (std::size_t k = 0; k < kTurns.size(); ++k) {
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int sign = 0; sign < 2; ++sign) {
+        const Real angle = sign == 0 ? -kTurns[k] : kTurns[k];
+        out[k][2 * axis + sign] =
+            Eigen::AngleAxis<Real>(angle, Vec3::Unit(axis)).toRotationMatrix();
+      }
+    }
+  }
+  return out;
+}
+
+/// The cost of the box of `support` with the given axes.
+Real support_cost(const Mesh& mesh, const Mat3& axes, std::span<const std::uint32_t> support) {
+  const Mat3 to_box = axes.transpose();
+  Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
+  Vec3 hi = -lo;
+  for (std::uint32_t v : support) {
+    const Vec3 p = to_box * mesh.vertices[v];
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  return box_search_cost(hi - lo);
+}
+
+}  // namespace
+
+Mat3 search_box_frame(const Mesh& mesh, const Mat3& start, std::span<const Mat3> others,
+                      std::span<const std::uint32_t> support) {
+  static const std::array<std::array<Mat3, 6>, kTurns.size()> turns = make_turns();
+  Mat3 best = start;
+  Real best_cost = support_cost(mesh, best, support);
+  const auto consider = [&](const Mat3& candidate) {
+    const Real c = support_cost(mesh, candidate, support);
+    if (c < best_cost) best_cost = c, best = candidate;
+  };
+  for (const Mat3& other : others) consider(other);
+  for (const std::array<Mat3, 6>& size : turns) {
+    for (int step = 0; step < kMaxSteps; ++step) {
+      const Real before = best_cost;
+      for (const Mat3& turn : size) consider(best * turn);
+      if (!(best_cost < before)) break;
+    }
+  }
+  // The products of rotations drift from orthonormal by rounding.
+  best.col(0).normalize();
+  best.col(1) = (best.col(1) - best.col(1).dot(best.col(0)) * best.col(0)).normalized();
+  best.col(2) = best.col(0).cross(best.col(1));
+  return best;
+}
 
 std::vector<FittedBox> fit_boxes(const BinaryLayout& layout, const Mesh& mesh) {
   std::vector<FittedBox> boxes(layout.nodes.size());

@@ -11,6 +11,9 @@
 // node's vertices in the frame found, and the searched frame is kept only
 // where that box is smaller than the covariance frame's.
 
+#include <array>
+#include <cstdint>
+#include <span>
 #include <vector>
 
 #include "dovetail/collision/mesh.h"
@@ -31,6 +34,22 @@ struct FittedBox {
   Vec3 lo = Vec3::Zero();  ///< in the box's frame
   Vec3 hi = Vec3::Zero();
 };
+
+/// The 26-DOP's directions, one of each opposite pair: a node's extreme
+/// vertices along them stand for it in a frame search.
+extern const std::array<Vec3, 13> kBoxSearchDirections;
+
+/// What a frame search minimises for a box of edges `e`: its volume, plus a
+/// little of its surface area times its edge sum so that a flat set (no
+/// volume in any frame that holds its plane) still prefers the tighter
+/// rectangle.
+Real box_search_cost(const Vec3& e);
+
+/// The best of `start` and `others` for the box of the `support` vertices,
+/// turned about its own axes while that shrinks the box (turns of 0.3, 0.1,
+/// 0.03 and 0.01 rad, at most four steps of each); orthonormal, right-handed.
+Mat3 search_box_frame(const Mesh& mesh, const Mat3& start, std::span<const Mat3> others,
+                      std::span<const std::uint32_t> support);
 
 /// Every node's box, in the layout's node order. A searched box is kept only
 /// where it is smaller than the covariance frame's, measured on all the

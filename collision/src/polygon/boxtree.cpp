@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "polygon/box_fit.h"
 #include "polygon/hierarchy_common.h"
 #include "polygon/principal_axes.h"
 
@@ -167,14 +168,13 @@ class BoxtreeBuilder {
   }
 
   static double box_cost(const Box& b) {
-    const double x = b.hi[0] - b.lo[0], y = b.hi[1] - b.lo[1], z = b.hi[2] - b.lo[2];
-    return x * y * z + 0.01 * half_area(b) * (x + y + z);
+    return detail::box_search_cost(Vec3(b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]));
   }
 
-  /// Gives prims [begin, end) a frame of their own, their principal axes,
-  /// when their box in it is enough smaller: `node` becomes a frame node and
-  /// its child's subtree is built in the new frame. Returns false (prims
-  /// unchanged) otherwise.
+  /// Gives prims [begin, end) a frame of their own, their principal axes
+  /// turned by the frame search, when their box in it is enough smaller: `node` becomes a frame
+  /// node and its child's subtree is built in the new frame. Returns false (prims unchanged)
+  /// otherwise.
   bool frame_node(std::uint32_t node, std::size_t begin, std::size_t end, std::size_t depth) {
     detail::Moments moments;
     for (std::size_t i = begin; i < end; ++i) {
@@ -184,7 +184,7 @@ class BoxtreeBuilder {
     }
     BoxtreeNode head;
     head.word[0] = head.word[1] = 0;
-    const Eigen::Quaternion<Real> q(detail::covariance_axes(moments));
+    const Eigen::Quaternion<Real> q(searched(detail::covariance_axes(moments), begin, end));
     const Real parts[4] = {q.w(), q.x(), q.y(), q.z()};
     for (int k = 0; k < 4; ++k) {
       const auto fixed = static_cast<std::int16_t>(std::lround(parts[k] * kQuaternionScale));
@@ -224,6 +224,37 @@ class BoxtreeBuilder {
     tree_.nodes_[node] = head;
     build_node(child, frame_box, begin, end, depth + 1);
     return true;
+  }
+
+  /// The frame search of the OBB tree (box_fit.h) from `start`, on the
+  /// subtree's extreme vertices along the 26-DOP's directions.
+  Mat3 searched(const Mat3& start, std::size_t begin, std::size_t end) {
+    constexpr std::size_t kCount = detail::kBoxSearchDirections.size();
+    std::array<Real, kCount> lo, hi;
+    std::array<std::uint32_t, kCount> lowest{}, highest{};
+    lo.fill(std::numeric_limits<Real>::infinity());
+    hi.fill(-std::numeric_limits<Real>::infinity());
+    if (seen_.empty()) seen_.assign(mesh_.vertices.size(), 0);
+    ++stamp_;
+    for (std::size_t i = begin; i < end; ++i) {
+      for (std::uint32_t v : mesh_.triangles[prims_[i].index]) {
+        if (seen_[v] == stamp_) continue;
+        seen_[v] = stamp_;
+        for (std::size_t d = 0; d < kCount; ++d) {
+          const Real x = detail::kBoxSearchDirections[d].dot(mesh_.vertices[v]);
+          if (x < lo[d]) lo[d] = x, lowest[d] = v;
+          if (x > hi[d]) hi[d] = x, highest[d] = v;
+        }
+      }
+    }
+    support_.clear();
+    for (std::size_t d = 0; d < kCount; ++d) {
+      for (std::uint32_t v : {lowest[d], highest[d]}) {
+        if (std::find(support_.begin(), support_.end(), v) == support_.end()) support_.push_back(v);
+      }
+    }
+    const std::array<Mat3, 1> others = {Mat3::Identity()};
+    return detail::search_box_frame(mesh_, start, others, support_);
   }
 
   /// Chooses axis and split by a binned surface-area cost of the two child
@@ -317,6 +348,9 @@ class BoxtreeBuilder {
   const BoxtreeSettings& settings_;
   std::vector<detail::BuildTriangle> prims_;
   std::vector<detail::BuildTriangle> local_;
+  std::vector<std::uint32_t> support_;
+  std::vector<std::uint32_t> seen_;  ///< per vertex: the stamp of the last search that saw it
+  std::uint32_t stamp_ = 0;
   /// A subtree of at most this many triangles is tried for a frame next.
   std::size_t frame_limit_ = settings_.frames ? std::numeric_limits<std::size_t>::max() : 0;
 };
@@ -409,19 +443,29 @@ class BoxtreeTraversal {
   }
 
  private:
-  /// The pose between the two trees' current frames. The rotations are
-  /// stored by column: ab[k] is B's axis k in A's frame, ba[k] A's in B's.
-  struct Pose {
-    double ab[3][3], ba[3][3];
-    Vec3 t_AB, t_BA;
-    Pose(const Mat3& R, const Vec3& t) : t_AB(t), t_BA(-(R.transpose() * t)) {
+  /// A rotation by column (col[k]: axis k in the other frame), and each
+  /// column's positive and negative parts, so that moving a face updates an
+  /// enclosure without branches.
+  struct Columns {
+    double col[3][3], pos[3][3], neg[3][3];
+    explicit Columns(const Mat3& M) {
       for (int k = 0; k < 3; ++k) {
         for (int i = 0; i < 3; ++i) {
-          ab[k][i] = R(i, k);
-          ba[k][i] = R(k, i);
+          col[k][i] = M(i, k);
+          pos[k][i] = std::max(M(i, k), 0.0);
+          neg[k][i] = std::min(M(i, k), 0.0);
         }
       }
     }
+  };
+
+  /// The pose between the two trees' current frames: ab holds B's axes in
+  /// A's frame, ba A's in B's.
+  struct Pose {
+    Columns ab, ba;
+    Vec3 t_AB, t_BA;
+    Pose(const Mat3& R, const Vec3& t)
+        : ab(R), ba(R.transpose()), t_AB(t), t_BA(-(R.transpose() * t)) {}
   };
 
   static Mat3 frame_rotation(const Boxtree& tree, std::uint32_t frame) {
@@ -461,12 +505,12 @@ class BoxtreeTraversal {
   }
 
   /// The box `box` maps into by x -> M x + t, as a box (M by column).
-  static Box enclose(const Box& box, const double (&M)[3][3], const Vec3& t) {
+  static Box enclose(const Box& box, const Columns& M, const Vec3& t) {
     Box enc;
     for (int i = 0; i < 3; ++i) {
       enc.lo[i] = enc.hi[i] = t[i];
       for (int j = 0; j < 3; ++j) {
-        const double u = M[j][i] * box.lo[j], v = M[j][i] * box.hi[j];
+        const double u = M.col[j][i] * box.lo[j], v = M.col[j][i] * box.hi[j];
         enc.lo[i] += std::min(u, v);
         enc.hi[i] += std::max(u, v);
       }
@@ -497,25 +541,23 @@ class BoxtreeTraversal {
   /// bounds where negatively. Every value is computed from the parent's, none
   /// read back from the child being written (a partial store followed by a
   /// wide load of the same bytes would stall).
-  static void move_upper(Side& child, const Side& s, int axis, double split,
-                         const double (&M)[3][3]) {
+  static void move_upper(Side& child, const Side& s, int axis, double split, const Columns& M) {
     const double d = s.box.hi[axis] - split;
     child.box = s.box;
     child.box.hi[axis] = split;
     for (int i = 0; i < 3; ++i) {
-      child.enc.hi[i] = s.enc.hi[i] - std::max(M[axis][i], 0.0) * d;
-      child.enc.lo[i] = s.enc.lo[i] - std::min(M[axis][i], 0.0) * d;
+      child.enc.hi[i] = s.enc.hi[i] - M.pos[axis][i] * d;
+      child.enc.lo[i] = s.enc.lo[i] - M.neg[axis][i] * d;
     }
   }
 
-  static void move_lower(Side& child, const Side& s, int axis, double split,
-                         const double (&M)[3][3]) {
+  static void move_lower(Side& child, const Side& s, int axis, double split, const Columns& M) {
     const double d = split - s.box.lo[axis];
     child.box = s.box;
     child.box.lo[axis] = split;
     for (int i = 0; i < 3; ++i) {
-      child.enc.lo[i] = s.enc.lo[i] + std::max(M[axis][i], 0.0) * d;
-      child.enc.hi[i] = s.enc.hi[i] + std::min(M[axis][i], 0.0) * d;
+      child.enc.lo[i] = s.enc.lo[i] + M.pos[axis][i] * d;
+      child.enc.hi[i] = s.enc.hi[i] + M.neg[axis][i] * d;
     }
   }
 
@@ -589,7 +631,7 @@ class BoxtreeTraversal {
   }
 
   template <typename Visit>
-  void descend(const BoxtreeNode& n, const Side& s, const double (&M)[3][3], const Side& other,
+  void descend(const BoxtreeNode& n, const Side& s, const Columns& M, const Side& other,
                Visit&& next) {
     const int axis = static_cast<int>(n.axis());
     const std::uint32_t kind = n.kind();

@@ -11,13 +11,15 @@
 //
 // Subtree frames: boxes aligned with the mesh's axes are loose wherever the
 // surface is slanted, and near contact a traversal tests every pair of boxes
-// that the gap cannot separate. A subtree whose box in its principal axes is
-// much smaller gets a frame of its own: a frame node (12 bytes, the rotation
-// in 16-bit fixed point) and its box (28 bytes). Below it the tree is an
-// ordinary restricted boxtree in the new frame; entering it costs the
-// traversal one full enclosure of each side. On the bunny this halves the
-// volume tests a query (1,286 to 563) and takes the memory from 15.5 to 14.2
-// bytes a triangle, since a leaf keeps two of its triangles in its own node.
+// that the gap cannot separate. A subtree whose box is much smaller in a
+// frame of its own (its principal axes, turned while that shrinks the box:
+// the OBB tree's frame search, box_fit.h) gets one: a frame node (12 bytes,
+// the rotation in 16-bit fixed point) and its box and child (28 bytes).
+// Below it the tree is an ordinary restricted boxtree in the new frame;
+// entering it costs the traversal one full enclosure of each side. On the
+// bunny this takes the volume tests a query from 1,286 to 418 and the memory
+// from 15.5 to 13.9 bytes a triangle, since a leaf keeps two of its
+// triangles in its own node.
 
 #include <bit>
 #include <cstdint>
@@ -34,14 +36,14 @@ struct BoxtreeSettings {
   int max_leaf_size = 4;        ///< triangles per leaf, 1..4
   double slab_threshold = 0.1;  ///< split off an empty slab wider than this fraction of the box
   int bins = 16;                ///< candidate split positions per axis
-  /// Subtree frames: a subtree gets a frame of its own, its principal axes,
-  /// where its box in that frame is smaller than `frame_gain` times its box
+  /// Subtree frames: a subtree gets a frame of its own (its searched box
+  /// frame) where its box in that frame is smaller than `frame_gain` times its box
   /// in the frame it is in. Tried at the root, then in subtrees `frame_step`
   /// times smaller than the last one tried, down to `frame_min_triangles`.
   bool frames = true;
   int frame_step = 3;  ///< >= 2
   int frame_min_triangles = 8;
-  double frame_gain = 0.7;
+  double frame_gain = 0.9;
 };
 
 /// One node, 12 bytes. Inner node: children at `child()` (and `child() + 1`
