@@ -84,7 +84,7 @@ TEST(BoxtreeFrames, RotationsAreOrthonormalAndBoxesHoldTheirSubtrees) {
 
 TEST(BoxtreeFrames, ExactWithAndWithoutFramesAndFewerTestsWithThem) {
   const Mesh sheet = slanted_sheet();
-  const Mesh ball = make_sphere(0.3, 3);
+  const Mesh ball = make_sphere(0.3, 2);
   const Boxtree with_a(sheet), with_b(ball);
   BoxtreeSettings plain;
   plain.frames = false;
@@ -96,7 +96,7 @@ TEST(BoxtreeFrames, ExactWithAndWithoutFramesAndFewerTestsWithThem) {
   // The ball near the sheet's surface: along the sheet's normal at random
   // points, from just through it to just clear of it.
   const Mat3 R = slant();
-  const std::vector<Transform> jitter = random_poses(300, 0.8, 7);
+  const std::vector<Transform> jitter = random_poses(200, 0.8, 7);
   std::uint64_t tests_with = 0, tests_without = 0;
   int colliding = 0;
   for (std::size_t i = 0; i < jitter.size(); ++i) {
