@@ -392,8 +392,8 @@ class BoxtreeTraversal {
   }
 
   /// One tree's current node: its box in its own frame (0: the mesh's, k:
-  /// the tree's frame k - 1) and the enclosure of that box in the other
-  /// tree's current frame.
+  /// the frame of the tree's node k - 1, a frame node) and the enclosure of
+  /// that box in the other tree's current frame.
   struct Side {
     Box box;
     Box enc;
