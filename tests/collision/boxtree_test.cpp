@@ -6,8 +6,6 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -41,9 +39,9 @@ void subtree_triangles(const Boxtree& tree, std::uint32_t node, std::vector<std:
   } else if (n.is_frame()) {
     subtree_triangles(tree, tree.frames()[n.index()].child, out);
   } else {
-    if (n.kind() != BoxtreeNode::kRightOnly) subtree_triangles(tree, n.index(), out);
+    // A slab node's one child, or the first of two, is at index().
+    subtree_triangles(tree, n.index(), out);
     if (n.kind() == BoxtreeNode::kBothChildren) subtree_triangles(tree, n.index() + 1, out);
-    if (n.kind() == BoxtreeNode::kRightOnly) subtree_triangles(tree, n.index(), out);
   }
 }
 

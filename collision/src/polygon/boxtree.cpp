@@ -183,7 +183,6 @@ class BoxtreeBuilder {
                                            mesh_.vertices[t[2]]));
     }
     BoxtreeNode head;
-    head.word[0] = head.word[1] = 0;
     const Eigen::Quaternion<Real> q(searched(detail::covariance_axes(moments), begin, end));
     const Real parts[4] = {q.w(), q.x(), q.y(), q.z()};
     for (int k = 0; k < 4; ++k) {
@@ -426,21 +425,14 @@ class BoxtreeTraversal {
         continue;
       }
       leaf_pairs = 0;
-      const Pose p = e.a.frame == 0 && e.b.frame == 0 ? root_pose_ : pose(e.a.frame, e.b.frame);
-      expand(e.a, e.b, p, [&](const Side& a, const Side& b, const Pose&) {
+      expand(e.a, e.b, pose(e.a.frame, e.b.frame), [&](const Side& a, const Side& b, const Pose&) {
         queue.push_back({a, b});
       });
     }
     return {queue.begin(), queue.end()};
   }
 
-  void run_from(const Entry& e) {
-    if (e.a.frame == 0 && e.b.frame == 0) {
-      visit(e.a, e.b, root_pose_);
-    } else {
-      visit(e.a, e.b, pose(e.a.frame, e.b.frame));
-    }
-  }
+  void run_from(const Entry& e) { visit(e.a, e.b, pose(e.a.frame, e.b.frame)); }
 
  private:
   /// A rotation by column (col[k]: axis k in the other frame), and each
@@ -467,10 +459,6 @@ class BoxtreeTraversal {
     Pose(const Mat3& R, const Vec3& t)
         : ab(R), ba(R.transpose()), t_AB(t), t_BA(-(R.transpose() * t)) {}
   };
-
-  static Mat3 frame_rotation(const Boxtree& tree, std::uint32_t frame) {
-    return frame == 0 ? Mat3::Identity() : tree.nodes_[frame - 1].rotation();
-  }
 
   Pose pose(std::uint32_t frame_a, std::uint32_t frame_b) const {
     if (frame_a == 0 && frame_b == 0) return Pose(X_AB_.R, X_AB_.t);
