@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "polygon/box_fit.h"
+#include "polygon/box_lanes.h"
 #include "polygon/pair_traversal.h"
 
 namespace dovetail::collision {
@@ -135,16 +136,17 @@ ObbTree::ObbTree(const Mesh& mesh, int max_leaf_size) {
     const detail::LayoutNode& node = layout.nodes[i];
     const detail::FittedBox& box = boxes[i];
     Node& out = nodes_[i];
-    out.axes = box.axes;
-    out.centre = box.axes * ((box.lo + box.hi) * 0.5);
-    out.half = (box.hi - box.lo) * 0.5;
+    Eigen::Map<Mat3>(out.box) = box.axes.transpose();
+    Eigen::Map<Vec3>(out.box + 9) = box.axes * ((box.lo + box.hi) * 0.5);
+    Eigen::Map<Vec3>(out.box + 12) = (box.hi - box.lo) * 0.5;
     out.link = detail::NodeLink::from(node);
   }
   for (const detail::BuildTriangle& t : layout.triangles) order_.push_back(t.index);
   if (!nodes_.empty()) {
-    ball_centre_ = nodes_.front().centre;
+    ball_centre_ = nodes_.front().centre();
     for (const Node& node : nodes_) {
-      ball_radius_ = std::max(ball_radius_, (node.centre - ball_centre_).norm() + node.half.norm());
+      ball_radius_ =
+          std::max(ball_radius_, (node.centre() - ball_centre_).norm() + node.half().norm());
     }
   }
 }
@@ -168,16 +170,16 @@ std::size_t ObbTree::bytes() const {
 class ObbPolicy {
  public:
   using EncA = detail::NoEnclosure;
-  struct EncB {
-    Mat3 axes;  ///< B's box axes in A's frame
-    Vec3 centre;
-    Vec3 half;
-  };
+  using EncB = detail::BoxLanes;  ///< B's box in A's frame
 
   EncA enclose_a(std::uint32_t) const { return {}; }
 
   ObbPolicy(const ObbTree& a, const ObbTree& b, const Transform& X_AB)
-      : a_(a), b_(b), X_AB_(X_AB), margin_(detail::query_margin(a.max_abs_, b.max_abs_, X_AB)) {
+      : a_(a),
+        b_(b),
+        X_AB_(X_AB),
+        margin_(detail::query_margin(a.max_abs_, b.max_abs_, X_AB)),
+        lanes_(detail::box_lane_ops()) {
     // Box frames are fitted, not exact: widen the margin by the size of the
     // rounding in expressing a box in another box's frame.
     margin_ += 0x1.0p-40 * (a.max_abs_ + b.max_abs_);
@@ -186,37 +188,36 @@ class ObbPolicy {
   EncB enclose_b(std::uint32_t n) const {
     const ObbTree::Node& node = b_.nodes_[n];
     prefetch_children(b_, node);
-    return {X_AB_.R * node.axes, X_AB_.apply(node.centre), node.half};
+    EncB e;
+    lanes_.move(node.box, X_AB_.R.data(), X_AB_.t.data(), e);
+    return e;
   }
 
   bool overlap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
     const ObbTree::Node& node = a_.nodes_[n];
     prefetch_children(a_, node);
-    return detail::oriented_boxes_overlap(node.axes, node.centre, node.half, e.axes, e.centre,
-                                          e.half, margin_);
+    return !(lanes_.gap(node.box, e, margin_) > 0);
   }
 
   /// Squared distance between the box centres: near contact, the pair of
   /// boxes more nearly concentric more often holds crossing triangles.
   Real nearness(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
-    return (a_.nodes_[n].centre - e.centre).squaredNorm();
+    return (a_.nodes_[n].centre() - Eigen::Map<const Vec3>(e.centre)).squaredNorm();
   }
 
   Real gap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
-    const ObbTree::Node& node = a_.nodes_[n];
-    return detail::oriented_boxes_gap(node.axes, node.centre, node.half, e.axes, e.centre, e.half,
-                                      margin_);
+    return lanes_.gap(a_.nodes_[n].box, e, margin_);
   }
 
   detail::NodeLink link_a(std::uint32_t n) const { return a_.nodes_[n].link; }
   detail::NodeLink link_b(std::uint32_t n) const { return b_.nodes_[n].link; }
-  Real size_a(std::uint32_t n) const { return a_.nodes_[n].half.sum(); }
-  Real size_b(std::uint32_t n) const { return b_.nodes_[n].half.sum(); }
+  Real size_a(std::uint32_t n) const { return a_.nodes_[n].half().sum(); }
+  Real size_b(std::uint32_t n) const { return b_.nodes_[n].half().sum(); }
   bool small_pair(std::uint32_t a, std::uint32_t b, Real max) const {
     // A box's diagonal 2|half| is at least 2 half.sum() / sqrt(3): most pairs
     // are rejected without a square root.
-    const Vec3& ha = a_.nodes_[a].half;
-    const Vec3& hb = b_.nodes_[b].half;
+    const Vec3 ha = a_.nodes_[a].half();
+    const Vec3 hb = b_.nodes_[b].half();
     if (2 * (ha.sum() + hb.sum()) > std::sqrt(Real{3}) * max) return false;
     return 2 * (ha.norm() + hb.norm()) <= max;
   }
@@ -244,6 +245,7 @@ class ObbPolicy {
   const ObbTree& b_;
   const Transform& X_AB_;
   Real margin_;
+  detail::BoxLaneOps lanes_;
 };
 
 CollideResult ObbTree::collide(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,

@@ -67,11 +67,16 @@ class ObbTree {
 
  private:
   friend class ObbPolicy;
+  /// A box as the lane test reads it (polygon/box_lanes.h): fifteen
+  /// doubles, the rotation into the box's frame (column-major; its rows are
+  /// the box's axes in the mesh's frame), the centre, the half extents.
   struct Node {
-    Mat3 axes;  ///< columns: box axes in the mesh's frame (orthonormal)
-    Vec3 centre;
-    Vec3 half;
+    double box[15];
     detail::NodeLink link;
+
+    Eigen::Map<const Mat3> to_box() const { return Eigen::Map<const Mat3>(box); }
+    Eigen::Map<const Vec3> centre() const { return Eigen::Map<const Vec3>(box + 9); }
+    Eigen::Map<const Vec3> half() const { return Eigen::Map<const Vec3>(box + 12); }
   };
   std::vector<Node> nodes_;
   std::vector<std::uint32_t> order_;

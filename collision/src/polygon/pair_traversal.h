@@ -403,36 +403,4 @@ inline bool boxes_overlap(const Mat3& R, const Vec3& T, const Vec3& ea, const Ve
   return !(boxes_gap_remaining_axes(R, absR, T, ea, eb, margin) > 0);
 }
 
-/// The gap between two boxes given by their axes (columns), centres and half
-/// extents, all in one frame, on the first separating axis found (> 0), or 0
-/// when they overlap (boxes_overlap's test and margin). The relative rotation
-/// is built row by row while A's face axes are tested, so a separation on one
-/// of those three axes (the common case) skips most of its cost.
-inline Real oriented_boxes_gap(const Mat3& axes_a, const Vec3& centre_a, const Vec3& ea,
-                               const Mat3& axes_b, const Vec3& centre_b, const Vec3& eb,
-                               Real margin) {
-  const Vec3 d = centre_b - centre_a;
-  Mat3 R, absR;
-  Vec3 T;
-  for (int i = 0; i < 3; ++i) {
-    const Vec3 a = axes_a.col(i);
-    for (int j = 0; j < 3; ++j) {
-      R(i, j) = a.dot(axes_b.col(j));
-      absR(i, j) = std::abs(R(i, j));
-    }
-    T[i] = a.dot(d);
-    const Real rb = absR(i, 0) * eb[0] + absR(i, 1) * eb[1] + absR(i, 2) * eb[2];
-    const Real gap = std::abs(T[i]) - (ea[i] + rb + margin);
-    if (gap > 0) return gap;
-  }
-  return boxes_gap_remaining_axes(R, absR, T, ea, eb, margin);
-}
-
-/// Whether two boxes overlap: oriented_boxes_gap finds no separating axis.
-inline bool oriented_boxes_overlap(const Mat3& axes_a, const Vec3& centre_a, const Vec3& ea,
-                                   const Mat3& axes_b, const Vec3& centre_b, const Vec3& eb,
-                                   Real margin) {
-  return !(oriented_boxes_gap(axes_a, centre_a, ea, axes_b, centre_b, eb, margin) > 0);
-}
-
 }  // namespace dovetail::collision::detail
