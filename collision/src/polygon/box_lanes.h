@@ -51,7 +51,8 @@ struct BoxLaneOps {
 };
 
 /// Four doubles wide where the processor has AVX2, else the scalar lanes;
-/// chosen once.
+/// chosen once. The environment variable DOVETAIL_SCALAR_LANES (any value)
+/// asks for the scalar lanes.
 BoxLaneOps box_lane_ops();
 
 /// The scalar lanes, on every processor.

@@ -22,6 +22,16 @@ struct Avx2Lanes {
   static V mul(V a, V b) { return _mm256_mul_pd(a, b); }
   static V max(V a, V b) { return _mm256_max_pd(a, b); }
   static V abs(V a) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), a); }
+  /// out[j] lane i = rows[i] lane j, for lanes 0 to 2.
+  static void transpose(const V (&rows)[3], V (&out)[3]) {
+    const V t0 = _mm256_unpacklo_pd(rows[0], rows[1]);  // r0[0] r1[0] r0[2] r1[2]
+    const V t1 = _mm256_unpackhi_pd(rows[0], rows[1]);  // r0[1] r1[1] r0[3] r1[3]
+    const V t2 = _mm256_unpacklo_pd(rows[2], rows[2]);  // r2[0] r2[0] r2[2] r2[2]
+    const V t3 = _mm256_unpackhi_pd(rows[2], rows[2]);  // r2[1] r2[1] r2[3] r2[3]
+    out[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
+    out[1] = _mm256_permute2f128_pd(t1, t3, 0x20);
+    out[2] = _mm256_permute2f128_pd(t0, t2, 0x31);
+  }
   static V turn1(V a) { return _mm256_permute4x64_pd(a, 0b11'00'10'01); }
   static V turn2(V a) { return _mm256_permute4x64_pd(a, 0b11'01'00'10); }
   template <int i>

@@ -32,21 +32,8 @@ double box_gap(const double* a, const BoxLanes& b, double margin) {
   const double d2 = b.centre[2] - centre_a[2];
   const V T = L::add(L::add(L::mul(L::broadcast(d0), a0), L::mul(L::broadcast(d1), a1)),
                      L::mul(L::broadcast(d2), a2));
-  // |R| column j, R = A^T B (lane i: |a_i . b_j|).
-  const auto column = [&](int j) {
-    return L::abs(
-        L::add(L::add(L::mul(L::broadcast(b.row[0][j]), a0), L::mul(L::broadcast(b.row[1][j]), a1)),
-               L::mul(L::broadcast(b.row[2][j]), a2)));
-  };
-  // A's face axes: |T_i| > e^A_i + sum_j |R_ij| e^B_j.
-  const V rb = L::add(L::add(L::mul(column(0), L::broadcast(b.half[0])),
-                             L::mul(column(1), L::broadcast(b.half[1]))),
-                      L::mul(column(2), L::broadcast(b.half[2])));
-  const V ea = L::load3(half_a);
-  const double face_a = widest_gap<L>(L::sub(L::abs(T), L::add(L::add(ea, rb), m)));
-  if (face_a > 0) return face_a;
-
-  // R row i (lane j: a_i . b_j), signed and absolute.
+  // R = A^T B by rows (lane j: a_i . b_j), signed and absolute; |R| by
+  // columns (lane i) for A's face axes.
   const V b0 = L::load4(b.row[0]), b1 = L::load4(b.row[1]), b2 = L::load4(b.row[2]);
   const auto row = [&](int i) {
     return L::add(L::add(L::mul(L::broadcast(a[i]), b0), L::mul(L::broadcast(a[3 + i]), b1)),
@@ -54,6 +41,16 @@ double box_gap(const double* a, const BoxLanes& b, double margin) {
   };
   const V R[3] = {row(0), row(1), row(2)};
   const V absR[3] = {L::abs(R[0]), L::abs(R[1]), L::abs(R[2])};
+  V column[3];
+  L::transpose(absR, column);
+  // A's face axes: |T_i| > e^A_i + sum_j |R_ij| e^B_j.
+  const V rb = L::add(L::add(L::mul(column[0], L::broadcast(b.half[0])),
+                             L::mul(column[1], L::broadcast(b.half[1]))),
+                      L::mul(column[2], L::broadcast(b.half[2])));
+  const V ea = L::load3(half_a);
+  const double face_a = widest_gap<L>(L::sub(L::abs(T), L::add(L::add(ea, rb), m)));
+  if (face_a > 0) return face_a;
+
   const V eA[3] = {L::broadcast(half_a[0]), L::broadcast(half_a[1]), L::broadcast(half_a[2])};
   // B's face axes: |b_j . d| > sum_i |R_ij| e^A_i + e^B_j.
   const V t_b = L::add(L::add(L::mul(L::broadcast(d0), b0), L::mul(L::broadcast(d1), b1)),
