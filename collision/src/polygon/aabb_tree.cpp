@@ -6,6 +6,7 @@
 
 #include "polygon/box_fit.h"
 #include "polygon/box_lanes.h"
+#include "polygon/box_lanes_scalar.h"
 #include "polygon/pair_traversal.h"
 
 namespace dovetail::collision {
@@ -179,7 +180,8 @@ class ObbPolicy {
         b_(b),
         X_AB_(X_AB),
         margin_(detail::query_margin(a.max_abs_, b.max_abs_, X_AB)),
-        lanes_(detail::box_lane_ops()) {
+        lanes_(detail::box_lane_ops()),
+        wide_(detail::box_lanes_wide(lanes_)) {
     // Box frames are fitted, not exact: widen the margin by the size of the
     // rounding in expressing a box in another box's frame.
     margin_ += 0x1.0p-40 * (a.max_abs_ + b.max_abs_);
@@ -189,14 +191,18 @@ class ObbPolicy {
     const ObbTree::Node& node = b_.nodes_[n];
     prefetch_children(b_, node);
     EncB e;
-    lanes_.move(node.box, X_AB_.R.data(), X_AB_.t.data(), e);
+    if (wide_) {
+      lanes_.move(node.box, X_AB_.R.data(), X_AB_.t.data(), e);
+    } else {
+      detail::box_move_scalar(node.box, X_AB_.R.data(), X_AB_.t.data(), e);
+    }
     return e;
   }
 
   bool overlap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
     const ObbTree::Node& node = a_.nodes_[n];
     prefetch_children(a_, node);
-    return !(lanes_.gap(node.box, e, margin_) > 0);
+    return !(box_gap(node.box, e) > 0);
   }
 
   /// Squared distance between the box centres: near contact, the pair of
@@ -206,7 +212,7 @@ class ObbPolicy {
   }
 
   Real gap(std::uint32_t n, const EncA&, std::uint32_t, const EncB& e) const {
-    return lanes_.gap(a_.nodes_[n].box, e, margin_);
+    return box_gap(a_.nodes_[n].box, e);
   }
 
   detail::NodeLink link_a(std::uint32_t n) const { return a_.nodes_[n].link; }
@@ -225,6 +231,11 @@ class ObbPolicy {
   const std::uint32_t* slots_b() const { return b_.order_.data(); }
 
  private:
+  /// The wide form through its pointer, the scalar form inline.
+  Real box_gap(const double* box_a, const EncB& e) const {
+    return wide_ ? lanes_.gap(box_a, e, margin_) : detail::box_gap_scalar(box_a, e, margin_);
+  }
+
   /// Starts loading a node's two children (adjacent, 128 bytes each)
   /// while its own box is tested: where the test passes, they are the next
   /// nodes the traversal reads. On the bunny, whose tree (10 MB) does not fit
@@ -246,6 +257,7 @@ class ObbPolicy {
   const Transform& X_AB_;
   Real margin_;
   detail::BoxLaneOps lanes_;
+  bool wide_;
 };
 
 CollideResult ObbTree::collide(const Mesh& mesh_a, const ObbTree& b, const Mesh& mesh_b,

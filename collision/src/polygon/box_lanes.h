@@ -1,22 +1,23 @@
 #pragma once
-// The OBB tree's separating-axis test, written over lanes: three of the
-// fifteen axes at a time, one axis a lane. Near contact about half the box
-// pairs a query tests overlap, and an overlapping pair needs every axis; the
-// scalar test spends most of its time there, in long dependent chains. In
-// lanes the test is a few dozen wide operations.
+// The OBB tree's separating-axis test, and the move of a box into the other
+// tree's frame, in two forms that give the same bits: scalar code with an
+// exit at the first separating axis, on every processor, and on x86-64
+// processors with AVX2 the same expressions four doubles wide, three axes a
+// lane group. Near contact about half the box pairs a query tests overlap,
+// and an overlapping pair needs all fifteen axes; four wide, those are a few
+// dozen operations.
 //
-// The test is written once (box_lanes_kernel.h), over a lane type: scalar
-// lanes run everywhere; on x86-64 processors with AVX2 the same steps run
-// four doubles wide, from a file of their own compiled for AVX2. Both do the
-// same IEEE operations in the same order, without fused multiply-adds, so
-// they give the same bits: a query's counts and its first hit do not depend
-// on the processor. This header holds plain data only, so that the AVX2
-// file shares no inline code with the rest of the library.
+// The wide form lives in a file of its own compiled for AVX2
+// (box_lanes_avx2.cpp) and is chosen at run time. Both forms compute every
+// value with the same IEEE operations in the same order, without fused
+// multiply-adds, and report the same axis: a query's counts and its first
+// hit do not depend on the processor. This header holds plain data only, so
+// that the AVX2 file shares no inline code with the rest of the library.
 
 namespace dovetail::collision::detail {
 
-/// Box B in A's frame, laid out for the lane test; lane 3 is zero.
-struct alignas(32) BoxLanes {
+/// Box B in A's frame, laid out for the wide test; lane 3 is zero.
+struct BoxLanes {
   double row[3][4];      ///< row k: component k of B's axes b_0, b_1, b_2
   double centre[4];      ///< B's centre
   double half[4];        ///< half extents e_j
@@ -24,41 +25,59 @@ struct alignas(32) BoxLanes {
   double half_after[4];  ///< e_{(j+2) mod 3}
 };
 
-/// B's box (fifteen doubles laid out as A's below, in B's frame) moved
-/// into A's frame by the rotation R_AB (column-major) and translation t_AB.
-/// The centre is R_AB c + t_AB summed as Transform::apply sums it.
+/// The separating-axis test of Gottschalk et al. (15 axes) of box A, given
+/// as fifteen doubles from `a`: the rotation into its frame (column-major,
+/// so a + 3k holds component k of its three axes), its centre and its half
+/// extents, all in A's frame; the wide test reads one double past each
+/// column, so the centre must follow the rotation. Each projected radius is
+/// widened by `margin`. Returns the gap (> 0) on the first axis that
+/// separates the boxes, in the order A's faces, B's faces, the edge pairs
+/// a_i x b_j by i then j; or 0 when none does. On an edge-edge axis, whose
+/// length is at most 1, the gap is scaled by that length: never more than
+/// the true one. NaN separates nothing.
+using BoxGapFn = double (*)(const double* a, const BoxLanes& b, double margin);
+
+/// Box B, given as fifteen doubles in B's frame (laid out as A's above),
+/// moved into A's frame by the rotation R_AB (column-major) and the
+/// translation t_AB; the centre is summed as Transform::apply sums it.
 using BoxMoveFn = void (*)(const double* box, const double* R_AB, const double* t_AB,
                            BoxLanes& out);
 
-/// Box A as the lane test reads it: fifteen doubles from `a`, the rows of
-/// its axes matrix (column-major: a + 3k holds component k of the three
-/// axes), then its centre, then its half extents, all in A's frame. The
-/// test reads a fourth double after each row, so a + 9 (the centre) must
-/// follow the rows.
-///
-/// The separating-axis test of Gottschalk et al. (15 axes), each projected
-/// radius widened by `margin`: the largest gap (> 0) on the axes tried,
-/// when one separates the boxes, or 0 when they overlap. A's face axes are
-/// tried first, and alone when one of them separates; then B's face axes
-/// and the nine edge-edge axes, whose gap is scaled by the axis length (at
-/// most 1), so never more than the true one. NaN separates nothing.
-using BoxGapFn = double (*)(const double* a, const BoxLanes& b, double margin);
-
-/// The test and the move, in one lane type.
+/// The test and the move, in one form.
 struct BoxLaneOps {
   BoxGapFn gap;
   BoxMoveFn move;
 };
 
-/// Four doubles wide where the processor has AVX2, else the scalar lanes;
+/// The wide form where the processor has AVX2, else the scalar form;
 /// chosen once. The environment variable DOVETAIL_SCALAR_LANES (any value)
-/// asks for the scalar lanes.
+/// asks for the scalar form.
 BoxLaneOps box_lane_ops();
 
-/// The scalar lanes, on every processor.
+/// The scalar form, on every processor.
 BoxLaneOps box_lane_ops_scalar();
 
-/// The AVX2 lanes, or null functions where this build or processor has none.
+/// The wide form, or null functions where this build or processor has none.
 BoxLaneOps box_lane_ops_avx2();
+
+/// Whether `ops` is a wide form (callers inline the scalar form instead of
+/// calling it).
+bool box_lanes_wide(BoxLaneOps ops);
+
+/// The part of a move both forms share: B's centre and half extents.
+/// Internal linkage: each file compiles its own copy for its own
+/// instruction set.
+static inline void box_move_rest(const double* box, const double* R_AB, const double* t_AB,
+                                 BoxLanes& out) {
+  const double* c = box + 9;
+  const double* half = box + 12;
+  for (int k = 0; k < 3; ++k) {
+    out.centre[k] = R_AB[k] * c[0] + R_AB[3 + k] * c[1] + R_AB[6 + k] * c[2] + t_AB[k];
+    out.half[k] = half[k];
+    out.half_next[k] = half[(k + 1) % 3];
+    out.half_after[k] = half[(k + 2) % 3];
+  }
+  out.centre[3] = out.half[3] = out.half_next[3] = out.half_after[3] = 0.0;
+}
 
 }  // namespace dovetail::collision::detail
