@@ -273,8 +273,7 @@ const FrameResult& Simulation::step() {
       report_.events.push_back(e);
     }
   }
-  report_.contacts.clear();
-  for (const auto& [key, stats] : contact_stats_) report_.contacts.push_back(stats);
+  report_stale_ = true;
   ++frame_;
   report_.frames = frame_;
   report_.parts = scene_.part_count();
@@ -283,9 +282,23 @@ const FrameResult& Simulation::step() {
   return last_;
 }
 
+const Report& Simulation::report() const {
+  // Contacts and plans are copied into the report when it is read, not every
+  // frame: both grow with the pairs ever met.
+  if (report_stale_) {
+    report_.contacts.clear();
+    for (const auto& [key, stats] : contact_stats_) report_.contacts.push_back(stats);
+    report_.plans.clear();
+    for (const auto& [key, plan] : plans_) report_.plans.push_back(plan);
+    report_stale_ = false;
+  }
+  return report_;
+}
+
 void Simulation::update_plans() {
+  const std::vector<collision::PairPlan> made = world_->plans_since(plans_version_);
   plans_version_ = world_->plans_version();
-  for (const collision::PairPlan& plan : world_->plans()) {
+  for (const collision::PairPlan& plan : made) {
     std::string a = collision_names_.at(plan.pair.a);
     std::string b = collision_names_.at(plan.pair.b);
     if (b < a) std::swap(a, b);
@@ -299,8 +312,6 @@ void Simulation::update_plans() {
         .max_size = plan.max_size,
         .reason = plan.reason};
   }
-  report_.plans.clear();
-  for (const auto& [key, plan] : plans_) report_.plans.push_back(plan);
 }
 
 std::uint64_t Simulation::run(std::uint64_t frames, bool progress) {

@@ -120,6 +120,38 @@ TEST(PairPlan, TheScenesLevelsComeFirstAndAChangedLevelIsPlannedAgain) {
   EXPECT_EQ(world.plans()[0].level, LevelOfDetail::kHull);
 }
 
+TEST(PairPlan, PlansSinceAVersionAreTheNewOnesOnly) {
+  CollisionWorld world;
+  const Mesh box = make_box(Vec3(1, 1, 1));
+  const PartId fixed = world.add_part({.mesh = share(box), .X_WP = {}, .movable = false});
+  const PartId near = world.add_part({.mesh = share(box), .X_WP = at(Vec3(0.9, 0, 0))});
+  const PartId far = world.add_part({.mesh = share(box), .X_WP = at(Vec3(5, 0, 0))});
+  world.step();
+  EXPECT_EQ(world.plans_since(0), world.plans());
+  ASSERT_EQ(world.plans().size(), 1u);
+  const std::uint64_t first = world.plans_version();
+  EXPECT_TRUE(world.plans_since(first).empty());
+  // The far part comes near both: two new pairs, the old one not repeated.
+  world.set_pose(far, at(Vec3(0.45, 0.9, 0)));
+  world.step();
+  const std::vector<PairPlan> made = world.plans_since(first);
+  ASSERT_EQ(made.size(), 2u);
+  EXPECT_EQ(made[0].pair, (PartPair{fixed, far}));
+  EXPECT_EQ(made[1].pair, (PartPair{near, far}));
+  EXPECT_EQ(world.plans().size(), 3u);
+  // A pair planned again after a new level is new again; a removed part's
+  // pairs are gone from both lists.
+  const std::uint64_t second = world.plans_version();
+  world.set_pair_level(fixed, near, LevelOfDetail::kHull);
+  world.remove_part(far);
+  world.step();
+  const std::vector<PairPlan> again = world.plans_since(second);
+  ASSERT_EQ(again.size(), 1u);
+  EXPECT_EQ(again[0].pair, (PartPair{fixed, near}));
+  EXPECT_EQ(again[0].level, LevelOfDetail::kHull);
+  EXPECT_EQ(world.plans_since(0), world.plans());
+}
+
 TEST(PairPlan, APartNobodyComesNearGetsNeitherHullNorHierarchy) {
   CollisionWorld world;
   // A large fixed part and a small moving one far from it.

@@ -73,6 +73,7 @@ struct PairState {
   SeparationFront front;
   PairPlan plan;
   bool planned = false;
+  std::uint64_t plan_version = 0;  ///< plans_version right after the plan was made
 };
 
 std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
@@ -120,6 +121,9 @@ struct CollisionWorld::Impl {
   StepResult result;
   std::uint64_t steps = 0;  ///< step() calls so far, for the captures' context
   std::uint64_t plans_version = 0;
+  /// (plans_version after it, pair key) of every plan made, in order: what
+  /// plans_since() reads instead of every pair's state.
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> plan_log;
 
   Part& part(PartId id) {
     if (id.index >= parts.size() || !parts[id.index].alive || parts[id.index].id != id) {
@@ -233,7 +237,8 @@ struct CollisionWorld::Impl {
     PairPlan& plan = state.plan;
     plan = PairPlan{.pair = {a.id, b.id}};
     state.planned = true;
-    ++plans_version;
+    state.plan_version = ++plans_version;
+    plan_log.emplace_back(plans_version, pair_key(a.id.index, b.id.index));
     const LevelOfDetail asked = level_of(a, b);
     if (asked == LevelOfDetail::kBox) {
       plan.level = LevelOfDetail::kBox;
@@ -786,6 +791,24 @@ std::vector<PairPlan> CollisionWorld::plans() const {
   std::vector<PairPlan> out;
   for (const auto& [key, state] : impl_->pair_states) {
     if (state.planned) out.push_back(state.plan);
+  }
+  std::sort(out.begin(), out.end(),
+            [](const PairPlan& x, const PairPlan& y) { return x.pair < y.pair; });
+  return out;
+}
+
+std::vector<PairPlan> CollisionWorld::plans_since(std::uint64_t version) const {
+  const auto& log = impl_->plan_log;
+  auto entry = std::upper_bound(log.begin(), log.end(), version,
+                                [](std::uint64_t v, const auto& e) { return v < e.first; });
+  std::vector<PairPlan> out;
+  for (; entry != log.end(); ++entry) {
+    const auto it = impl_->pair_states.find(entry->second);
+    // Skipped: pairs forgotten since, and plans made again later in the log.
+    if (it != impl_->pair_states.end() && it->second.planned &&
+        it->second.plan_version == entry->first) {
+      out.push_back(it->second.plan);
+    }
   }
   std::sort(out.begin(), out.end(),
             [](const PairPlan& x, const PairPlan& y) { return x.pair < y.pair; });

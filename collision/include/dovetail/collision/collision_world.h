@@ -235,6 +235,10 @@ class CollisionWorld {
 
   /// The plan of every pair tested so far and not removed, sorted by pair.
   std::vector<PairPlan> plans() const;
+  /// The plans made after plans_version() was `version` and still current,
+  /// sorted by pair: what is new since then, at a cost that grows with that,
+  /// not with every pair planned so far.
+  std::vector<PairPlan> plans_since(std::uint64_t version) const;
   /// Changes whenever plans() would give something new (a pair planned or
   /// forgotten): cheap to poll every step.
   std::uint64_t plans_version() const;

@@ -148,7 +148,7 @@ class Simulation {
   std::uint64_t state_hash() const { return state_hash_; }
   const FrameResult& last_frame() const { return last_; }
   /// The report so far (timeline, contact statistics, state hash, timings).
-  const Report& report() const { return report_; }
+  const Report& report() const;
 
   /// The collision world, for settings such as interest and levels of detail.
   collision::CollisionWorld& collision_world() { return *world_; }
@@ -198,7 +198,10 @@ class Simulation {
   bool paused_ = false;
   std::uint64_t state_hash_ = 0;
   FrameResult last_;
-  Report report_;
+  /// The report; its contacts and plans are filled in by report() when a
+  /// frame has passed since (report_stale_).
+  mutable Report report_;
+  mutable bool report_stale_ = false;
 };
 
 }  // namespace dovetail::engine
