@@ -56,7 +56,19 @@ void EventBus::unsubscribe(SubscriptionId id) {
 }
 
 void EventBus::publish(std::vector<Event>& events) {
-  std::sort(events.begin(), events.end(), event_less);
+  // Sorted as by event_less, comparing names only where needed: by frame and
+  // kind first, then each run of one kind by its names unless it is in order
+  // already (the simulation emits part moves by name).
+  std::stable_sort(events.begin(), events.end(), [](const Event& x, const Event& y) {
+    return std::tie(x.frame, x.kind) < std::tie(y.frame, y.kind);
+  });
+  for (auto run = events.begin(); run != events.end();) {
+    const auto end = std::find_if(run, events.end(), [&](const Event& e) {
+      return e.frame != run->frame || e.kind != run->kind;
+    });
+    if (!std::is_sorted(run, end, event_less)) std::sort(run, end, event_less);
+    run = end;
+  }
   // A handler may subscribe or unsubscribe; deliver to a snapshot.
   const std::vector<Subscription> current = subscriptions_;
   for (const Event& event : events) {

@@ -108,8 +108,10 @@ void Simulation::commit(std::vector<Event>& events, double now) {
         removed_.push_back(r->id);
       }
       r.reset();
+      by_name_.clear();  // a part gone: sorted again below
     }
   }
+  moved_.assign(registered_.size(), false);
   for (const PartId part : scene_.parts()) {
     const Transform X_WP = scene_.world_pose(part);
     if (part.index >= registered_.size()) registered_.resize(part.index + 1);
@@ -118,6 +120,7 @@ void Simulation::commit(std::vector<Event>& events, double now) {
       r = std::make_unique<Registered>();
       r->handle = part;
       r->X_WP = X_WP;
+      by_name_.clear();  // a new part: sorted again below
       const auto& mesh = scene_.collision_mesh(part);
       if (mesh) {
         r->id = world_->add_part({.mesh = mesh,
@@ -143,7 +146,19 @@ void Simulation::commit(std::vector<Event>& events, double now) {
     if (same_bits(r->X_WP, X_WP)) continue;
     r->X_WP = X_WP;
     if (r->id.valid()) world_->set_pose(r->id, X_WP);
-    events.push_back({EventKind::kPartMoved, frame_, now, scene_.name(part), {}});
+    if (part.index >= moved_.size()) moved_.resize(part.index + 1, false);
+    moved_[part.index] = true;
+  }
+  // Part moves by name, so that the bus finds them in order.
+  if (by_name_.size() != scene_.part_count()) {
+    by_name_ = scene_.parts();
+    std::sort(by_name_.begin(), by_name_.end(),
+              [&](PartId x, PartId y) { return scene_.name(x) < scene_.name(y); });
+  }
+  for (const PartId part : by_name_) {
+    if (part.index < moved_.size() && moved_[part.index]) {
+      events.push_back({EventKind::kPartMoved, frame_, now, scene_.name(part), {}});
+    }
   }
 }
 
@@ -171,13 +186,18 @@ void Simulation::contact_events(const collision::StepResult& step, std::vector<E
            step.contacts[j].b == pair.b) {
       ++j;
     }
-    const auto key = names(pair);
-    auto it = contact_stats_.find(key);
-    if (it == contact_stats_.end()) {
-      it = contact_stats_.emplace(key, PairContactStats{key.first, key.second}).first;
-      it->second.first_frame = frame_;
+    // By ids first: the names' map only on a pair's first contact.
+    PairContactStats*& cached = contact_stats_by_id_[{pair.a, pair.b}];
+    if (!cached) {
+      const auto key = names(pair);
+      auto it = contact_stats_.find(key);
+      if (it == contact_stats_.end()) {
+        it = contact_stats_.emplace(key, PairContactStats{key.first, key.second}).first;
+        it->second.first_frame = frame_;
+      }
+      cached = &it->second;
     }
-    PairContactStats& s = it->second;
+    PairContactStats& s = *cached;
     ++s.frames_in_contact;
     s.last_frame = frame_;
     s.max_contacts = std::max<std::uint64_t>(s.max_contacts, j - i);
@@ -252,7 +272,11 @@ const FrameResult& Simulation::step() {
   // 6. Events: differences from the last frame.
   contact_events(result, events, now);
   // Removed parts' pairs have ended now; their names are no longer needed.
-  for (const collision::PartId id : removed_) collision_names_.erase(id);
+  for (const collision::PartId id : removed_) {
+    collision_names_.erase(id);
+    std::erase_if(contact_stats_by_id_,
+                  [id](const auto& kv) { return kv.first.first == id || kv.first.second == id; });
+  }
   removed_.clear();
   timer_events(events, now);
   region_events(events, now);

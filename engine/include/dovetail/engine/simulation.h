@@ -189,8 +189,12 @@ class Simulation {
   /// The scene name of every part in the collision world.
   std::map<collision::PartId, std::string> collision_names_;
   std::vector<collision::PartId> removed_;  ///< removed since the last collision step
+  std::vector<PartId> by_name_;  ///< the scene's parts sorted by name (empty: to be sorted)
+  std::vector<bool> moved_;      ///< per scene slot: moved in this frame's commit
   /// Contact statistics by (a, b) names.
   std::map<std::pair<std::string, std::string>, PairContactStats> contact_stats_;
+  /// The same statistics by the pair's collision ids, while both parts live.
+  std::map<std::pair<collision::PartId, collision::PartId>, PairContactStats*> contact_stats_by_id_;
   /// Pair plans by (a, b) names, kept after a part is removed.
   std::map<std::pair<std::string, std::string>, PairPlanReport> plans_;
   std::uint64_t plans_version_ = 0;
