@@ -59,9 +59,12 @@ void EventBus::publish(std::vector<Event>& events) {
   // Sorted as by event_less, comparing names only where needed: by frame and
   // kind first, then each run of one kind by its names unless it is in order
   // already (the simulation emits part moves by name).
-  std::stable_sort(events.begin(), events.end(), [](const Event& x, const Event& y) {
+  const auto by_kind = [](const Event& x, const Event& y) {
     return std::tie(x.frame, x.kind) < std::tie(y.frame, y.kind);
-  });
+  };
+  if (!std::is_sorted(events.begin(), events.end(), by_kind)) {
+    std::stable_sort(events.begin(), events.end(), by_kind);
+  }
   for (auto run = events.begin(); run != events.end();) {
     const auto end = std::find_if(run, events.end(), [&](const Event& e) {
       return e.frame != run->frame || e.kind != run->kind;

@@ -206,11 +206,16 @@ void Simulation::contact_events(const collision::StepResult& step, std::vector<E
 }
 
 void Simulation::timer_events(std::vector<Event>& events, double now) {
+  std::vector<Event> fired;
   for (Timer& timer : timers_) {
     if (timer.fired || now < timer.time) continue;
     timer.fired = true;
-    events.push_back({EventKind::kTimer, frame_, now, timer.name, {}});
+    fired.push_back({EventKind::kTimer, frame_, now, timer.name, {}});
   }
+  // In front, where their kind sorts: the bus then usually finds the frame's
+  // events in kind order already.
+  events.insert(events.begin(), std::make_move_iterator(fired.begin()),
+                std::make_move_iterator(fired.end()));
 }
 
 void Simulation::region_events(std::vector<Event>& events, double now) {
@@ -289,7 +294,6 @@ const FrameResult& Simulation::step() {
   state_hash_ = engine::state_hash(scene_);
   last_.frame = frame_;
   last_.time = now;
-  last_.events = events;
   last_.state_hash = state_hash_;
   last_.collision = result.stats;
   for (const Event& e : events) {
@@ -297,6 +301,7 @@ const FrameResult& Simulation::step() {
       report_.events.push_back(e);
     }
   }
+  last_.events = std::move(events);
   report_stale_ = true;
   ++frame_;
   report_.frames = frame_;
