@@ -11,8 +11,9 @@
 // (box_lanes_avx2.cpp) and is chosen at run time. Both forms compute every
 // value with the same IEEE operations in the same order, without fused
 // multiply-adds, and report the same axis: a query's counts and its first
-// hit do not depend on the processor. This header holds plain data only, so
-// that the AVX2 file shares no inline code with the rest of the library.
+// hit do not depend on the processor. This header holds plain data and one
+// function of internal linkage, so that the AVX2 file shares no inline code
+// with the rest of the library (the scalar form is in box_lanes_scalar.h).
 
 namespace dovetail::collision::detail {
 
