@@ -1,6 +1,7 @@
 // Engine benchmarks: headless simulation speed against real time.
 //
 //   engine_bench [--seconds S] [--runs R] [--assembly FILE] [--only engine|synthetic]
+//                [--broadphase sap|grid|octree|mbp|brute]
 //
 // 1. The 2-cylinder engine assembly (Debian's assimp-testmodels) simulated
 //    for S seconds at 90 Hz, four of its parts moving through and against the
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "bench_util.h"
+#include "dovetail/collision/broadphase.h"
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/pose_sampling.h"
 #include "dovetail/engine/scene.h"
@@ -27,6 +29,10 @@
 #include "engine_sweep.h"
 
 namespace {
+
+/// The object level of both scenes (--broadphase).
+dovetail::collision::BroadphaseMethod g_broadphase =
+    dovetail::collision::BroadphaseMethod::kSweepAndPrune;
 
 using dovetail::bench::EngineSweep;
 using dovetail::bench::load_engine_sweep;
@@ -39,6 +45,7 @@ using collision::Vec3;
 using Clock = std::chrono::steady_clock;
 
 struct RunResult {
+  double box_pairs = 0, convex_tests = 0, cached_planes = 0;        ///< per frame
   double polygon_pairs = 0, colliding_pairs = 0, volume_tests = 0;  ///< per frame
   double wall_s = 0;                                                ///< the stepping loop
   double prepare_s = 0;    ///< building hulls and hierarchies before the loop
@@ -61,6 +68,9 @@ RunResult run(engine::Simulation& sim, double seconds, Move&& move) {
   const auto t0 = Clock::now();
   for (std::uint64_t f = 0; f < frames; ++f) {
     const engine::FrameResult& fr = sim.step();
+    r.box_pairs += static_cast<double>(fr.collision.box_pairs) / frames;
+    r.convex_tests += static_cast<double>(fr.collision.convex_tests) / frames;
+    r.cached_planes += static_cast<double>(fr.collision.cached_planes) / frames;
     r.polygon_pairs += static_cast<double>(fr.collision.polygon_pairs) / frames;
     r.colliding_pairs += static_cast<double>(fr.collision.colliding_pairs) / frames;
     r.volume_tests += static_cast<double>(fr.collision.polygon.volume_tests) / frames;
@@ -90,8 +100,11 @@ void print(const char* name, std::size_t parts, double seconds,
       "contact events  hash %016llx\n",
       name, parts, seconds, wall, runs[0].frames / wall, seconds / wall, runs[0].contact_events,
       static_cast<unsigned long long>(runs[0].state_hash));
-  std::printf("%-28s per frame: %.1f polygon-level pairs, %.1f in contact, %.0f volume tests\n", "",
-              runs[0].polygon_pairs, runs[0].colliding_pairs, runs[0].volume_tests);
+  std::printf(
+      "%-28s per frame: %.1f overlapping boxes, %.1f separating-plane tests (%.1f settled by last "
+      "frame's plane), %.1f polygon-level pairs, %.1f in contact, %.0f volume tests\n",
+      "", runs[0].box_pairs, runs[0].convex_tests, runs[0].cached_planes, runs[0].polygon_pairs,
+      runs[0].colliding_pairs, runs[0].volume_tests);
   std::printf(
       "%-28s collision pipeline %.3f s of the wall time; set-up before the loop (hulls and "
       "hierarchies) %.3f s\n",
@@ -104,7 +117,8 @@ void engine_assembly(const std::string& path, double seconds, int runs) {
   for (int r = 0; r < runs; ++r) {
     EngineSweep sweep = load_engine_sweep(path);
     parts = sweep.with_mesh.size();
-    engine::Simulation sim(std::move(sweep.scene), {.collision_threads = 1});
+    engine::Simulation sim(std::move(sweep.scene),
+                           {.collision_threads = 1, .broadphase = g_broadphase});
     results.push_back(
         run(sim, seconds, [&](std::uint64_t, double t) { sweep.pose_at(sim.scene(), t); }));
   }
@@ -148,7 +162,7 @@ void synthetic(std::size_t n, double seconds, int runs) {
       handles.push_back(scene.add_part(
           {.name = name, .X_QP = pose[i], .render_mesh = shapes[i % shapes.size()]}));
     }
-    engine::Simulation sim(std::move(scene), {.collision_threads = 1});
+    engine::Simulation sim(std::move(scene), {.collision_threads = 1, .broadphase = g_broadphase});
     const Real dt = sim.settings().time_step;
     results.push_back(run(sim, seconds, [&](std::uint64_t, double) {
       for (std::size_t i = 0; i < n; ++i) {
@@ -181,7 +195,16 @@ int main(int argc, char** argv) {
           static_cast<int>(dovetail::bench::whole("engine_bench", "--runs", argv[i + 1], 1, 1000));
     else if (arg == "--assembly")
       assembly = argv[i + 1];
-    else if (arg == "--only")
+    else if (arg == "--broadphase") {
+      const auto method = dovetail::collision::parse_broadphase(argv[i + 1]);
+      if (!method) {
+        std::fprintf(stderr,
+                     "engine_bench: unknown broad phase %s (brute, sap, grid, octree, mbp)\n",
+                     argv[i + 1]);
+        return 2;
+      }
+      g_broadphase = *method;
+    } else if (arg == "--only")
       only = argv[i + 1];
     else {
       std::fprintf(stderr, "engine_bench: unknown option %s\n", arg.c_str());

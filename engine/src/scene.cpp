@@ -1,6 +1,7 @@
 #include "dovetail/engine/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -167,11 +168,24 @@ const Transform& Scene::local_pose(PartId part) const { return slot(part).X_QP; 
 void Scene::set_local_pose(PartId part, const Transform& X_QP) { slot(part).X_QP = X_QP; }
 
 Transform Scene::world_pose(PartId part) const {
-  // Iterative, root first, so a deep chain cannot exhaust the stack.
-  std::vector<const Slot*> chain;
-  for (PartId p = part; p.valid(); p = slot(p).parent) chain.push_back(&slot(p));
-  Transform X_WP = chain.back()->X_QP;  // the root, in the world
-  for (std::size_t k = chain.size() - 1; k > 0; --k) X_WP = compose(X_WP, chain[k - 1]->X_QP);
+  const Slot& leaf = slot(part);
+  if (!leaf.parent.valid()) return leaf.X_QP;  // the common case: a part in the world
+  // Iterative, root first, so a deep chain cannot exhaust the stack; chains
+  // of up to 16 parts without an allocation.
+  std::array<const Slot*, 16> near;
+  std::vector<const Slot*> deep;
+  std::size_t depth = 0;
+  for (PartId p = part; p.valid(); p = slot(p).parent) {
+    if (depth == near.size()) deep.assign(near.begin(), near.end());
+    if (depth < near.size())
+      near[depth] = &slot(p);
+    else
+      deep.push_back(&slot(p));
+    ++depth;
+  }
+  const Slot* const* chain = depth <= near.size() ? near.data() : deep.data();
+  Transform X_WP = chain[depth - 1]->X_QP;  // the root, in the world
+  for (std::size_t k = depth - 1; k > 0; --k) X_WP = compose(X_WP, chain[k - 1]->X_QP);
   return X_WP;
 }
 

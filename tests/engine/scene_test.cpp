@@ -120,6 +120,25 @@ TEST(Scene, MovingAParentMovesItsChildren) {
   EXPECT_TRUE(scene.world_pose(gripper).t.isApprox(X_WG.t, 1e-12));
 }
 
+TEST(Scene, WorldPosesOfLongChainsComposeRootFirst) {
+  // Chains shorter and longer than the 16 parts world_pose keeps without an
+  // allocation: the pose is X_Q0 * X_Q1 * ... * X_QP composed from the root,
+  // bit for bit.
+  const std::vector<Transform> locals = collision::random_poses(40, 1.0, 11);
+  Scene scene;
+  std::string parent;
+  Transform expected;
+  for (std::size_t k = 0; k < locals.size(); ++k) {
+    const std::string name = "link" + std::to_string(k);
+    scene.add_part({.name = name, .parent = parent, .X_QP = locals[k]});
+    expected = k == 0 ? locals[0] : compose(expected, locals[k]);
+    const Transform X_WP = scene.world_pose(name);
+    EXPECT_EQ(X_WP.R, expected.R) << name;
+    EXPECT_EQ(X_WP.t, expected.t) << name;
+    parent = name;
+  }
+}
+
 TEST(Assembly, FileCamerasBecomeSceneCamerasInMetres) {
   AssemblyReport report;
   const Scene scene = load_assembly(kEngine, {}, &report);

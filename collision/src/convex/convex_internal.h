@@ -68,9 +68,9 @@ inline std::uint32_t hull_support(const ConvexHull& hull, const Vec3& d, std::ui
   Real value = dot(d, vertices[current]);
   const Real slack = 2 * dot_error_bound(d, hull.extent);
   for (;;) {
-    // Best neighbour by computed value (first one on ties).
+    // Highest neighbour by computed value (the first one on ties).
     std::uint32_t best = current;
-    Real best_value = value;
+    Real best_value = -std::numeric_limits<Real>::infinity();
     const std::uint32_t end = offsets[current + 1];
     for (std::uint32_t k = offsets[current]; k < end; ++k) {
       const Real f = dot(d, vertices[neighbors[k]]);

@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -186,15 +187,32 @@ class Simulation {
   std::vector<RegionState> regions_;
   /// Per scene slot: the registered part, if any.
   std::vector<std::unique_ptr<Registered>> registered_;
+  /// Hash of collision ids and of pairs of them, for the lookups below.
+  struct IdHash {
+    static std::uint64_t mix(std::uint64_t x) {
+      x ^= x >> 31;
+      x *= 0x7fb5d329728ea185ull;
+      x ^= x >> 27;
+      return x;
+    }
+    static std::uint64_t word(collision::PartId id) {
+      return (std::uint64_t{id.index} << 32) | id.generation;
+    }
+    std::size_t operator()(collision::PartId id) const { return mix(word(id)); }
+    std::size_t operator()(const std::pair<collision::PartId, collision::PartId>& p) const {
+      return mix(word(p.first) ^ mix(word(p.second)));
+    }
+  };
   /// The scene name of every part in the collision world.
-  std::map<collision::PartId, std::string> collision_names_;
+  std::unordered_map<collision::PartId, std::string, IdHash> collision_names_;
   std::vector<collision::PartId> removed_;  ///< removed since the last collision step
   std::vector<PartId> by_name_;  ///< the scene's parts sorted by name (empty: to be sorted)
   std::vector<bool> moved_;      ///< per scene slot: moved in this frame's commit
   /// Contact statistics by (a, b) names.
   std::map<std::pair<std::string, std::string>, PairContactStats> contact_stats_;
   /// The same statistics by the pair's collision ids, while both parts live.
-  std::map<std::pair<collision::PartId, collision::PartId>, PairContactStats*> contact_stats_by_id_;
+  std::unordered_map<std::pair<collision::PartId, collision::PartId>, PairContactStats*, IdHash>
+      contact_stats_by_id_;
   /// Pair plans by (a, b) names, kept after a part is removed.
   std::map<std::pair<std::string, std::string>, PairPlanReport> plans_;
   std::uint64_t plans_version_ = 0;
