@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <tuple>
 #include <utility>
 
 namespace dovetail::engine {
@@ -318,7 +319,12 @@ const Report& Simulation::report() const {
     report_.contacts.clear();
     for (const auto& [key, stats] : contact_stats_) report_.contacts.push_back(stats);
     report_.plans.clear();
+    report_.plans.reserve(plans_.size());
     for (const auto& [key, plan] : plans_) report_.plans.push_back(plan);
+    std::sort(report_.plans.begin(), report_.plans.end(),
+              [](const PairPlanReport& x, const PairPlanReport& y) {
+                return std::tie(x.a, x.b) < std::tie(y.a, y.b);
+              });
     report_stale_ = false;
   }
   return report_;

@@ -214,7 +214,15 @@ class Simulation {
   std::unordered_map<std::pair<collision::PartId, collision::PartId>, PairContactStats*, IdHash>
       contact_stats_by_id_;
   /// Pair plans by (a, b) names, kept after a part is removed.
-  std::map<std::pair<std::string, std::string>, PairPlanReport> plans_;
+  /// Hashed, not ordered: a crowded scene meets new pairs every frame; the
+  /// report sorts them by name when it is read.
+  struct NamePairHash {
+    std::size_t operator()(const std::pair<std::string, std::string>& p) const {
+      const std::size_t h = std::hash<std::string>{}(p.first);
+      return h ^ (std::hash<std::string>{}(p.second) + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2));
+    }
+  };
+  std::unordered_map<std::pair<std::string, std::string>, PairPlanReport, NamePairHash> plans_;
   std::uint64_t plans_version_ = 0;
   std::uint64_t frame_ = 0;
   bool paused_ = false;
