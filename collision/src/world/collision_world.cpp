@@ -17,6 +17,7 @@
 #include "dovetail/collision/task_system.h"
 #include "dovetail/collision/tri_tri.h"
 #include "polygon/hierarchy_common.h"
+#include "world/rotated_bounds.h"
 
 namespace dovetail::collision {
 
@@ -33,6 +34,9 @@ struct Shape {
   /// Convex level and tight world boxes of moving parts: built when a pair
   /// of the part is first tested, not before.
   std::shared_ptr<const ConvexHull> hull;
+  /// A small hull's vertices by coordinate (every x, then every y, then
+  /// every z), for its world boxes; empty for a large hull.
+  std::vector<Real> small_hull;
   bool hull_failed = false;  ///< flat part: no hull, conservative boxes
   /// Closed and on its hull (surface_on_hull): the hull is the part. Decided
   /// with the hull, when a tolerance asks for it.
@@ -153,6 +157,13 @@ struct CollisionWorld::Impl {
     try {
       shape.hull = std::make_shared<const ConvexHull>(
           compute_convex_hull(shape.mesh->vertices, shape.mesh->source));
+      const std::vector<Vec3>& v = shape.hull->vertices;
+      if (v.size() <= kSmallHull) {
+        shape.small_hull.resize(3 * v.size());
+        for (std::size_t i = 0; i < v.size(); ++i) {
+          for (int k = 0; k < 3; ++k) shape.small_hull[k * v.size() + i] = v[i][k];
+        }
+      }
     } catch (const std::invalid_argument&) {
       shape.hull_failed = true;  // a flat part: conservative boxes, no convex level
     }
@@ -171,7 +182,15 @@ struct CollisionWorld::Impl {
 
   Method polygon_method() const { return settings.method.value_or(Method::kObb); }
 
-  /// The part's world box: extremal hull vertices found by walking from last
+  /// Hulls of at most this many vertices get their world boxes from all
+  /// their vertices, in one pass with six independent maxima: on a hull of
+  /// 30 vertices that takes a third of the time of six walks to the extremal
+  /// vertices, which wait on one comparison after another.
+  static constexpr std::size_t kSmallHull = 64;
+
+  /// The part's world box: for a small hull the bounds of its vertices,
+  /// rotated (each coordinate as one row of R times the vertex) and then
+  /// moved; for a larger one extremal hull vertices found by walking from last
   /// step's; without a hull (none built yet, or a flat part), the box of the
   /// transformed vertices for a fixed part (it moves seldom; the same box the
   /// hull would give) and the transformed local box for a moving one; widened
@@ -189,6 +208,14 @@ struct CollisionWorld::Impl {
         box.min = box.min.cwiseMin(v_W);
         box.max = box.max.cwiseMax(v_W);
       }
+    } else if (!shape.small_hull.empty() && X.R.allFinite()) {
+      const std::size_t n = shape.hull->vertices.size();
+      const Real* x = shape.small_hull.data();
+      const Real* y = x + n;
+      const Real* z = y + n;
+      const auto [lo, hi] = detail::rotated_bounds(X.R, x, y, z, n);
+      box.max = hi + X.t;
+      box.min = lo + X.t;
     } else if (shape.hull) {
       for (int k = 0; k < 3; ++k) {
         const Vec3 d_P = X.R.row(k).transpose();  // world axis k in the part's frame
