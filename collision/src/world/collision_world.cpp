@@ -385,40 +385,43 @@ struct CollisionWorld::Impl {
     if (w.state->has_witness) w.state->witness = w.result.pairs.front();
   }
 
-  /// Exact test of one triangle pair at a pose (B's vertices mapped by
-  /// Transform::apply, as the hierarchies do).
-  static bool pair_intersects(const Mesh& a, const Mesh& b, const Transform& X_AB,
-                              const TrianglePair& t) {
-    const TriangleIndices& ta = a.triangles[t.a];
-    const TriangleIndices& tb = b.triangles[t.b];
-    return triangles_intersect(a.vertices[ta[0]], a.vertices[ta[1]], a.vertices[ta[2]],
-                               X_AB.apply(b.vertices[tb[0]]), X_AB.apply(b.vertices[tb[1]]),
-                               X_AB.apply(b.vertices[tb[2]]));
-  }
-
   /// Follows last step's contact: the witness pair itself, then each of its
   /// triangles against the triangles around the other's vertices (the
   /// contact usually moves to a neighbour). On success `witness` is the pair
   /// found. A hit is a proof; a miss proves nothing and the caller traverses.
+  /// B's vertices are mapped by Transform::apply, as the hierarchies do; the
+  /// witness's own B triangle once for all of A's candidates.
   static bool follow_witness(const Shape& a, const Shape& b, const Transform& X_AB,
                              TrianglePair& witness, std::uint64_t& tests) {
-    ++tests;
-    if (pair_intersects(*a.mesh, *b.mesh, X_AB, witness)) return true;
+    const Mesh& mesh_a = *a.mesh;
+    const Mesh& mesh_b = *b.mesh;
+    const auto corners_b = [&](std::uint32_t t) {
+      const TriangleIndices& tb = mesh_b.triangles[t];
+      return std::array<Vec3, 3>{X_AB.apply(mesh_b.vertices[tb[0]]),
+                                 X_AB.apply(mesh_b.vertices[tb[1]]),
+                                 X_AB.apply(mesh_b.vertices[tb[2]])};
+    };
+    const auto hits = [&](std::uint32_t t, const std::array<Vec3, 3>& q) {
+      ++tests;
+      const TriangleIndices& ta = mesh_a.triangles[t];
+      return triangles_intersect(mesh_a.vertices[ta[0]], mesh_a.vertices[ta[1]],
+                                 mesh_a.vertices[ta[2]], q[0], q[1], q[2]);
+    };
     const TrianglePair last = witness;
-    for (std::uint32_t v : a.mesh->triangles[last.a]) {
+    const std::array<Vec3, 3> last_b = corners_b(last.b);
+    if (hits(last.a, last_b)) return true;
+    for (std::uint32_t v : mesh_a.triangles[last.a]) {
       for (std::uint32_t k = a.around.offsets[v]; k < a.around.offsets[v + 1]; ++k) {
-        const TrianglePair candidate{a.around.triangles[k], last.b};
-        if (candidate.a == last.a) continue;
-        ++tests;
-        if (pair_intersects(*a.mesh, *b.mesh, X_AB, candidate)) return witness = candidate, true;
+        const std::uint32_t t = a.around.triangles[k];
+        if (t == last.a) continue;
+        if (hits(t, last_b)) return witness = {t, last.b}, true;
       }
     }
-    for (std::uint32_t v : b.mesh->triangles[last.b]) {
+    for (std::uint32_t v : mesh_b.triangles[last.b]) {
       for (std::uint32_t k = b.around.offsets[v]; k < b.around.offsets[v + 1]; ++k) {
-        const TrianglePair candidate{last.a, b.around.triangles[k]};
-        if (candidate.b == last.b) continue;
-        ++tests;
-        if (pair_intersects(*a.mesh, *b.mesh, X_AB, candidate)) return witness = candidate, true;
+        const std::uint32_t t = b.around.triangles[k];
+        if (t == last.b) continue;
+        if (hits(last.a, corners_b(t))) return witness = {last.a, t}, true;
       }
     }
     return false;
