@@ -1,11 +1,12 @@
 // Engine benchmarks: headless simulation speed against real time.
 //
 //   engine_bench [--seconds S] [--runs R] [--assembly FILE] [--only engine|synthetic]
-//                [--broadphase sap|grid|octree|mbp|brute]
+//                [--broadphase sap|grid|octree|mbp|brute] [--threads N]
 //
 // 1. The 2-cylinder engine assembly (Debian's assimp-testmodels) simulated
 //    for S seconds at 90 Hz, four of its parts moving through and against the
-//    others, everything else fixed, every pair decided exactly, one thread.
+//    others, everything else fixed, every pair decided exactly, one collision
+//    thread (--threads N: N).
 // 2. A synthetic scene of 1,000 moving parts (convex polytopes of about 56
 //    faces tumbling in a box), the same way.
 // Reports wall time, frames per second and the real-time factor (simulated
@@ -33,6 +34,8 @@ namespace {
 /// The object level of both scenes (--broadphase).
 dovetail::collision::BroadphaseMethod g_broadphase =
     dovetail::collision::BroadphaseMethod::kSweepAndPrune;
+/// Collision worker threads of both scenes (--threads).
+int g_threads = 1;
 
 using dovetail::bench::EngineSweep;
 using dovetail::bench::load_engine_sweep;
@@ -118,7 +121,7 @@ void engine_assembly(const std::string& path, double seconds, int runs) {
     EngineSweep sweep = load_engine_sweep(path);
     parts = sweep.with_mesh.size();
     engine::Simulation sim(std::move(sweep.scene),
-                           {.collision_threads = 1, .broadphase = g_broadphase});
+                           {.collision_threads = g_threads, .broadphase = g_broadphase});
     results.push_back(
         run(sim, seconds, [&](std::uint64_t, double t) { sweep.pose_at(sim.scene(), t); }));
   }
@@ -162,7 +165,8 @@ void synthetic(std::size_t n, double seconds, int runs) {
       handles.push_back(scene.add_part(
           {.name = name, .X_QP = pose[i], .render_mesh = shapes[i % shapes.size()]}));
     }
-    engine::Simulation sim(std::move(scene), {.collision_threads = 1, .broadphase = g_broadphase});
+    engine::Simulation sim(std::move(scene),
+                           {.collision_threads = g_threads, .broadphase = g_broadphase});
     const Real dt = sim.settings().time_step;
     results.push_back(run(sim, seconds, [&](std::uint64_t, double) {
       for (std::size_t i = 0; i < n; ++i) {
@@ -193,6 +197,9 @@ int main(int argc, char** argv) {
     else if (arg == "--runs")
       runs =
           static_cast<int>(dovetail::bench::whole("engine_bench", "--runs", argv[i + 1], 1, 1000));
+    else if (arg == "--threads")
+      g_threads = static_cast<int>(
+          dovetail::bench::whole("engine_bench", "--threads", argv[i + 1], 1, 256));
     else if (arg == "--assembly")
       assembly = argv[i + 1];
     else if (arg == "--broadphase") {

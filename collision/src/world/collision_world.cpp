@@ -684,7 +684,7 @@ struct CollisionWorld::Impl {
     //    per mesh); then the polygon level in parallel over pairs (coarse
     //    grain), with heavy pairs each split over the threads (fine grain).
     //    Either way each pair's result is the same.
-    tasks->parallel_for(work.size(), 1, [&](std::size_t begin, std::size_t end) {
+    tasks->parallel_for(work.size(), 16, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) evaluate_coarse(work[i]);
     });
     build_models_for_polygon_pairs();
