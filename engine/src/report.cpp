@@ -45,10 +45,17 @@ std::uint64_t state_hash(const Scene& scene) {
   };
   for (const PartId part : scene.parts()) {
     const std::string& name = scene.name(part);
+    // Eight bytes a word, the first in the lowest byte, zero-padded (a
+    // name of a multiple of eight bytes ends with a zero word).
     for (std::size_t i = 0; i <= name.size(); i += 8) {
+      const std::size_t take = std::min<std::size_t>(8, name.size() - i);
       std::uint64_t w = 0;
-      for (std::size_t k = 0; k < 8 && i + k < name.size(); ++k) {
-        w |= std::uint64_t{static_cast<unsigned char>(name[i + k])} << (8 * k);
+      if constexpr (std::endian::native == std::endian::little) {
+        std::memcpy(&w, name.data() + i, take);
+      } else {
+        for (std::size_t k = 0; k < take; ++k) {
+          w |= std::uint64_t{static_cast<unsigned char>(name[i + k])} << (8 * k);
+        }
       }
       word(w);
     }
