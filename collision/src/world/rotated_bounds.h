@@ -2,7 +2,9 @@
 // The bounds of a small point set rotated by R, for the world boxes of parts
 // with small hulls: every coordinate is one row of R times the point,
 // (R(k,0) x + R(k,1) y) + R(k,2) z, and the bounds are exact minima and
-// maxima of those doubles, so the two forms below give the same values.
+// maxima of those doubles, so the two forms below give equal values (a
+// zero bound may differ in sign between them; one build always uses the
+// same form).
 
 #include <limits>
 #include <utility>
