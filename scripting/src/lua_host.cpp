@@ -25,6 +25,16 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+/// Whether `where` ("chunk:line: " or "chunk: ") has a line.
+bool has_line(const char* where) {
+  std::size_t n = std::strlen(where);
+  if (n < 4 || where[n - 1] != ' ' || where[n - 2] != ':') return false;
+  n -= 2;
+  std::size_t digits = 0;
+  while (n > 0 && where[n - 1] >= '0' && where[n - 1] <= '9') --n, ++digits;
+  return digits > 0 && n > 0 && where[n - 1] == ':';
+}
+
 // The allocator of the state: counts every byte and, while a host call runs,
 // refuses growth beyond the cap (Lua then collects garbage and retries once,
 // and raises a memory error if that does not help).
@@ -46,6 +56,17 @@ void* allocate(void* data, void* block, std::size_t old_size, std::size_t new_si
       if (host.refusal_pending && host.refused_old == held && host.refused_new == new_size &&
           host.active()) {
         host.memory_failed = true;
+        // A script that fails before the count hook first fires (a string
+        // doubled twenty times) has no location yet: take the main thread's
+        // position now. Lua saves it before any step that can allocate, and
+        // reading the stack allocates nothing. The hook's location is kept
+        // when there is one: in a coroutine it names the coroutine's line,
+        // the main thread only the line that resumed it.
+        if (host.L != nullptr && !has_line(host.where)) {
+          char here[sizeof(host.where)];
+          write_where(host.L, 0, here, sizeof(here));
+          if (here[0] != '\0') std::memcpy(host.where, here, sizeof(here));
+        }
       }
       host.refusal_pending = true;
       host.refused_old = held;
@@ -222,20 +243,6 @@ void note_memory_error(HostState& host, lua_State* L) {
   host.memory_failed = true;
   limit_exhausted(host, L);
 }
-
-namespace {
-
-/// Whether `where` ("chunk:line: " or "chunk: ") has a line.
-bool has_line(const char* where) {
-  std::size_t n = std::strlen(where);
-  if (n < 4 || where[n - 1] != ' ' || where[n - 2] != ':') return false;
-  n -= 2;
-  std::size_t digits = 0;
-  while (n > 0 && where[n - 1] >= '0' && where[n - 1] <= '9') --n, ++digits;
-  return digits > 0 && n > 0 && where[n - 1] == ':';
-}
-
-}  // namespace
 
 bool limit_exhausted(HostState& host, lua_State* L) {
   if (host.memory_failed && !host.exhausted) {

@@ -398,6 +398,17 @@ TEST(LuaHostMemory, TableGrowthBombHitsTheCap) {
   expect_works(host);
 }
 
+TEST(LuaHostMemory, AFailureBeforeTheFirstHookNamesItsLine) {
+  // Twenty-odd doublings reach the cap long before the count hook first
+  // fires: the line comes from where the script is when the cap is hit.
+  LuaHost host(small_limits(), 1);
+  const ScriptError error = run_error(host, "local s = 'x'\n\nwhile true do s = s .. s end");
+  EXPECT_EQ(error.kind(), Kind::kMemory);
+  EXPECT_EQ(error.message().rfind("script.lua:3: memory limit of 16777216 bytes exceeded", 0), 0u)
+      << error.what();
+  expect_works(host);
+}
+
 TEST(LuaHostMemory, PcallCannotSwallowIt) {
   SandboxLimits limits = small_limits();
   limits.instructions_per_call = 20'000'000;  // the cap must come first
