@@ -109,10 +109,9 @@ void Simulation::commit(std::vector<Event>& events, double now) {
         removed_.push_back(r->id);
       }
       r.reset();
-      by_name_.clear();  // a part gone: sorted again below
     }
   }
-  moved_.assign(registered_.size(), false);
+  // In name order (Scene::parts), so the part moves reach the bus sorted.
   for (const PartId part : scene_.parts()) {
     const Transform X_WP = scene_.world_pose(part);
     if (part.index >= registered_.size()) registered_.resize(part.index + 1);
@@ -121,7 +120,6 @@ void Simulation::commit(std::vector<Event>& events, double now) {
       r = std::make_unique<Registered>();
       r->handle = part;
       r->X_WP = X_WP;
-      by_name_.clear();  // a new part: sorted again below
       const auto& mesh = scene_.collision_mesh(part);
       if (mesh) {
         r->id = world_->add_part({.mesh = mesh,
@@ -147,19 +145,7 @@ void Simulation::commit(std::vector<Event>& events, double now) {
     if (same_bits(r->X_WP, X_WP)) continue;
     r->X_WP = X_WP;
     if (r->id.valid()) world_->set_pose(r->id, X_WP);
-    if (part.index >= moved_.size()) moved_.resize(part.index + 1, false);
-    moved_[part.index] = true;
-  }
-  // Part moves by name, so that the bus finds them in order.
-  if (by_name_.size() != scene_.part_count()) {
-    by_name_ = scene_.parts();
-    std::sort(by_name_.begin(), by_name_.end(),
-              [&](PartId x, PartId y) { return scene_.name(x) < scene_.name(y); });
-  }
-  for (const PartId part : by_name_) {
-    if (part.index < moved_.size() && moved_[part.index]) {
-      events.push_back({EventKind::kPartMoved, frame_, now, scene_.name(part), {}});
-    }
+    events.push_back({EventKind::kPartMoved, frame_, now, scene_.name(part), {}});
   }
 }
 

@@ -80,6 +80,11 @@ struct PairState {
   std::uint64_t plan_version = 0;  ///< plans_version right after the plan was made
 };
 
+void sort_by_pair(std::vector<PairPlan>& plans) {
+  std::sort(plans.begin(), plans.end(),
+            [](const PairPlan& x, const PairPlan& y) { return x.pair < y.pair; });
+}
+
 std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
   if (a > b) std::swap(a, b);
   return (static_cast<std::uint64_t>(a) << 32) | b;
@@ -827,8 +832,7 @@ std::vector<PairPlan> CollisionWorld::plans() const {
   for (const auto& [key, state] : impl_->pair_states) {
     if (state.planned) out.push_back(state.plan);
   }
-  std::sort(out.begin(), out.end(),
-            [](const PairPlan& x, const PairPlan& y) { return x.pair < y.pair; });
+  sort_by_pair(out);
   return out;
 }
 
@@ -845,8 +849,7 @@ std::vector<PairPlan> CollisionWorld::plans_since(std::uint64_t version) const {
       out.push_back(it->second.plan);
     }
   }
-  std::sort(out.begin(), out.end(),
-            [](const PairPlan& x, const PairPlan& y) { return x.pair < y.pair; });
+  sort_by_pair(out);
   return out;
 }
 

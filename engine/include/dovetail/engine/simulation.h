@@ -206,8 +206,6 @@ class Simulation {
   /// The scene name of every part in the collision world.
   std::unordered_map<collision::PartId, std::string, IdHash> collision_names_;
   std::vector<collision::PartId> removed_;  ///< removed since the last collision step
-  std::vector<PartId> by_name_;  ///< the scene's parts sorted by name (empty: to be sorted)
-  std::vector<bool> moved_;      ///< per scene slot: moved in this frame's commit
   /// Contact statistics by (a, b) names.
   std::map<std::pair<std::string, std::string>, PairContactStats> contact_stats_;
   /// The same statistics by the pair's collision ids, while both parts live.
