@@ -397,44 +397,80 @@ struct CollisionWorld::Impl {
 
   /// Follows last step's contact: the witness pair itself, then each of its
   /// triangles against the triangles around the other's vertices (the
-  /// contact usually moves to a neighbour). On success `witness` is the pair
-  /// found. A hit is a proof; a miss proves nothing and the caller traverses.
-  /// B's vertices are mapped by Transform::apply, as the hierarchies do; the
-  /// witness's own B triangle once for all of A's candidates.
+  /// contact usually moves to a neighbour), each neighbour once, in the order
+  /// of the vertices. On success `witness` is the pair found. A hit is a
+  /// proof; a miss proves nothing and the caller traverses. B's vertices are
+  /// mapped by Transform::apply, as the hierarchies do; the witness's own B
+  /// triangle once for all of A's candidates. As in the hierarchies' leaves,
+  /// a pair whose bounding boxes (of the very coordinates the exact test
+  /// reads) are apart is rejected before the exact test, which alone counts
+  /// in `tests`.
   static bool follow_witness(const Shape& a, const Shape& b, const Transform& X_AB,
                              TrianglePair& witness, std::uint64_t& tests) {
     const Mesh& mesh_a = *a.mesh;
     const Mesh& mesh_b = *b.mesh;
+    const auto corners_a = [&](std::uint32_t t) {
+      const TriangleIndices& ta = mesh_a.triangles[t];
+      return Corners{mesh_a.vertices[ta[0]], mesh_a.vertices[ta[1]], mesh_a.vertices[ta[2]]};
+    };
     const auto corners_b = [&](std::uint32_t t) {
       const TriangleIndices& tb = mesh_b.triangles[t];
-      return std::array<Vec3, 3>{X_AB.apply(mesh_b.vertices[tb[0]]),
-                                 X_AB.apply(mesh_b.vertices[tb[1]]),
-                                 X_AB.apply(mesh_b.vertices[tb[2]])};
+      return Corners{X_AB.apply(mesh_b.vertices[tb[0]]), X_AB.apply(mesh_b.vertices[tb[1]]),
+                     X_AB.apply(mesh_b.vertices[tb[2]])};
     };
-    const auto hits = [&](std::uint32_t t, const std::array<Vec3, 3>& q) {
+    const auto hits = [&](const Corners& p, const Corners& q) {
+      if (!p.box_meets(q)) return false;
       ++tests;
-      const TriangleIndices& ta = mesh_a.triangles[t];
-      return triangles_intersect(mesh_a.vertices[ta[0]], mesh_a.vertices[ta[1]],
-                                 mesh_a.vertices[ta[2]], q[0], q[1], q[2]);
+      return triangles_intersect(p.v[0], p.v[1], p.v[2], q.v[0], q.v[1], q.v[2]);
     };
     const TrianglePair last = witness;
-    const std::array<Vec3, 3> last_b = corners_b(last.b);
-    if (hits(last.a, last_b)) return true;
-    for (std::uint32_t v : mesh_a.triangles[last.a]) {
-      for (std::uint32_t k = a.around.offsets[v]; k < a.around.offsets[v + 1]; ++k) {
-        const std::uint32_t t = a.around.triangles[k];
-        if (t == last.a) continue;
-        if (hits(t, last_b)) return witness = {t, last.b}, true;
+    const Corners last_a = corners_a(last.a);
+    const Corners last_b = corners_b(last.b);
+    if (hits(last_a, last_b)) return true;
+    bool found = false;
+    around_once(a, mesh_a, last.a, [&](std::uint32_t t) {
+      found = hits(corners_a(t), last_b);
+      if (found) witness = {t, last.b};
+      return found;
+    });
+    if (found) return true;
+    around_once(b, mesh_b, last.b, [&](std::uint32_t t) {
+      found = hits(last_a, corners_b(t));
+      if (found) witness = {last.a, t};
+      return found;
+    });
+    return found;
+  }
+
+  /// A triangle's corners and their bounding box.
+  struct Corners {
+    Corners(const Vec3& p, const Vec3& q, const Vec3& r)
+        : v{p, q, r}, lo(p.cwiseMin(q).cwiseMin(r)), hi(p.cwiseMax(q).cwiseMax(r)) {}
+    bool box_meets(const Corners& o) const {
+      return !((lo.array() > o.hi.array()).any() || (o.lo.array() > hi.array()).any());
+    }
+    std::array<Vec3, 3> v;
+    Vec3 lo, hi;
+  };
+
+  /// Calls visit(t) for every triangle other than `f` that shares a vertex
+  /// with it, once each, around f's first vertex, then its second, then its
+  /// third, until visit returns true.
+  template <typename Visit>
+  static void around_once(const Shape& shape, const Mesh& mesh, std::uint32_t f, Visit&& visit) {
+    const TriangleIndices& corners = mesh.triangles[f];
+    for (int i = 0; i < 3; ++i) {
+      const std::uint32_t v = corners[i];
+      for (std::uint32_t k = shape.around.offsets[v]; k < shape.around.offsets[v + 1]; ++k) {
+        const std::uint32_t t = shape.around.triangles[k];
+        if (t == f) continue;
+        // Met already around an earlier corner?
+        const TriangleIndices& tt = mesh.triangles[t];
+        const auto has = [&](std::uint32_t u) { return tt[0] == u || tt[1] == u || tt[2] == u; };
+        if ((i > 0 && has(corners[0])) || (i > 1 && has(corners[1]))) continue;
+        if (visit(t)) return;
       }
     }
-    for (std::uint32_t v : mesh_b.triangles[last.b]) {
-      for (std::uint32_t k = b.around.offsets[v]; k < b.around.offsets[v + 1]; ++k) {
-        const std::uint32_t t = b.around.triangles[k];
-        if (t == last.b) continue;
-        if (hits(last.a, corners_b(t))) return witness = {last.a, t}, true;
-      }
-    }
-    return false;
   }
 
   /// The polygon level of heavy pairs, each divided into parts, all parts of
