@@ -416,6 +416,58 @@ TEST(Broadphase, Deterministic) {
   }
 }
 
+TEST(Broadphase, PairsOfTwoFixedBoxesAreLeftOut) {
+  // Every method reports exactly the overlapping pairs of all boxes less
+  // those of two fixed ones, while the marks change between frames (a mark
+  // set before its box is added, on a box removed and added again, cleared).
+  for (BroadphaseMethod m : all_broadphases()) {
+    Scene scene({.name = "fixed", .objects = 200, .frames = 0, .clustered = true, .seed = 4});
+    Rng rng(17);
+    std::unique_ptr<Broadphase> bp = make_broadphase(m);
+    std::vector<std::uint8_t> in(scene.size(), 0);
+    std::vector<ProxyPair> out;
+    std::size_t left_out = 0;
+    for (int f = 0; f < 40; ++f) {
+      for (int k = 0; k < 10; ++k) {
+        const std::uint32_t id = rng.below(static_cast<std::uint32_t>(scene.size() + 5));
+        bp->set_fixed(id, rng.uniform() < 0.7);
+      }
+      in.resize(scene.size(), 0);
+      std::vector<ProxyPair> all;
+      std::vector<std::uint32_t> present;
+      for (std::uint32_t id = 0; id < scene.size(); ++id) {
+        if (!scene.present(id)) {
+          if (in[id]) bp->remove(id);
+          in[id] = 0;
+          continue;
+        }
+        if (in[id])
+          bp->move(id, scene.box(id));
+        else
+          bp->add(id, scene.box(id));
+        in[id] = 1;
+        present.push_back(id);
+      }
+      for (std::size_t i = 0; i < present.size(); ++i) {
+        for (std::size_t j = i + 1; j < present.size(); ++j) {
+          if (scene.box(present[i]).overlaps(scene.box(present[j]))) {
+            all.push_back({present[i], present[j]});
+          }
+        }
+      }
+      std::vector<ProxyPair> expected;
+      for (const ProxyPair& p : all) {
+        if (!(bp->fixed(p.a) && bp->fixed(p.b))) expected.push_back(p);
+      }
+      left_out += all.size() - expected.size();
+      bp->pairs(out);
+      ASSERT_EQ(out, expected) << broadphase_name(m) << " frame " << f;
+      scene.step();
+    }
+    EXPECT_GT(left_out, 100u) << broadphase_name(m);  // the marks were exercised
+  }
+}
+
 TEST(Broadphase, GridCellSize) {
   // Chosen from the boxes: twice the median size; re-chosen when sizes drift.
   UniformGrid grid;

@@ -199,12 +199,19 @@ TEST(CollisionWorld, LevelsOfDetailAndInterest) {
 TEST(CollisionWorld, FixedPartsAreNotTestedAgainstEachOther) {
   const auto box = share(make_box(Vec3(1, 1, 1)));
   CollisionWorld world;
-  world.add_part({.mesh = box, .X_WP = Transform::identity(), .movable = false});
-  world.add_part({.mesh = box, .X_WP = Transform::identity(), .movable = false});
+  const PartId a = world.add_part({.mesh = box, .X_WP = Transform::identity(), .movable = false});
+  const PartId b = world.add_part({.mesh = box, .X_WP = Transform::identity(), .movable = false});
   const StepResult& r = world.step();
-  EXPECT_EQ(r.stats.box_pairs, 1u);
+  // Not even reported by the broad phase: the boxes of two fixed parts.
+  EXPECT_EQ(r.stats.box_pairs, 0u);
   EXPECT_EQ(r.stats.tested_pairs, 0u);
   EXPECT_TRUE(r.colliding.empty());
+  // Unless the pair is asked for.
+  world.set_interest(a, b, true);
+  const StepResult& asked = world.step();
+  EXPECT_EQ(asked.stats.box_pairs, 1u);
+  EXPECT_EQ(asked.stats.tested_pairs, 1u);
+  EXPECT_EQ(asked.colliding.size(), 1u);
 }
 
 TEST(CollisionWorld, RemovedPartsEndTheirContactsAndGoStale) {

@@ -1,5 +1,6 @@
 #include "dovetail/collision/broadphase.h"
 
+#include <algorithm>
 #include <array>
 #include <stdexcept>
 
@@ -36,6 +37,25 @@ std::optional<BroadphaseMethod> parse_broadphase(std::string_view name) {
 }
 
 std::span<const BroadphaseMethod> all_broadphases() { return kBroadphases; }
+
+void Broadphase::set_fixed(ProxyId id, bool fixed) {
+  if (id >= fixed_.size()) {
+    if (!fixed) return;
+    fixed_.resize(std::size_t{id} + 1, 0);
+  }
+  const std::uint8_t mark = fixed ? 1 : 0;
+  if (fixed_[id] == mark) return;
+  fixed_[id] = mark;
+  if (fixed)
+    ++fixed_count_;
+  else
+    --fixed_count_;
+}
+
+void Broadphase::drop_fixed_pairs(std::vector<ProxyPair>& out) const {
+  if (fixed_count_ < 2) return;
+  std::erase_if(out, [this](const ProxyPair& p) { return both_fixed(p.a, p.b); });
+}
 
 std::unique_ptr<Broadphase> make_broadphase(BroadphaseMethod method,
                                             const BroadphaseSettings& settings) {

@@ -64,6 +64,7 @@ void BruteBroadphase::pairs(std::vector<ProxyPair>& out) {
       }
     }
   }
+  drop_fixed_pairs(out);
   last_stats_ = {};
   last_stats_.box_tests = n < 2 ? 0 : std::uint64_t{n} * (n - 1) / 2;
 }

@@ -314,6 +314,7 @@ void MultiBoxPruning::pairs(std::vector<ProxyPair>& out) {
   } else {
     find_pairs(sort_keys_.wide, bits, out);
   }
+  drop_fixed_pairs(out);
 
   // Next frame's order: each box where its first column holds it, then the big ones.
   order_.clear();

@@ -324,6 +324,7 @@ void Octree::pairs(std::vector<ProxyPair>& out) {
   found_ = 0;
   visit(0, 0, out);
   out.resize(found_);
+  drop_fixed_pairs(out);
   detail::sort_proxy_pairs(out, sort_keys_);
   last_stats_ = stats_;
   stats_ = {};

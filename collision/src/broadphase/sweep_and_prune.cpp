@@ -312,6 +312,7 @@ void SweepAndPrune::pairs(std::vector<ProxyPair>& out) {
   for (std::uint64_t key : overlapping_.keys()) {
     const ProxyId a = id_of_[key >> 32];
     const ProxyId b = id_of_[static_cast<std::uint32_t>(key)];
+    if (both_fixed(a, b)) continue;
     out.push_back(a < b ? ProxyPair{a, b} : ProxyPair{b, a});
   }
   detail::sort_proxy_pairs(out, sort_keys_);

@@ -344,6 +344,7 @@ void UniformGrid::pairs(std::vector<ProxyPair>& out) {
     }
   }
   stats_.box_tests += tests;
+  drop_fixed_pairs(out);
   detail::sort_proxy_pairs(out, sort_keys_);
   last_stats_ = stats_;
   stats_ = {};

@@ -810,6 +810,8 @@ PartId CollisionWorld::add_part(const PartDef& def) {
   p.level = def.level;
   p.name = def.name;
   p.alive = true;
+  // Pairs of fixed parts are of no interest unless a pair is set to be.
+  w.broadphase->set_fixed(index, !def.movable);
   return p.id;
 }
 
@@ -849,6 +851,11 @@ void CollisionWorld::set_interest(PartId a, PartId b, bool interested) {
   impl_->part(a);
   impl_->part(b);
   impl_->interest[pair_key(a.index, b.index)] = interested;
+  if (interested) {
+    // The broad phase must report the pair, even of two fixed parts.
+    impl_->broadphase->set_fixed(a.index, false);
+    impl_->broadphase->set_fixed(b.index, false);
+  }
 }
 
 void CollisionWorld::set_pair_level(PartId a, PartId b, LevelOfDetail level) {

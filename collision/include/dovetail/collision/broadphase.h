@@ -86,11 +86,30 @@ class Broadphase {
   /// Moves box `id` (present) to `box`.
   virtual void move(ProxyId id, const Aabb& box) = 0;
   /// Every overlapping pair of present boxes, sorted by (a, b), into `out`
-  /// (cleared first).
+  /// (cleared first), except pairs of two fixed boxes.
   virtual void pairs(std::vector<ProxyPair>& out) = 0;
 
   virtual std::size_t size() const = 0;
   virtual BroadphaseStats stats() const = 0;
+
+  /// Marks box `id` fixed, or not (every id starts not fixed). The mark
+  /// belongs to the id, present or not, until it is set again. A pair of two
+  /// fixed boxes is never reported: the pipeline marks the parts whose pairs
+  /// with each other it never tests, and their overlaps, in a packed
+  /// assembly most of them, are then not gathered and sorted every frame
+  /// only to be thrown away.
+  void set_fixed(ProxyId id, bool fixed);
+  bool fixed(ProxyId id) const { return id < fixed_.size() && fixed_[id] != 0; }
+
+ protected:
+  /// Whether pairs() leaves out the pair of a and b.
+  bool both_fixed(ProxyId a, ProxyId b) const { return fixed_count_ > 1 && fixed(a) && fixed(b); }
+  /// Removes the pairs of two fixed boxes from `out`, keeping the order of the rest.
+  void drop_fixed_pairs(std::vector<ProxyPair>& out) const;
+
+ private:
+  std::vector<std::uint8_t> fixed_;
+  std::size_t fixed_count_ = 0;
 };
 
 /// Makes an empty broad phase of `method`.

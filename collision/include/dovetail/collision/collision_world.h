@@ -149,7 +149,9 @@ std::string_view level_name(LevelOfDetail level);
 /// What one step did at each level.
 struct StepStats {
   std::size_t parts = 0;
-  std::size_t box_pairs = 0;         ///< overlapping world boxes (broad phase)
+  /// Overlapping world boxes (broad phase), leaving out pairs of two fixed
+  /// parts unless set_interest asked for such a pair.
+  std::size_t box_pairs = 0;
   std::size_t tested_pairs = 0;      ///< of those, pairs of interest
   std::size_t convex_tests = 0;      ///< separating-plane tests
   std::size_t convex_separated = 0;  ///< pairs the convex level proved apart
