@@ -37,35 +37,31 @@ double seconds_now() {
 
 }  // namespace
 
-std::uint64_t state_hash(const Scene& scene) {
-  std::uint64_t hash = kFnvOffset;
-  const auto word = [&hash](std::uint64_t w) {
-    hash = (hash ^ w) * 0x100000001b3ull;
-    hash ^= hash >> 32;
-  };
-  for (const PartId part : scene.parts()) {
-    const std::string& name = scene.name(part);
-    // Eight bytes a word, the first in the lowest byte, zero-padded (a
-    // name of a multiple of eight bytes ends with a zero word).
-    for (std::size_t i = 0; i <= name.size(); i += 8) {
-      const std::size_t take = std::min<std::size_t>(8, name.size() - i);
-      std::uint64_t w = 0;
-      if constexpr (std::endian::native == std::endian::little) {
-        std::memcpy(&w, name.data() + i, take);
-      } else {
-        for (std::size_t k = 0; k < take; ++k) {
-          w |= std::uint64_t{static_cast<unsigned char>(name[i + k])} << (8 * k);
-        }
+void StateHasher::add(std::string_view name, const collision::Transform& X_WP) {
+  // Eight bytes a word, the first in the lowest byte, zero-padded (a name of
+  // a multiple of eight bytes ends with a zero word).
+  for (std::size_t i = 0; i <= name.size(); i += 8) {
+    const std::size_t take = std::min<std::size_t>(8, name.size() - i);
+    std::uint64_t w = 0;
+    if constexpr (std::endian::native == std::endian::little) {
+      std::memcpy(&w, name.data() + i, take);
+    } else {
+      for (std::size_t k = 0; k < take; ++k) {
+        w |= std::uint64_t{static_cast<unsigned char>(name[i + k])} << (8 * k);
       }
-      word(w);
     }
-    const Transform X_WP = scene.world_pose(part);
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) word(std::bit_cast<std::uint64_t>(X_WP.R(r, c)));
-    }
-    for (int k = 0; k < 3; ++k) word(std::bit_cast<std::uint64_t>(X_WP.t(k)));
+    word(w);
   }
-  return hash;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) word(std::bit_cast<std::uint64_t>(X_WP.R(r, c)));
+  }
+  for (int k = 0; k < 3; ++k) word(std::bit_cast<std::uint64_t>(X_WP.t(k)));
+}
+
+std::uint64_t state_hash(const Scene& scene) {
+  StateHasher hasher;
+  for (const PartId part : scene.parts()) hasher.add(scene.name(part), scene.world_pose(part));
+  return hasher.value();
 }
 
 std::string Report::timings_json() const {

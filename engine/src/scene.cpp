@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -95,6 +96,7 @@ PartId Scene::add_part(const PartDef& desc) {
   s.collision_mesh = desc.collision_mesh ? desc.collision_mesh : desc.render_mesh;
   by_name_.insert(at, {desc.name, index});
   ++count_;
+  touch();
   return {index, s.generation};
 }
 
@@ -110,6 +112,7 @@ void Scene::remove_part(PartId part) {
   s.generation = generation;
   free_.push_back(part.index);
   --count_;
+  touch();
 }
 
 std::vector<PartId> Scene::parts() const {
@@ -161,11 +164,15 @@ void Scene::set_parent(PartId part, PartId parent, bool keep_world_pose) {
     }
   }
   slot(part).parent = parent;
+  touch();
   if (keep_world_pose) set_world_pose(part, X_WP);
 }
 
 const Transform& Scene::local_pose(PartId part) const { return slot(part).X_QP; }
-void Scene::set_local_pose(PartId part, const Transform& X_QP) { slot(part).X_QP = X_QP; }
+void Scene::set_local_pose(PartId part, const Transform& X_QP) {
+  slot(part).X_QP = X_QP;
+  touch();
+}
 
 Transform Scene::world_pose(PartId part) const {
   const Slot& leaf = slot(part);
@@ -192,6 +199,12 @@ Transform Scene::world_pose(PartId part) const {
 void Scene::set_world_pose(PartId part, const Transform& X_WP) {
   const PartId parent = slot(part).parent;
   slot(part).X_QP = parent.valid() ? compose(world_pose(parent).inverse(), X_WP) : X_WP;
+  touch();
+}
+
+void Scene::touch() {
+  static std::atomic<std::uint64_t> last{0};
+  revision_ = last.fetch_add(1, std::memory_order_relaxed) + 1;
 }
 
 bool Scene::movable(PartId part) const { return slot(part).movable; }

@@ -60,7 +60,7 @@ Simulation::Simulation(Scene scene, const SimulationSettings& settings)
                                .cross_check = settings_.cross_check});
   std::vector<Event> ignored;
   commit(ignored, 0);
-  state_hash_ = engine::state_hash(scene_);
+  state_hash_ = current_state_hash();
   report_.time_step = settings_.time_step;
   report_.parts = scene_.part_count();
   report_.state_hash = state_hash_;
@@ -111,9 +111,12 @@ void Simulation::commit(std::vector<Event>& events, double now) {
       r.reset();
     }
   }
-  // In name order (Scene::parts), so the part moves reach the bus sorted.
+  // In name order (Scene::parts), so the part moves reach the bus sorted,
+  // and the state hash is folded on the way.
+  StateHasher hasher;
   for (const PartId part : scene_.parts()) {
     const Transform X_WP = scene_.world_pose(part);
+    hasher.add(scene_.name(part), X_WP);
     if (part.index >= registered_.size()) registered_.resize(part.index + 1);
     std::unique_ptr<Registered>& r = registered_[part.index];
     if (!r) {
@@ -147,6 +150,12 @@ void Simulation::commit(std::vector<Event>& events, double now) {
     if (r->id.valid()) world_->set_pose(r->id, X_WP);
     events.push_back({EventKind::kPartMoved, frame_, now, scene_.name(part), {}});
   }
+  committed_hash_ = hasher.value();
+  committed_revision_ = scene_.revision();
+}
+
+std::uint64_t Simulation::current_state_hash() const {
+  return scene_.revision() == committed_revision_ ? committed_hash_ : engine::state_hash(scene_);
 }
 
 void Simulation::contact_events(const collision::StepResult& step, std::vector<Event>& events,
@@ -281,7 +290,7 @@ const FrameResult& Simulation::step() {
   bus_.publish(events);
 
   // 8. Output.
-  state_hash_ = engine::state_hash(scene_);
+  state_hash_ = current_state_hash();
   last_.frame = frame_;
   last_.time = now;
   last_.state_hash = state_hash_;

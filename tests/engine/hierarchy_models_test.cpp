@@ -29,8 +29,8 @@ std::shared_ptr<const collision::Mesh> load(const std::string& relative) {
 
 /// Random poses that keep B's centre near A's centre (within `spread` of the
 /// larger bounding-box diagonal), plus contact-distance poses.
-std::vector<Transform> poses_for(const collision::Mesh& a, const collision::Mesh& b, std::size_t count,
-                                 double spread, std::uint64_t seed) {
+std::vector<Transform> poses_for(const collision::Mesh& a, const collision::Mesh& b,
+                                 std::size_t count, double spread, std::uint64_t seed) {
   const collision::Bounds ba = collision::mesh_bounds(a), bb = collision::mesh_bounds(b);
   const double size = std::max((ba.max - ba.min).norm(), (bb.max - bb.min).norm());
   const collision::Vec3 ca = (ba.min + ba.max) / 2, cb = (bb.min + bb.max) / 2;
@@ -50,7 +50,8 @@ void expect_all_methods_match_brute(const std::shared_ptr<const collision::Mesh>
   collision::ContactPoseSettings settings;
   settings.directions = 60;
   settings.seed = 7;
-  for (const auto& s : collision::contact_distance_poses(*ma[0], *mb[0], settings)) poses.push_back(s.X_AB);
+  for (const auto& s : collision::contact_distance_poses(*ma[0], *mb[0], settings))
+    poses.push_back(s.X_AB);
 
   int colliding = 0, disagreements = 0;
   for (std::size_t p = 0; p < poses.size(); ++p) {
@@ -61,7 +62,8 @@ void expect_all_methods_match_brute(const std::shared_ptr<const collision::Mesh>
       const CollideResult all = ma[m]->collide(*mb[m], poses[p], {.all_pairs = true});
       if (first != reference.colliding || all.pairs != reference.pairs) {
         if (++disagreements <= 5) {
-          ADD_FAILURE() << scene << " pose " << p << " method " << collision::method_name(ma[m]->method());
+          ADD_FAILURE() << scene << " pose " << p << " method "
+                        << collision::method_name(ma[m]->method());
         }
       }
     }
@@ -75,7 +77,8 @@ void expect_all_methods_match_brute(const std::shared_ptr<const collision::Mesh>
 
 TEST(HierarchiesOnModels, SpiderAgainstItself) {
   const auto spider = load("OBJ/spider.obj");
-  expect_all_methods_match_brute(spider, spider, poses_for(*spider, *spider, 1200, 0.4, 61), "spider/spider");
+  expect_all_methods_match_brute(spider, spider, poses_for(*spider, *spider, 1200, 0.4, 61),
+                                 "spider/spider");
 }
 
 TEST(HierarchiesOnModels, SphereWithHoleAgainstSpider) {

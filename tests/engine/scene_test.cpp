@@ -120,6 +120,43 @@ TEST(Scene, MovingAParentMovesItsChildren) {
   EXPECT_TRUE(scene.world_pose(gripper).t.isApprox(X_WG.t, 1e-12));
 }
 
+TEST(Scene, RevisionChangesWithPartsParentsAndPoses) {
+  Scene scene;
+  std::set<std::uint64_t> seen{scene.revision()};
+  // Each of these changes names or poses: a new stamp every time.
+  const auto changed = [&](const char* what) {
+    EXPECT_TRUE(seen.insert(scene.revision()).second) << what;
+  };
+  scene.add_part({.name = "frame", .X_QP = translation(1, 0, 0)});
+  changed("add_part");
+  const PartId arm = scene.add_part({.name = "arm", .X_QP = translation(0, 2, 0)});
+  changed("add_part");
+  scene.set_local_pose(arm, translation(0, 3, 0));
+  changed("set_local_pose");
+  scene.set_local_pose(arm, translation(0, 3, 0));
+  changed("set_local_pose, the same pose");
+  scene.set_world_pose(arm, translation(0, 4, 0));
+  changed("set_world_pose");
+  scene.set_parent(arm, scene.get("frame"), false);
+  changed("set_parent");
+  // Tags, highlights and visibility are not in the state hash: no new stamp.
+  const std::uint64_t before = scene.revision();
+  scene.add_tag(arm, "grip");
+  scene.set_highlight(arm, std::array<float, 3>{1, 0, 0});
+  scene.set_visible(arm, false);
+  scene.set_movable(arm, false);
+  EXPECT_EQ(scene.revision(), before);
+  // A copy keeps the stamp until one of the two changes.
+  Scene copy = scene;
+  EXPECT_EQ(copy.revision(), scene.revision());
+  copy.set_local_pose(copy.get("arm"), translation(0, 5, 0));
+  EXPECT_NE(copy.revision(), scene.revision());
+  scene.set_local_pose(arm, translation(0, 5, 0));
+  EXPECT_NE(copy.revision(), scene.revision());  // the same poses, but stamped apart
+  scene.remove_part(arm);
+  changed("remove_part");
+}
+
 TEST(Scene, WorldPosesOfLongChainsComposeRootFirst) {
   // Chains shorter and longer than the 16 parts world_pose keeps without an
   // allocation: the pose is X_Q0 * X_Q1 * ... * X_QP composed from the root,

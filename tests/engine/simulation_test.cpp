@@ -219,6 +219,28 @@ TEST(Simulation, StateHashFollowsPosesBitForBit) {
   EXPECT_EQ(b.last_frame().state_hash, b.state_hash());
 }
 
+TEST(Simulation, StateHashSeesMovesMadeBySubscribers) {
+  // The hash folded while the poses are committed is used only while the
+  // scene is unchanged; a subscriber that moves a part during the frame
+  // changes the scene after the commit, and the hash must show it.
+  Simulation sim(test_scene());
+  int moves = 0;
+  sim.events().subscribe_all([&](const Event&) {
+    if (moves >= 3) return;
+    Transform X = sim.scene().local_pose(sim.scene().get("ball"));
+    X.t.z() += 0.25;
+    sim.scene().set_local_pose("ball", X);
+    ++moves;
+  });
+  sim.queue_pose({1, "ball", at(-5, 0, 0.5)});
+  for (int f = 0; f < 6; ++f) {
+    sim.step();
+    EXPECT_EQ(sim.state_hash(), state_hash(sim.scene())) << "frame " << f;
+    EXPECT_EQ(sim.last_frame().state_hash, sim.state_hash());
+  }
+  EXPECT_EQ(moves, 3);
+}
+
 /// The state hash recomputed from its definition in docs/engine.md,
 /// independently of the engine.
 std::uint64_t documented_state_hash(const Scene& scene, std::vector<std::string> names) {

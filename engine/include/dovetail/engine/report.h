@@ -14,8 +14,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "dovetail/collision/types.h"
 #include "dovetail/engine/events.h"
 
 namespace dovetail::engine {
@@ -89,6 +91,21 @@ inline constexpr std::uint64_t kFnvOffset = 0xcbf29ce484222325ull;
 /// doubles of its world pose (R row by row, then t) as IEEE-754 bit patterns.
 /// Each step is a bijection of h, so a change in any one bit changes it.
 std::uint64_t state_hash(const Scene& scene);
+
+/// The state hash folded one part at a time: add() every part in name order
+/// with its world pose, and value() is state_hash of that scene.
+class StateHasher {
+ public:
+  void add(std::string_view name, const collision::Transform& X_WP);
+  std::uint64_t value() const { return hash_; }
+
+ private:
+  void word(std::uint64_t w) {
+    hash_ = (hash_ ^ w) * 0x100000001b3ull;
+    hash_ ^= hash_ >> 32;
+  }
+  std::uint64_t hash_ = kFnvOffset;
+};
 
 /// Shows progress of a run on stderr: a bar redrawn in place on a terminal,
 /// otherwise a plain line "frame k/N" every few seconds.

@@ -90,6 +90,11 @@ class Scene {
   /// Live parts carrying `tag`, in name order.
   std::vector<PartId> parts_with_tag(std::string_view tag) const;
   std::size_t part_count() const { return count_; }
+  /// A stamp of the parts' names and poses: it changes whenever a part is
+  /// added or removed, re-parented or given a pose. Stamps are unique in the
+  /// process, so two scenes with the same stamp (a scene and its copy) have
+  /// the same parts, names and poses.
+  std::uint64_t revision() const { return revision_; }
 
   const std::string& name(PartId part) const;
   const std::vector<std::string>& tags(PartId part) const;
@@ -166,6 +171,9 @@ class Scene {
   /// (name, index) sorted by name: lookups by binary search, iteration in name order.
   std::vector<std::pair<std::string, std::uint32_t>> by_name_;
   std::size_t count_ = 0;
+  std::uint64_t revision_ = 0;
+  /// A new revision stamp, after a change of parts, parents or poses.
+  void touch();
   std::vector<NamedCamera> cameras_;
 };
 

@@ -161,6 +161,10 @@ class Simulation {
  private:
   struct Registered;
   void commit(std::vector<Event>& events, double now);
+  /// The state hash of the scene now: the one commit() folded while it read
+  /// every pose, unless the scene has changed since (subscribers may move
+  /// parts).
+  std::uint64_t current_state_hash() const;
   void contact_events(const collision::StepResult& step, std::vector<Event>& events, double now);
   void timer_events(std::vector<Event>& events, double now);
   void region_events(std::vector<Event>& events, double now);
@@ -225,6 +229,8 @@ class Simulation {
   std::uint64_t frame_ = 0;
   bool paused_ = false;
   std::uint64_t state_hash_ = 0;
+  std::uint64_t committed_hash_ = 0;                      ///< state hash of the scene commit() read
+  std::uint64_t committed_revision_ = ~std::uint64_t{0};  ///< Scene::revision() then; none yet
   FrameResult last_;
   /// The report; its contacts and plans are filled in by report() when a
   /// frame has passed since (report_stale_).
