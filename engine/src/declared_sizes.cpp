@@ -10,6 +10,8 @@
 #include <string_view>
 #include <vector>
 
+#include "obj_lines.h"
+
 namespace dovetail::engine::detail {
 
 namespace {
@@ -238,47 +240,6 @@ std::optional<std::string> check_binary_stl(std::string_view head, std::uintmax_
   return std::nullopt;
 }
 
-/// OBJ declares nothing; a file large enough to hold more vertex or face
-/// lines than the limits allow is counted line by line before parsing.
-std::optional<std::string> check_obj(const std::filesystem::path& path, std::uintmax_t file_size,
-                                     const collision::MeshLimits& limits) {
-  constexpr std::uintmax_t kMinLine = 8;  // "v 0 0 0\n", "f 1 2 3\n"
-  const std::uintmax_t most_lines = file_size / kMinLine + 1;
-  if (most_lines <= std::min(limits.max_vertices, limits.max_triangles)) return std::nullopt;
-
-  std::ifstream in(path, std::ios::binary);
-  std::vector<char> buffer(std::size_t{1} << 20);
-  std::uint64_t vertices = 0;
-  std::uint64_t faces = 0;
-  bool at_line_start = true;
-  char previous = '\0';  // first character of the line when it was 'v' or 'f'
-  while (in) {
-    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-    const std::size_t got = static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0));
-    for (std::size_t k = 0; k < got; ++k) {
-      const char c = buffer[k];
-      if (previous != '\0') {
-        if (c == ' ' || c == '\t') {
-          if (previous == 'v') ++vertices;
-          if (previous == 'f') ++faces;
-        }
-        previous = '\0';
-      }
-      if (at_line_start && (c == 'v' || c == 'f')) previous = c;
-      at_line_start = c == '\n';
-    }
-    if (vertices > limits.max_vertices) {
-      return "has more than " + std::to_string(limits.max_vertices) +
-             " vertex lines, over the limit";
-    }
-    if (faces > limits.max_triangles) {
-      return "has more than " + std::to_string(limits.max_triangles) +
-             " face lines, over the triangle limit";
-    }
-  }
-  return std::nullopt;
-}
-
 }  // namespace
 
 std::optional<std::string> check_declared_sizes(const std::filesystem::path& path,
@@ -297,7 +258,7 @@ std::optional<std::string> check_declared_sizes(const std::filesystem::path& pat
     return check_ply(head, file_size, limits);
   }
   if (extension == ".stl") return check_binary_stl(head, file_size, limits);
-  if (extension == ".obj") return check_obj(path, file_size, limits);
+  if (extension == ".obj") return check_obj_lines(path, limits);
   return std::nullopt;
 }
 

@@ -19,10 +19,11 @@
 namespace dovetail::engine::detail {
 
 /// Reads the start of `path` (its size is `file_size` bytes) and, for formats
-/// that declare counts (PLY, binary STL) or may hold more vertices than
-/// the limits (OBJ over a size threshold), returns what is wrong with the
-/// declared sizes; nullopt when nothing is wrong or the format is not one of
-/// these (the importer decides then).
+/// that declare counts (PLY, binary STL), returns what is wrong with the
+/// declared sizes; for OBJ, which declares nothing, what check_obj_lines
+/// (obj_lines.h) finds wrong with its vertex and face lines; nullopt when
+/// nothing is wrong or the format is none of these (the importer decides
+/// then).
 std::optional<std::string> check_declared_sizes(const std::filesystem::path& path,
                                                 std::uintmax_t file_size,
                                                 const collision::MeshLimits& limits);

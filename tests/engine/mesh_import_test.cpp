@@ -445,6 +445,58 @@ TEST(MeshImport, ObjWithMoreVertexLinesThanTheLimitIsRefusedBeforeParsing) {
   EXPECT_NE(message.find("more than 16 vertex lines"), std::string::npos) << message;
 }
 
+TEST(MeshImport, BadObjLinesAreNamedByLine) {
+  TempDir dir;
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  struct Case {
+    const char* name;
+    std::string text;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {"short_vertex", "v 0 0 0\nv 1 0 0\nv 0 1\nf 1 2 3\n",
+       "short_vertex.obj: line 3: a vertex needs three numbers (x y z), this one has 2: 'v 0 1'"},
+      {"word_in_vertex", "v 0 0 0\n# a comment\nv 1 x 0\nv 0 1 0\nf 1 2 3\n",
+       "word_in_vertex.obj: line 3: 'x' is not a number, in the vertex 'v 1 x 0'"},
+      {"comment_for_a_number", "v 0 0 0\nv 1 0 # 0\nv 0 1 0\nf 1 2 3\n",
+       "comment_for_a_number.obj: line 2: '#' is not a number"},
+      {"comment_after_a_face", tri + "f 1 2 3 # the only face\n",
+       "comment_after_a_face.obj: line 4: '#' is not a vertex number"},
+      {"indented_vertex", "v 0 0 0\nv 1 0 0\n  v 0 1 0\nf 1 2 3\n",
+       "indented_vertex.obj: line 3: '  v 0 1 0' is indented; a vertex line must start"},
+      {"indented_face", tri + "\tf 1 2 3\n", "indented_face.obj: line 4: '\tf 1 2 3' is indented"},
+      {"leading_point", "v 0 0 0\nv 1 0 0\nv .5 1 0\nv 5 5 5\nf 1 2 3\n",
+       "leading_point.obj: line 3: '.5' has no digit before its decimal point, in the vertex "
+       "'v .5 1 0'; the OBJ reader cannot read it: write 0.5"},
+      {"past_the_end", tri + "f 1 2 3\nf 1 2 7\nf 1 2 9\n",
+       "past_the_end.obj: line 5: a face refers to vertex 7, but the file has 3 vertices"},
+      {"relative_too_far", tri + "f 1 2 -4\n",
+       "relative_too_far.obj: line 4: the face 'f 1 2 -4' refers to vertex -4, but only 3 "
+       "vertices come before it"},
+      {"zero", tri + "f 0 1 2\n", "zero.obj: line 4: '0' is not a vertex number"},
+      {"word_in_face", tri + "f 1/1 2/1 three/1\n",
+       "word_in_face.obj: line 4: 'three/1' is not a vertex number"},
+  };
+  for (const Case& c : cases) {
+    write_file(dir / (std::string(c.name) + ".obj"), c.text);
+    const std::string message = import_error(dir / (std::string(c.name) + ".obj"));
+    EXPECT_NE(message.find(c.expected), std::string::npos) << c.name << ": " << message;
+  }
+}
+
+TEST(MeshImport, ObjLinesTheCheckLetThrough) {
+  // What OBJ allows and assimp reads: a weight or a colour after x y z,
+  // signs, exponents, a tab after the keyword, CRLF, a face before its
+  // vertices, relative corners, texture and normal numbers, comment lines.
+  TempDir dir;
+  write_file(dir / "forms.obj",
+             "# forms\r\nf 1/1/1 2/1/1 3/1/1\r\n"
+             "v 0 0 0 1\r\nv\t+1e0 0 0 0.5 0.5 0.5\r\nv 0 1. -0.0\r\nv -.5 +.5 2.E-1 # top\r\n"
+             "vt 0 0\r\nvn 0 0 1\r\nf -4//1 -3//1 -1//1\r\n");
+  const ImportReport report = import_file(dir / "forms.obj");
+  EXPECT_EQ(total_triangles(report), 2u);
+}
+
 // ---------------------------------------------------------------- transforms and parts
 
 /// A glTF scene: `nodes_json` placed over one triangle mesh named "tri" with

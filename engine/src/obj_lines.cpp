@@ -1,0 +1,149 @@
+#include "obj_lines.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cstdint>
+#include <fstream>
+#include <string_view>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+namespace dovetail::engine::detail {
+
+namespace {
+
+bool space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+/// The next word of `line` from `at` (empty at the end of the line); `at`
+/// moves past it. A '#' after the keyword is a word like any other: assimp
+/// reads no comment there (a face "f 1 2 3 # c" fails in it).
+std::string_view next_word(std::string_view line, std::size_t& at) {
+  while (at < line.size() && space(line[at])) ++at;
+  const std::size_t start = at;
+  while (at < line.size() && !space(line[at])) ++at;
+  return line.substr(start, at - start);
+}
+
+/// The whole word as a number, with an optional leading '+'.
+bool is_number(std::string_view word) {
+  const char* first = word.data();
+  const char* last = word.data() + word.size();
+  if (first != last && *first == '+') ++first;
+  double value = 0;
+  const auto [ptr, ec] = std::from_chars(first, last, value);
+  // Out of range (1e999) is a number: the mesh check calls it not finite.
+  return first != last && ptr == last &&
+         (ec == std::errc() || ec == std::errc::result_out_of_range);
+}
+
+/// The whole word as a vertex number (an integer, maybe negative), or
+/// nullopt.
+std::optional<std::int64_t> vertex_number(std::string_view word) {
+  const char* first = word.data();
+  const char* last = word.data() + word.size();
+  if (first != last && *first == '+') ++first;
+  std::int64_t value = 0;
+  const auto [ptr, ec] = std::from_chars(first, last, value);
+  if (first == last || ptr != last || ec != std::errc()) return std::nullopt;
+  return value;
+}
+
+std::string quoted(std::string_view text) {
+  constexpr std::size_t kLongest = 60;
+  std::string out(1, '\'');
+  out.append(text.substr(0, kLongest));
+  if (text.size() > kLongest) out.append("...");
+  out.push_back('\'');
+  return out;
+}
+
+std::string at_line(std::uint64_t line, const std::string& what) {
+  return "line " + std::to_string(line) + ": " + what;
+}
+
+}  // namespace
+
+std::optional<std::string> check_obj_lines(const std::filesystem::path& path,
+                                           const collision::MeshLimits& limits) {
+  std::ifstream in(path, std::ios::binary);
+  std::string text;
+  std::uint64_t line_number = 0;
+  std::uint64_t vertices = 0;
+  std::uint64_t faces = 0;
+  // Faces naming a vertex not defined yet (line, highest such vertex),
+  // checked at the end: a vertex may be defined further down.
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> ahead;
+  while (std::getline(in, text)) {
+    ++line_number;
+    const std::string_view line = text;
+    std::size_t at = 0;
+    const std::string_view keyword = next_word(line, at);
+    if ((keyword == "v" || keyword == "f") && space(line[0])) {
+      // assimp passes over such a line without a word.
+      return at_line(line_number, quoted(line) + " is indented; a " +
+                                      (keyword == "v" ? "vertex" : "face") +
+                                      " line must start at the beginning of the line");
+    }
+    if (keyword == "v") {
+      ++vertices;
+      if (vertices > limits.max_vertices) {
+        return "has more than " + std::to_string(limits.max_vertices) +
+               " vertex lines, over the limit";
+      }
+      for (int k = 0; k < 3; ++k) {
+        const std::string_view word = next_word(line, at);
+        if (word.empty()) {
+          return at_line(line_number, "a vertex needs three numbers (x y z), this one has " +
+                                          std::to_string(k) + ": " + quoted(line));
+        }
+        if (!is_number(word)) {
+          return at_line(line_number,
+                         quoted(word) + " is not a number, in the vertex " + quoted(line));
+        }
+        if (word.front() == '.') {
+          // assimp 5.2 drops such a line without a word, and every later
+          // vertex number then names the vertex after the one meant.
+          return at_line(line_number,
+                         quoted(word) + " has no digit before its decimal point, in the vertex " +
+                             quoted(line) + "; the OBJ reader cannot read it: write 0" +
+                             std::string(word));
+        }
+      }
+    } else if (keyword == "f") {
+      ++faces;
+      std::uint64_t highest = 0;
+      if (faces > limits.max_triangles) {
+        return "has more than " + std::to_string(limits.max_triangles) +
+               " face lines, over the triangle limit";
+      }
+      for (std::string_view word = next_word(line, at); !word.empty(); word = next_word(line, at)) {
+        const std::string_view corner = word.substr(0, word.find('/'));
+        const std::optional<std::int64_t> v = vertex_number(corner);
+        if (!v || *v == 0) {
+          return at_line(line_number, quoted(word) +
+                                          " is not a vertex number (1, 2, ... or -1, -2, ...), "
+                                          "in the face " +
+                                          quoted(line));
+        }
+        if (*v < 0 && static_cast<std::uint64_t>(-(*v + 1)) >= vertices) {
+          return at_line(line_number, "the face " + quoted(line) + " refers to vertex " +
+                                          std::to_string(*v) + ", but only " +
+                                          std::to_string(vertices) + " vertices come before it");
+        }
+        if (*v > 0) highest = std::max(highest, static_cast<std::uint64_t>(*v));
+      }
+      if (highest > vertices) ahead.emplace_back(line_number, highest);
+    }
+  }
+  if (in.bad()) return std::string("cannot be read");
+  for (const auto& [line, vertex] : ahead) {
+    if (vertex <= vertices) continue;
+    return at_line(line, "a face refers to vertex " + std::to_string(vertex) +
+                             ", but the file has " + std::to_string(vertices) +
+                             (vertices == 1 ? " vertex" : " vertices"));
+  }
+  return std::nullopt;
+}
+
+}  // namespace dovetail::engine::detail
