@@ -214,6 +214,43 @@ TEST(CollisionWorld, FixedPartsAreNotTestedAgainstEachOther) {
   EXPECT_EQ(asked.colliding.size(), 1u);
 }
 
+TEST(CollisionWorld, ACacheUntestedForLongIsForgottenAndThePlanKept) {
+  // A pair apart for 2,048 steps (its cache is freed by the first pass, every
+  // 1,024 steps, after 1,024 steps untested) cannot start GJK warm any more,
+  // keeps its plan, and is decided as before when it meets again.
+  const auto ring = share(make_torus(1.0, 0.2, 32, 12));
+  const auto ball = share(make_sphere(0.3, 2));
+  CollisionWorld world;
+  const PartId a = world.add_part({.mesh = ring, .X_WP = Transform::identity(), .movable = false});
+  Transform touching = Transform::identity();
+  touching.t = Vec3(1.0, 0, 0);  // the ball on the ring's tube
+  const PartId b = world.add_part({.mesh = ball, .X_WP = touching});
+  EXPECT_EQ(world.step().colliding.size(), 1u);
+  const PartDistanceRequest hull{.level = LevelOfDetail::kHull};
+  world.distance(a, b, hull);
+  EXPECT_TRUE(world.distance(a, b, hull).warm_started);
+  const std::vector<PairPlan> plans = world.plans();
+  ASSERT_EQ(plans.size(), 1u);
+
+  Transform far = Transform::identity();
+  far.t = Vec3(10, 0, 0);
+  world.set_pose(b, far);
+  for (int k = 0; k < 2100; ++k) EXPECT_TRUE(world.step().colliding.empty());
+  EXPECT_FALSE(world.distance(a, b, hull).warm_started);  // forgotten
+  EXPECT_EQ(world.plans(), plans);                        // kept
+
+  // A pair tested now and then keeps its cache.
+  world.set_pose(b, touching);
+  EXPECT_EQ(world.step().colliding.size(), 1u);
+  world.distance(a, b, hull);
+  for (int k = 0; k < 2100; ++k) {
+    world.distance(a, b, hull);
+    world.step();
+  }
+  EXPECT_TRUE(world.distance(a, b, hull).warm_started);
+  EXPECT_EQ(world.plans(), plans);
+}
+
 TEST(CollisionWorld, RemovedPartsEndTheirContactsAndGoStale) {
   const auto box = share(make_box(Vec3(1, 1, 1)));
   CollisionWorld world;

@@ -62,8 +62,9 @@ struct Part {
       extremal{};  ///< hull vertices extremal along +-x, +-y, +-z last step
 };
 
-/// Per-pair state kept across steps (temporal coherence of the convex level).
-struct PairState {
+/// What the last steps learned about a pair (temporal coherence). Only the
+/// work depends on it, never a verdict.
+struct PairCache {
   SeparatingPlaneCache plane;
   GjkCache gjk;
   /// First-hit mode: the triangle pair that intersected last step. Parts in
@@ -75,9 +76,37 @@ struct PairState {
   TraversalHint hint;
   /// The box pairs the last query found apart (PairPlan::front).
   SeparationFront front;
-  PairPlan plan;
+};
+
+/// A pair's plan as kept: a PairPlan whose reason is an index into the
+/// world's list of distinct reasons (a crowded scene plans a hundred
+/// thousand pairs with a handful of sentences).
+struct StoredPlan {
+  PartPair pair;
+  LevelOfDetail level = LevelOfDetail::kExact;
+  bool convex_level = false;
+  std::optional<Method> method{};
+  bool front = false;
+  Real max_size = 0;
+  std::uint32_t reason = 0;
+};
+
+/// Steps a pair may go untested before its cache is freed, by a pass every
+/// so many steps.
+constexpr std::uint64_t kForgetSteps = 1024;
+
+/// Per-pair state kept across steps: the plan for as long as both parts
+/// exist (plans() reports it), the cache while the pair is being tested. A
+/// crowded scene meets ever more pairs; their caches (about 1 kB each with a
+/// separation front) are freed once they have gone kForgetSteps steps
+/// untested, so only the plans (about 100 bytes a pair) grow with the pairs
+/// met.
+struct PairState {
+  StoredPlan plan;
   bool planned = false;
-  std::uint64_t plan_version = 0;  ///< plans_version right after the plan was made
+  std::uint64_t plan_version = 0;    ///< plans_version right after the plan was made
+  std::unique_ptr<PairCache> cache;  ///< null until tested, and once forgotten
+  std::uint64_t tested_at = 0;       ///< `steps` at its last test
 };
 
 void sort_by_pair(std::vector<PairPlan>& plans) {
@@ -125,6 +154,10 @@ struct CollisionWorld::Impl {
   std::unordered_map<std::uint64_t, bool> interest;
   std::unordered_map<std::uint64_t, LevelOfDetail> levels;
   std::unordered_map<std::uint64_t, PairState> pair_states;
+  /// The distinct reasons of the plans made (StoredPlan::reason), and their
+  /// indices; node-based, so the pointers stay valid.
+  std::vector<const std::string*> reasons;
+  std::unordered_map<std::string, std::uint32_t> reason_ids;
   std::vector<ProxyPair> candidates;
   std::vector<PairWork> work;
   StepResult result;
@@ -269,18 +302,53 @@ struct CollisionWorld::Impl {
     return *shape.convex;
   }
 
+  /// Frees the caches of the pairs not tested for kForgetSteps steps.
+  void forget_idle_caches() {
+    for (auto& [key, state] : pair_states) {
+      if (state.cache && state.tested_at + kForgetSteps <= steps) state.cache.reset();
+    }
+  }
+
   /// Plans a pair on its first test (serially: it may build the two hulls).
   void make_plan(const Part& a, const Part& b, PairState& state) {
-    PairPlan& plan = state.plan;
-    plan = PairPlan{.pair = {a.id, b.id}};
     state.planned = true;
     state.plan_version = ++plans_version;
     plan_log.emplace_back(plans_version, pair_key(a.id.index, b.id.index));
+    PairPlan plan = plan_for(a, b);
+    state.plan = {.pair = plan.pair,
+                  .level = plan.level,
+                  .convex_level = plan.convex_level,
+                  .method = plan.method,
+                  .front = plan.front,
+                  .max_size = plan.max_size,
+                  .reason = intern_reason(std::move(plan.reason))};
+  }
+
+  std::uint32_t intern_reason(std::string reason) {
+    const auto [it, added] =
+        reason_ids.emplace(std::move(reason), static_cast<std::uint32_t>(reasons.size()));
+    if (added) reasons.push_back(&it->first);
+    return it->second;
+  }
+
+  PairPlan to_plan(const StoredPlan& p) const {
+    return {.pair = p.pair,
+            .level = p.level,
+            .convex_level = p.convex_level,
+            .method = p.method,
+            .front = p.front,
+            .max_size = p.max_size,
+            .reason = *reasons[p.reason]};
+  }
+
+  /// The plan of a pair of parts a and b.
+  PairPlan plan_for(const Part& a, const Part& b) {
+    PairPlan plan{.pair = {a.id, b.id}};
     const LevelOfDetail asked = level_of(a, b);
     if (asked == LevelOfDetail::kBox) {
       plan.level = LevelOfDetail::kBox;
       plan.reason = "the scene asks for the box level: boxes that overlap are in contact";
-      return;
+      return plan;
     }
     ensure_hull(*a.shape);
     ensure_hull(*b.shape);
@@ -289,7 +357,7 @@ struct CollisionWorld::Impl {
       plan.level = LevelOfDetail::kHull;
       plan.convex_level = true;
       plan.reason = "the scene asks for the hull level: GJK on the convex hulls";
-      return;
+      return plan;
     }
     // GJK's touching band is kGjkContactTolerance of the pair's scale; a
     // tolerance far above it is kept by the hull level of convex parts.
@@ -301,7 +369,7 @@ struct CollisionWorld::Impl {
       plan.reason =
           "both parts are convex (closed, every triangle on the hull): the hulls are the parts, "
           "and GJK on them decides contact far within the tolerance";
-      return;
+      return plan;
     }
     plan.level = LevelOfDetail::kExact;
     plan.convex_level = hulls && settings.convex_level;
@@ -326,6 +394,7 @@ struct CollisionWorld::Impl {
                   : "; a part is not convex, and this hierarchy has no tolerance cut: exact";
     }
     plan.reason = std::move(why);
+    return plan;
   }
 
   /// Decides one pair up to the polygon level by its plan; returns whether
@@ -333,7 +402,8 @@ struct CollisionWorld::Impl {
   bool evaluate_coarse(PairWork& w) {
     const Part& a = parts[w.a];
     const Part& b = parts[w.b];
-    const PairPlan& plan = w.state->plan;
+    const StoredPlan& plan = w.state->plan;
+    PairCache& cache = *w.state->cache;
     if (plan.level == LevelOfDetail::kBox) {
       w.colliding = true;
       return false;
@@ -341,7 +411,7 @@ struct CollisionWorld::Impl {
     const Transform X_AB = relative(a.X_WP, b.X_WP);
     if (plan.convex_level) {
       const SeparatingPlaneResult separation =
-          separating_plane_test(*a.shape->hull, *b.shape->hull, X_AB, w.state->plane);
+          separating_plane_test(*a.shape->hull, *b.shape->hull, X_AB, cache.plane);
       w.convex_tested = true;
       w.cached_plane = separation.cache_hit;
       w.search_capped = separation.gave_up && !separation.overlap &&
@@ -351,7 +421,7 @@ struct CollisionWorld::Impl {
         return false;
       }
       if (plan.level == LevelOfDetail::kHull) {
-        const GjkResult g = gjk(*a.shape->hull, *b.shape->hull, X_AB, &w.state->gjk);
+        const GjkResult g = gjk(*a.shape->hull, *b.shape->hull, X_AB, &cache.gjk);
         w.colliding = g.intersecting;
         w.search_capped = w.search_capped || g.hit_iteration_cap;
         return false;
@@ -371,13 +441,13 @@ struct CollisionWorld::Impl {
     const Part& a = parts[w.a];
     const Part& b = parts[w.b];
     const Transform X_AB = relative(a.X_WP, b.X_WP);
+    PairCache& cache = *w.state->cache;
     CollideRequest request = polygon_request();
     request.max_size = w.state->plan.max_size;
-    if (!request.all_pairs && w.state->has_witness) {
+    if (!request.all_pairs && cache.has_witness) {
       std::uint64_t tests = 0;
-      if (follow_witness(*a.shape, *b.shape, X_AB, w.state->witness, tests)) {
-        w.result =
-            CollideResult{.colliding = true, .pairs = {w.state->witness}, .stats = {0, tests}};
+      if (follow_witness(*a.shape, *b.shape, X_AB, cache.witness, tests)) {
+        w.result = CollideResult{.colliding = true, .pairs = {cache.witness}, .stats = {0, tests}};
         w.colliding = true;
         return;
       }
@@ -385,14 +455,14 @@ struct CollisionWorld::Impl {
     }
     const std::uint64_t witness_tests = w.result.stats.triangle_tests;
     CollideRequest hinted = request;
-    if (!request.all_pairs) hinted.hint = &w.state->hint;
-    if (w.state->plan.front) hinted.front = &w.state->front;
+    if (!request.all_pairs) hinted.hint = &cache.hint;
+    if (w.state->plan.front) hinted.front = &cache.front;
     w.result = a.shape->model->collide(*b.shape->model, X_AB, hinted);
     w.result.stats.triangle_tests += witness_tests;
     w.colliding = w.result.colliding;
     // A hit of the tolerance cut has no triangle pair to follow.
-    w.state->has_witness = !request.all_pairs && w.colliding && !w.result.pairs.empty();
-    if (w.state->has_witness) w.state->witness = w.result.pairs.front();
+    cache.has_witness = !request.all_pairs && w.colliding && !w.result.pairs.empty();
+    if (cache.has_witness) cache.witness = w.result.pairs.front();
   }
 
   /// Follows last step's contact: the witness pair itself, then each of its
@@ -526,11 +596,14 @@ struct CollisionWorld::Impl {
     PartDistance r;
     if (level != LevelOfDetail::kExact && hulls) {
       PairState& state = pair_states[pair_key(a.id.index, b.id.index)];
-      r.warm_started = request.warm_start && state.gjk.valid;
+      if (!state.cache) state.cache = std::make_unique<PairCache>();
+      state.tested_at = steps;
+      GjkCache& warm = state.cache->gjk;
+      r.warm_started = request.warm_start && warm.valid;
       GjkCache cold;
-      GjkCache& cache = request.warm_start ? state.gjk : cold;
+      GjkCache& cache = request.warm_start ? warm : cold;
       const GjkResult g = gjk(*a.shape->hull, *b.shape->hull, X_AB, &cache);
-      if (!request.warm_start) state.gjk = cold;
+      if (!request.warm_start) warm = cold;
       r.level = LevelOfDetail::kHull;
       r.distance = g.distance;
       r.intersecting = g.intersecting;
@@ -716,6 +789,8 @@ struct CollisionWorld::Impl {
       w.b = c.b;
       w.state = &pair_states[pair_key(c.a, c.b)];
       if (!w.state->planned) make_plan(a, b, *w.state);
+      if (!w.state->cache) w.state->cache = std::make_unique<PairCache>();
+      w.state->tested_at = steps;
       w.level = w.state->plan.level;
       work.push_back(std::move(w));
     }
@@ -746,6 +821,7 @@ struct CollisionWorld::Impl {
 
     if (settings.capture) capture_suspects();
     ++steps;
+    if (steps % kForgetSteps == 0) forget_idle_caches();
 
     // 4. Gather in pair order: contacts sorted by (a, b, triangle_a, triangle_b).
     for (const PairWork& w : work) {
@@ -873,7 +949,7 @@ void CollisionWorld::set_pair_level(PartId a, PartId b, LevelOfDetail level) {
 std::vector<PairPlan> CollisionWorld::plans() const {
   std::vector<PairPlan> out;
   for (const auto& [key, state] : impl_->pair_states) {
-    if (state.planned) out.push_back(state.plan);
+    if (state.planned) out.push_back(impl_->to_plan(state.plan));
   }
   sort_by_pair(out);
   return out;
@@ -889,7 +965,7 @@ std::vector<PairPlan> CollisionWorld::plans_since(std::uint64_t version) const {
     // Skipped: pairs forgotten since, and plans made again later in the log.
     if (it != impl_->pair_states.end() && it->second.planned &&
         it->second.plan_version == entry->first) {
-      out.push_back(it->second.plan);
+      out.push_back(impl_->to_plan(it->second.plan));
     }
   }
   sort_by_pair(out);
