@@ -318,7 +318,18 @@ const Report& Simulation::report() const {
     for (const auto& [key, stats] : contact_stats_) report_.contacts.push_back(stats);
     report_.plans.clear();
     report_.plans.reserve(plans_.size());
-    for (const auto& [key, plan] : plans_) report_.plans.push_back(plan);
+    for (const auto& [names, plan] : plans_) {
+      report_.plans.push_back({.a = names.first,
+                               .b = names.second,
+                               .level = std::string(collision::level_name(plan.level)),
+                               .method = plan.method
+                                             ? std::string(collision::method_name(*plan.method))
+                                             : std::string(),
+                               .convex_level = plan.convex_level,
+                               .front = plan.front,
+                               .max_size = plan.max_size,
+                               .reason = *plan_reasons_[plan.reason]});
+    }
     std::sort(report_.plans.begin(), report_.plans.end(),
               [](const PairPlanReport& x, const PairPlanReport& y) {
                 return std::tie(x.a, x.b) < std::tie(y.a, y.b);
@@ -335,15 +346,15 @@ void Simulation::update_plans() {
     std::string a = collision_names_.at(plan.pair.a);
     std::string b = collision_names_.at(plan.pair.b);
     if (b < a) std::swap(a, b);
-    plans_[{a, b}] = PairPlanReport{
-        .a = a,
-        .b = b,
-        .level = std::string(collision::level_name(plan.level)),
-        .method = plan.method ? std::string(collision::method_name(*plan.method)) : std::string(),
-        .convex_level = plan.convex_level,
-        .front = plan.front,
-        .max_size = plan.max_size,
-        .reason = plan.reason};
+    const auto [reason, added] =
+        plan_reason_ids_.emplace(plan.reason, static_cast<std::uint32_t>(plan_reasons_.size()));
+    if (added) plan_reasons_.push_back(&reason->first);
+    plans_[{std::move(a), std::move(b)}] = KeptPlan{.level = plan.level,
+                                                    .method = plan.method,
+                                                    .convex_level = plan.convex_level,
+                                                    .front = plan.front,
+                                                    .max_size = plan.max_size,
+                                                    .reason = reason->second};
   }
 }
 

@@ -224,7 +224,21 @@ class Simulation {
       return h ^ (std::hash<std::string>{}(p.second) + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2));
     }
   };
-  std::unordered_map<std::pair<std::string, std::string>, PairPlanReport, NamePairHash> plans_;
+  /// A pair's plan as kept until the report is read: a PairPlanReport
+  /// without the names (the key's) and with its reason an index into
+  /// plan_reasons_ (a crowded scene plans a hundred thousand pairs with a
+  /// handful of sentences).
+  struct KeptPlan {
+    collision::LevelOfDetail level = collision::LevelOfDetail::kExact;
+    std::optional<collision::Method> method{};
+    bool convex_level = false;
+    bool front = false;
+    double max_size = 0;
+    std::uint32_t reason = 0;
+  };
+  std::unordered_map<std::pair<std::string, std::string>, KeptPlan, NamePairHash> plans_;
+  std::vector<const std::string*> plan_reasons_;  ///< the keys of plan_reason_ids_
+  std::unordered_map<std::string, std::uint32_t> plan_reason_ids_;
   std::uint64_t plans_version_ = 0;
   std::uint64_t frame_ = 0;
   bool paused_ = false;
