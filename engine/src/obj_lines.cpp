@@ -49,10 +49,17 @@ std::optional<std::int64_t> vertex_number(std::string_view word) {
   return value;
 }
 
+/// `text` in quotes for a message: at most 60 characters, a tab as \t,
+/// other control characters and bytes outside ASCII as '?'.
 std::string quoted(std::string_view text) {
   constexpr std::size_t kLongest = 60;
   std::string out(1, '\'');
-  out.append(text.substr(0, kLongest));
+  for (const char c : text.substr(0, kLongest)) {
+    if (c == '\t')
+      out += "\\t";
+    else
+      out.push_back(c >= 0x20 && c < 0x7f ? c : '?');
+  }
   if (text.size() > kLongest) out.append("...");
   out.push_back('\'');
   return out;

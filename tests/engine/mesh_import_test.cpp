@@ -464,7 +464,7 @@ TEST(MeshImport, BadObjLinesAreNamedByLine) {
        "comment_after_a_face.obj: line 4: '#' is not a vertex number"},
       {"indented_vertex", "v 0 0 0\nv 1 0 0\n  v 0 1 0\nf 1 2 3\n",
        "indented_vertex.obj: line 3: '  v 0 1 0' is indented; a vertex line must start"},
-      {"indented_face", tri + "\tf 1 2 3\n", "indented_face.obj: line 4: '\tf 1 2 3' is indented"},
+      {"indented_face", tri + "\tf 1 2 3\n", "indented_face.obj: line 4: '\\tf 1 2 3' is indented"},
       {"leading_point", "v 0 0 0\nv 1 0 0\nv .5 1 0\nv 5 5 5\nf 1 2 3\n",
        "leading_point.obj: line 3: '.5' has no digit before its decimal point, in the vertex "
        "'v .5 1 0'; the OBJ reader cannot read it: write 0.5"},
@@ -474,6 +474,7 @@ TEST(MeshImport, BadObjLinesAreNamedByLine) {
        "relative_too_far.obj: line 4: the face 'f 1 2 -4' refers to vertex -4, but only 3 "
        "vertices come before it"},
       {"zero", tri + "f 0 1 2\n", "zero.obj: line 4: '0' is not a vertex number"},
+      {"binary", tri + "f 1 2 \x01\xff\n", "binary.obj: line 4: '??' is not a vertex number"},
       {"word_in_face", tri + "f 1/1 2/1 three/1\n",
        "word_in_face.obj: line 4: 'three/1' is not a vertex number"},
   };
