@@ -474,7 +474,7 @@ TEST(MeshImport, BadObjLinesAreNamedByLine) {
        "relative_too_far.obj: line 4: the face 'f 1 2 -4' refers to vertex -4, but only 3 "
        "vertices come before it"},
       {"zero", tri + "f 0 1 2\n", "zero.obj: line 4: '0' is not a vertex number"},
-      {"binary", tri + "f 1 2 \x01\xff\n", "binary.obj: line 4: '??' is not a vertex number"},
+      {"binary", tri + "f 1 2 \x01\xff\n", "binary.obj: line 4: '?\?' is not a vertex number"},
       {"word_in_face", tri + "f 1/1 2/1 three/1\n",
        "word_in_face.obj: line 4: 'three/1' is not a vertex number"},
   };
