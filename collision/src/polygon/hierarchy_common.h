@@ -70,6 +70,14 @@ inline Real query_margin(Real max_abs_a, Real max_abs_b, const Transform& X_AB) 
   return 0x1.0p-40 * (max_abs_a + 3 * max_abs_b + X_AB.t.cwiseAbs().sum());
 }
 
+/// Whether two closed axis-aligned boxes, given by their corners, share a
+/// point. On the bounds of two triangles' very coordinates it rejects pairs
+/// the exact triangle test would reject too, before it.
+inline bool aligned_boxes_meet(const Vec3& a_lo, const Vec3& a_hi, const Vec3& b_lo,
+                               const Vec3& b_hi) {
+  return !((a_lo.array() > b_hi.array()).any() || (b_lo.array() > a_hi.array()).any());
+}
+
 /// State of one query's traversal: meshes, pose, result, early exit.
 class LeafTester {
  public:
@@ -100,7 +108,7 @@ class LeafTester {
       const Vec3& r = a_.vertices[ta[2]];
       const Vec3 a_lo = p.cwiseMin(q).cwiseMin(r), a_hi = p.cwiseMax(q).cwiseMax(r);
       for (int j = 0; j < count_b && !done_; ++j) {
-        if (boxes_overlap(a_lo, a_hi, b_lo[j], b_hi[j]))
+        if (aligned_boxes_meet(a_lo, a_hi, b_lo[j], b_hi[j]))
           test_exact(tris_a[i], p, q, r, tris_b[j], b[j]);
       }
     }
@@ -114,8 +122,9 @@ class LeafTester {
     const Vec3& p = a_.vertices[ta[0]];
     const Vec3& q = a_.vertices[ta[1]];
     const Vec3& r = a_.vertices[ta[2]];
-    if (boxes_overlap(p.cwiseMin(q).cwiseMin(r), p.cwiseMax(q).cwiseMax(r),
-                      b[0].cwiseMin(b[1]).cwiseMin(b[2]), b[0].cwiseMax(b[1]).cwiseMax(b[2]))) {
+    if (aligned_boxes_meet(p.cwiseMin(q).cwiseMin(r), p.cwiseMax(q).cwiseMax(r),
+                           b[0].cwiseMin(b[1]).cwiseMin(b[2]),
+                           b[0].cwiseMax(b[1]).cwiseMax(b[2]))) {
       test_exact(ia, p, q, r, ib, b);
     }
   }
@@ -134,11 +143,6 @@ class LeafTester {
   }
 
  private:
-  static bool boxes_overlap(const Vec3& a_lo, const Vec3& a_hi, const Vec3& b_lo,
-                            const Vec3& b_hi) {
-    return !((a_lo.array() > b_hi.array()).any() || (b_lo.array() > a_hi.array()).any());
-  }
-
   void test_exact(std::uint32_t ia, const Vec3& p, const Vec3& q, const Vec3& r, std::uint32_t ib,
                   const std::array<Vec3, 3>& b) {
     ++result_.stats.triangle_tests;

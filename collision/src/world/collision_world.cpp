@@ -517,7 +517,7 @@ struct CollisionWorld::Impl {
     Corners(const Vec3& p, const Vec3& q, const Vec3& r)
         : v{p, q, r}, lo(p.cwiseMin(q).cwiseMin(r)), hi(p.cwiseMax(q).cwiseMax(r)) {}
     bool box_meets(const Corners& o) const {
-      return !((lo.array() > o.hi.array()).any() || (o.lo.array() > hi.array()).any());
+      return detail::aligned_boxes_meet(lo, hi, o.lo, o.hi);
     }
     std::array<Vec3, 3> v;
     Vec3 lo, hi;
