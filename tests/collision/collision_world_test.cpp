@@ -214,6 +214,43 @@ TEST(CollisionWorld, FixedPartsAreNotTestedAgainstEachOther) {
   EXPECT_EQ(asked.colliding.size(), 1u);
 }
 
+TEST(CollisionWorld, APairStillTouchingAtItsLastTrianglesSkipsTheHullTest) {
+  // Two balls overlapping: the first step tests their hulls and then their
+  // triangles; while the same triangles (or their neighbours) still cross,
+  // later steps decide the pair by them alone. Apart, the hull test is back.
+  const auto ball = share(make_sphere(0.5, 2));
+  CollisionWorld world({.contacts = ContactDetail::kPairs});
+  world.add_part({.mesh = ball, .X_WP = Transform::identity()});
+  Transform X = Transform::identity();
+  X.t = Vec3(0.9, 0, 0);
+  const PartId b = world.add_part({.mesh = ball, .X_WP = X});
+  const StepStats first = world.step().stats;
+  EXPECT_EQ(first.convex_tests, 1u);
+  EXPECT_EQ(first.polygon_pairs, 1u);
+  EXPECT_EQ(first.colliding_pairs, 1u);
+  EXPECT_GT(first.polygon.volume_tests, 0u);
+
+  X.t.y() += 1e-3;
+  world.set_pose(b, X);
+  const StepStats held = world.step().stats;
+  EXPECT_EQ(held.convex_tests, 0u);
+  EXPECT_EQ(held.polygon_pairs, 1u);
+  EXPECT_EQ(held.colliding_pairs, 1u);
+  EXPECT_EQ(held.polygon.volume_tests, 0u);
+  EXPECT_GT(held.polygon.triangle_tests, 0u);
+
+  // Boxes still overlapping, balls apart: the old triangles no longer
+  // cross, and the hulls' test separates the pair.
+  X.t = Vec3(0.8, 0.8, 0);
+  world.set_pose(b, X);
+  const StepStats apart = world.step().stats;
+  EXPECT_EQ(apart.box_pairs, 1u);
+  EXPECT_EQ(apart.convex_tests, 1u);
+  EXPECT_EQ(apart.convex_separated, 1u);
+  EXPECT_EQ(apart.polygon_pairs, 0u);
+  EXPECT_EQ(apart.colliding_pairs, 0u);
+}
+
 TEST(CollisionWorld, ACacheUntestedForLongIsForgottenAndThePlanKept) {
   // A pair apart for 2,048 steps (its cache is freed by the first pass, every
   // 1,024 steps, after 1,024 steps untested) cannot start GJK warm any more,

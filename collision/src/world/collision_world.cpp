@@ -138,6 +138,7 @@ struct PairWork {
   bool convex_separated = false;
   bool cached_plane = false;
   bool polygon = false;
+  bool by_witness = false;     ///< decided by last step's contact (Impl::witness_holds)
   bool search_capped = false;  ///< the separating plane or GJK stopped at its iteration cap
   CollideResult result;
 };
@@ -409,6 +410,8 @@ struct CollisionWorld::Impl {
       return false;
     }
     const Transform X_AB = relative(a.X_WP, b.X_WP);
+    const bool polygon_level = plan.level == LevelOfDetail::kExact || !plan.convex_level;
+    if (polygon_level && witness_holds(w, X_AB)) return false;
     if (plan.convex_level) {
       const SeparatingPlaneResult separation =
           separating_plane_test(*a.shape->hull, *b.shape->hull, X_AB, cache.plane);
@@ -436,7 +439,27 @@ struct CollisionWorld::Impl {
     return {.all_pairs = settings.contacts == ContactDetail::kTriangles};
   }
 
-  /// The polygon level of one pair, in one piece.
+  /// The start of a first-hit pair's polygon level, before its hulls'
+  /// test: a pair in contact at the last step is most often still in
+  /// contact at or next to the same triangles, and a hit there decides it
+  /// (colliding, at the polygon level) without the hulls' test, which could
+  /// not have separated it. Returns whether it did; a miss leaves its
+  /// triangle tests in w.result for evaluate_polygon to add.
+  bool witness_holds(PairWork& w, const Transform& X_AB) {
+    PairCache& cache = *w.state->cache;
+    if (polygon_request().all_pairs || !cache.has_witness) return false;
+    std::uint64_t tests = 0;
+    const bool hit =
+        follow_witness(*parts[w.a].shape, *parts[w.b].shape, X_AB, cache.witness, tests);
+    w.result = CollideResult{};
+    w.result.stats.triangle_tests = tests;
+    if (hit) w.result.pairs = {cache.witness};
+    w.result.colliding = hit;
+    w.polygon = w.by_witness = w.colliding = hit;
+    return hit;
+  }
+
+  /// The polygon level of one pair, in one piece, after witness_holds.
   void evaluate_polygon(PairWork& w) {
     const Part& a = parts[w.a];
     const Part& b = parts[w.b];
@@ -444,15 +467,6 @@ struct CollisionWorld::Impl {
     PairCache& cache = *w.state->cache;
     CollideRequest request = polygon_request();
     request.max_size = w.state->plan.max_size;
-    if (!request.all_pairs && cache.has_witness) {
-      std::uint64_t tests = 0;
-      if (follow_witness(*a.shape, *b.shape, X_AB, cache.witness, tests)) {
-        w.result = CollideResult{.colliding = true, .pairs = {cache.witness}, .stats = {0, tests}};
-        w.colliding = true;
-        return;
-      }
-      w.result.stats.triangle_tests = tests;
-    }
     const std::uint64_t witness_tests = w.result.stats.triangle_tests;
     CollideRequest hinted = request;
     if (!request.all_pairs) hinted.hint = &cache.hint;
@@ -811,7 +825,7 @@ struct CollisionWorld::Impl {
         tasks->thread_count() > 1 && settings.contacts == ContactDetail::kTriangles;
     std::vector<std::size_t> polygon_pairs, heavy_pairs;
     for (std::size_t i = 0; i < work.size(); ++i) {
-      if (!work[i].polygon) continue;
+      if (!work[i].polygon || work[i].by_witness) continue;
       (split_heavy && heavy(work[i]) ? heavy_pairs : polygon_pairs).push_back(i);
     }
     tasks->parallel_for(polygon_pairs.size(), 1, [&](std::size_t begin, std::size_t end) {
