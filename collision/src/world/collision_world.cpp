@@ -132,6 +132,7 @@ struct PairWork {
   std::uint32_t a = 0, b = 0;
   LevelOfDetail level = LevelOfDetail::kExact;
   PairState* state = nullptr;  ///< the pair's caches and its plan
+  Transform X_AB;              ///< B in A's frame, once the convex level has it
   // Outputs.
   bool colliding = false;
   bool convex_tested = false;
@@ -409,7 +410,8 @@ struct CollisionWorld::Impl {
       w.colliding = true;
       return false;
     }
-    const Transform X_AB = relative(a.X_WP, b.X_WP);
+    w.X_AB = relative(a.X_WP, b.X_WP);
+    const Transform& X_AB = w.X_AB;
     const bool polygon_level = plan.level == LevelOfDetail::kExact || !plan.convex_level;
     if (polygon_level && witness_holds(w, X_AB)) return false;
     if (plan.convex_level) {
@@ -463,7 +465,7 @@ struct CollisionWorld::Impl {
   void evaluate_polygon(PairWork& w) {
     const Part& a = parts[w.a];
     const Part& b = parts[w.b];
-    const Transform X_AB = relative(a.X_WP, b.X_WP);
+    const Transform& X_AB = w.X_AB;
     PairCache& cache = *w.state->cache;
     CollideRequest request = polygon_request();
     request.max_size = w.state->plan.max_size;
@@ -564,9 +566,8 @@ struct CollisionWorld::Impl {
     tasks->parallel_for(heavy_pairs.size(), 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t q = begin; q < end; ++q) {
         const PairWork& w = work[heavy_pairs[q]];
-        queries[q] = parts[w.a].shape->model->split(*parts[w.b].shape->model,
-                                                    relative(parts[w.a].X_WP, parts[w.b].X_WP),
-                                                    polygon_request());
+        queries[q] =
+            parts[w.a].shape->model->split(*parts[w.b].shape->model, w.X_AB, polygon_request());
       }
     });
     std::vector<std::pair<std::uint32_t, std::uint32_t>> jobs;  // (query, part)
