@@ -29,6 +29,9 @@ struct HostState {
   SandboxLimits limits;
   std::uint64_t seed = 0;
   lua_State* L = nullptr;
+  // The thread running Lua code: a coroutine while the sandbox's resume
+  // runs it, else null (the main thread, L).
+  lua_State* running = nullptr;
 
   // The allocator's account. A refusal repeated for the same request means
   // the emergency collection in between did not help: the cap is reached.

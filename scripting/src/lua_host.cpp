@@ -56,15 +56,15 @@ void* allocate(void* data, void* block, std::size_t old_size, std::size_t new_si
       if (host.refusal_pending && host.refused_old == held && host.refused_new == new_size &&
           host.active()) {
         host.memory_failed = true;
-        // A script that fails before the count hook first fires (a string
-        // doubled twenty times) has no location yet: take the main thread's
-        // position now. Lua saves it before any step that can allocate, and
-        // reading the stack allocates nothing. The hook's location is kept
-        // when there is one: in a coroutine it names the coroutine's line,
-        // the main thread only the line that resumed it.
-        if (host.L != nullptr && !has_line(host.where)) {
+        // The line the script is at now, in the thread that runs (the
+        // coroutine's own line inside one), rather than where the count
+        // hook last fired, up to kHookInterval instructions ago or not yet.
+        // Lua saves a thread's position before any step that can allocate,
+        // and reading the stack allocates nothing.
+        lua_State* const at = host.running != nullptr ? host.running : host.L;
+        if (at != nullptr) {
           char here[sizeof(host.where)];
-          write_where(host.L, 0, here, sizeof(here));
+          write_where(at, 0, here, sizeof(here));
           if (here[0] != '\0') std::memcpy(host.where, here, sizeof(here));
         }
       }

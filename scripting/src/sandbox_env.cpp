@@ -597,7 +597,11 @@ int resume(lua_State* L, lua_State* co, int count) {
   }
   lua_xmove(L, co, count);
   int results = 0;
+  HostState& host = host_of(L);
+  lua_State* const outer = host.running;
+  host.running = co;
   const int status = lua_resume(co, L, count, &results);
+  host.running = outer;
   if (status == LUA_OK || status == LUA_YIELD) {
     if (!lua_checkstack(L, results + 1)) {
       lua_pop(co, results);
@@ -607,7 +611,7 @@ int resume(lua_State* L, lua_State* co, int count) {
     lua_xmove(co, L, results);
     return results;
   }
-  if (status == LUA_ERRMEM) note_memory_error(host_of(L), L);
+  if (status == LUA_ERRMEM) note_memory_error(host, L);
   lua_xmove(co, L, 1);
   return -1;
 }

@@ -409,6 +409,30 @@ TEST(LuaHostMemory, AFailureBeforeTheFirstHookNamesItsLine) {
   expect_works(host);
 }
 
+TEST(LuaHostMemory, AFailureNamesTheLineItHappensOnNotTheHooksLast) {
+  // The count hook last fires in the loop of line 2; the cap is reached a
+  // few instructions later, on line 4, before the hook fires again. In a
+  // coroutine the line is the coroutine's own, not the one resuming it.
+  LuaHost host(small_limits(), 1);
+  const char* straight =
+      "local t = {}\nfor i = 1, 5000 do t[i] = i end\nlocal s = string.rep('x', 1 << 20)\n"
+      "while true do s = s .. s end";
+  ScriptError error = run_error(host, straight);
+  EXPECT_EQ(error.kind(), Kind::kMemory);
+  EXPECT_EQ(error.message().rfind("script.lua:4: memory limit of 16777216 bytes exceeded", 0), 0u)
+      << error.what();
+  expect_works(host);
+
+  const char* in_coroutine =
+      "local t = {}\nfor i = 1, 5000 do t[i] = i end\nlocal co = coroutine.wrap(function()\n"
+      "  local s = string.rep('x', 1 << 20)\n  while true do s = s .. s end\nend)\nco()";
+  error = run_error(host, in_coroutine);
+  EXPECT_EQ(error.kind(), Kind::kMemory);
+  EXPECT_EQ(error.message().rfind("script.lua:5: memory limit of 16777216 bytes exceeded", 0), 0u)
+      << error.what();
+  expect_works(host);
+}
+
 TEST(LuaHostMemory, PcallCannotSwallowIt) {
   SandboxLimits limits = small_limits();
   limits.instructions_per_call = 20'000'000;  // the cap must come first
