@@ -109,8 +109,48 @@ class Loader {
   Scenario load();
 
  private:
+  /// A mistake in the file, where it is.
+  struct Problem {
+    SourceLocation where;
+    std::string message;
+  };
+
+  /// A problem after which reading cannot go on: reported at once, with
+  /// those noted before it.
   [[noreturn]] void fail(const SourceLocation& where, const std::string& message) const {
-    throw ScenarioError(where.str() + ": " + message);
+    std::vector<Problem> all = noted_;
+    all.push_back({where, message});
+    throw ScenarioError(in_line_order(std::move(all)));
+  }
+
+  /// A problem after which reading can go on: an unknown field or item is
+  /// left unread, a name nothing declares unresolved. Kept, and reported
+  /// with the others when reading ends (throw_noted), so that one check
+  /// names every such mistake, by line.
+  void note(const SourceLocation& where, const std::string& message) {
+    noted_.push_back({where, message});
+  }
+
+  void throw_noted() const {
+    if (!noted_.empty()) throw ScenarioError(in_line_order(noted_));
+  }
+
+  /// One line a problem, in the order of the file (problems of the whole
+  /// file first), at most kShownProblems of them.
+  static std::string in_line_order(std::vector<Problem> problems) {
+    constexpr std::size_t kShownProblems = 20;
+    std::stable_sort(problems.begin(), problems.end(), [](const Problem& x, const Problem& y) {
+      return x.where.line < y.where.line;
+    });
+    std::string out;
+    for (std::size_t i = 0; i < problems.size() && i < kShownProblems; ++i) {
+      if (i > 0) out += '\n';
+      out += problems[i].where.str() + ": " + problems[i].message;
+    }
+    if (problems.size() > kShownProblems) {
+      out += "\n(and " + std::to_string(problems.size() - kShownProblems) + " more)";
+    }
+    return out;
   }
 
   // ---- raw table access on absolute stack indices
@@ -446,11 +486,11 @@ class Loader {
     for (const Param& p : word.params) known.emplace_back(p.name);
     for (const std::string& key : keys) {
       if (std::find(known.begin(), known.end(), key) == known.end()) {
-        fail(where, what + ": unknown field '" + key + "'" + did_you_mean(key, known));
+        note(where, what + ": unknown field '" + key + "'" + did_you_mean(key, known));
       }
     }
     for (const lua_Integer p : positions) {
-      if (p < 1 || p > positional) fail(where, what + ": unexpected item " + std::to_string(p));
+      if (p < 1 || p > positional) note(where, what + ": unexpected item " + std::to_string(p));
     }
   }
   const Param& param(const Word& word, std::string_view name) {
@@ -554,6 +594,7 @@ class Loader {
 
   std::filesystem::path folder_;
   Scenario scenario_;
+  std::vector<Problem> noted_;  ///< see note()
   std::vector<std::filesystem::path>* files_read_ = nullptr;
   std::map<std::string, engine::ImportReport> imports_;  ///< mesh files read by node
 };
@@ -584,6 +625,7 @@ Scenario Loader::load() {
   read_scenario_fields(lua_gettop(L_), where);
   lua_settop(L_, base);
   resolve();
+  throw_noted();
   return std::move(scenario_);
 }
 
@@ -1018,7 +1060,7 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
   auto check = [&](const std::string& name, const std::vector<std::string>& known,
                    const char* kind) {
     if (std::find(known.begin(), known.end(), name) == known.end()) {
-      fail(clause.where, std::string(clause.word->name) + ": no " + kind + " '" + name + "'" +
+      note(clause.where, std::string(clause.word->name) + ": no " + kind + " '" + name + "'" +
                              did_you_mean(name, known));
     }
   };
@@ -1029,7 +1071,7 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
       case ArgType::kPartOrHand:
         if (arg.text == "hand") {
           if (!scenario_.glove)
-            fail(clause.where, std::string(clause.word->name) + ": the scenario has no hand");
+            note(clause.where, std::string(clause.word->name) + ": the scenario has no hand");
           break;
         }
         check(arg.text, parts, "part");
@@ -1073,14 +1115,14 @@ void Loader::resolve() {
   auto check_part = [&](const std::string& name, const SourceLocation& where,
                         const std::string& what) {
     if (std::find(parts.begin(), parts.end(), name) == parts.end()) {
-      fail(where, what + ": no part '" + name + "'" + did_you_mean(name, parts));
+      note(where, what + ": no part '" + name + "'" + did_you_mean(name, parts));
     }
   };
   for (const MateSpec& m : scenario_.mates) {
     check_part(m.mate.part, m.where, "mate '" + m.mate.name + "'");
     check_part(m.mate.other, m.where, "mate '" + m.mate.name + "'");
     if (fixed(m.mate.part))
-      fail(m.where, "mate '" + m.mate.name + "': its part '" + m.mate.part + "' is fixed");
+      note(m.where, "mate '" + m.mate.name + "': its part '" + m.mate.part + "' is fixed");
   }
   for (const RegionSpec& r : scenario_.regions) {
     for (const std::string& p : r.region.parts)
@@ -1089,7 +1131,7 @@ void Loader::resolve() {
   if (scenario_.glove && !scenario_.glove->holding.empty()) {
     check_part(scenario_.glove->holding, scenario_.glove->where, "glove: holding");
     if (fixed(scenario_.glove->holding)) {
-      fail(scenario_.glove->where,
+      note(scenario_.glove->where,
            "glove: the hand cannot hold the fixed part '" + scenario_.glove->holding + "'");
     }
   }

@@ -104,6 +104,31 @@ TEST(ScenarioLoad, AnUnknownFieldAndAWrongKindAreNamed) {
   }
 }
 
+TEST(ScenarioLoad, EveryUnknownFieldAndNameIsNamedAtOnceInLineOrder) {
+  // An unknown name on line 17, an unknown field on line 18 and another
+  // unknown name in an expectation on line 21: one error naming all three,
+  // one line each, in the order of the file, though the names are resolved
+  // after every table has been read.
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(dir, "three.lua",
+                          moved_peg("    rule { when = touches(\"peg\", \"blok\"), act = { log "
+                                    "\"x\" } },\n    rule { when = after(1), act = { log \"x\" }, "
+                                    "cooldwn = 1 },",
+                                    "    mate_made \"peg_in_hoel\","));
+  LuaHost host({}, 1);
+  try {
+    load_scenario(host, file);
+    FAIL() << "loaded";
+  } catch (const ScenarioError& e) {
+    const std::string what = e.what();
+    const std::string expected =
+        ".*three.lua:17: touches: no part 'blok' \\(did you mean 'block'\\?\\)\n"
+        ".*three.lua:18: rule 2: unknown field 'cooldwn' \\(did you mean 'cooldown'\\?\\)\n"
+        ".*three.lua:21: mate_made: no mate 'peg_in_hoel' \\(did you mean 'peg_in_hole'\\?\\)";
+    EXPECT_TRUE(std::regex_match(what, std::regex(expected))) << what;
+  }
+}
+
 TEST(ScenarioLoad, ARuleThatCanNeverFireIsAWarning) {
   const test::TempDir dir("dovetail_scenario");
   const auto file =
