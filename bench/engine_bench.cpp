@@ -10,7 +10,8 @@
 // 2. A synthetic scene of 1,000 moving parts (convex polytopes of about 56
 //    faces tumbling in a box), the same way.
 // Reports wall time, frames per second and the real-time factor (simulated
-// seconds per wall second), median over runs.
+// seconds per wall second), median over runs, and the slowest and fastest
+// run's factor: on a shared machine the spread is part of the figure.
 
 #include <algorithm>
 #include <chrono>
@@ -98,11 +99,16 @@ void print(const char* name, std::size_t parts, double seconds,
     collisions.push_back(r.collision_s);
   }
   const double wall = median(walls);
+  const auto [fastest, slowest] = std::minmax_element(walls.begin(), walls.end());
   std::printf(
       "%-28s %6zu parts  %5.1f s simulated  %8.3f s wall  %8.0f frames/s  %7.1fx real time  %5zu "
       "contact events  hash %016llx\n",
       name, parts, seconds, wall, runs[0].frames / wall, seconds / wall, runs[0].contact_events,
       static_cast<unsigned long long>(runs[0].state_hash));
+  if (runs.size() > 1) {
+    std::printf("%-28s real time over the %zu runs: median %.1fx, slowest %.1fx, fastest %.1fx\n",
+                "", runs.size(), seconds / wall, seconds / *slowest, seconds / *fastest);
+  }
   std::printf(
       "%-28s per frame: %.1f overlapping boxes, %.1f separating-plane tests (%.1f settled by last "
       "frame's plane), %.1f polygon-level pairs, %.1f in contact, %.0f volume tests\n",
