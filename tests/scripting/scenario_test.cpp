@@ -23,6 +23,19 @@ std::filesystem::path write(const test::TempDir& dir, const std::string& name,
   return path;
 }
 
+/// The loader's error for `file`: a ScenarioError's message, or a test
+/// failure and "" when the file loads.
+std::string load_error(const std::filesystem::path& file) {
+  LuaHost host({}, 1);
+  try {
+    load_scenario(host, file);
+  } catch (const ScenarioError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << file << " loaded";
+  return "";
+}
+
 /// A scene without a hand: the peg is moved into the hole by a rule.
 std::string moved_peg(const std::string& rules, const std::string& expect,
                       const std::string& extra = "") {
@@ -58,16 +71,10 @@ TEST(ScenarioLoad, AMisspeltPartIsAnErrorWithFileLineAndASuggestion) {
   const auto file =
       write(dir, "bad.lua",
             moved_peg("    rule { when = touches(\"peg\", \"blok\"), act = { log \"x\" } },", ""));
-  LuaHost host({}, 1);
-  try {
-    load_scenario(host, file);
-    FAIL() << "loaded";
-  } catch (const ScenarioError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("bad.lua:17: touches: no part 'blok' (did you mean 'block'?)"),
-              std::string::npos)
-        << what;
-  }
+  const std::string what = load_error(file);
+  EXPECT_NE(what.find("bad.lua:17: touches: no part 'blok' (did you mean 'block'?)"),
+            std::string::npos)
+      << what;
 }
 
 TEST(ScenarioLoad, AnUnknownFieldAndAWrongKindAreNamed) {
@@ -75,33 +82,17 @@ TEST(ScenarioLoad, AnUnknownFieldAndAWrongKindAreNamed) {
   const auto typo =
       write(dir, "typo.lua",
             moved_peg("    rule { when = after(1), act = { log \"x\" }, cooldwn = 1 },", ""));
-  LuaHost host({}, 1);
-  EXPECT_THROW(
-      {
-        try {
-          load_scenario(host, typo);
-        } catch (const ScenarioError& e) {
-          EXPECT_NE(
-              std::string(e.what()).find("unknown field 'cooldwn' (did you mean 'cooldown'?)"),
-              std::string::npos)
-              << e.what();
-          throw;
-        }
-      },
-      ScenarioError);
+  const std::string typo_error = load_error(typo);
+  EXPECT_NE(typo_error.find("unknown field 'cooldwn' (did you mean 'cooldown'?)"),
+            std::string::npos)
+      << typo_error;
   const auto kind =
       write(dir, "kind.lua",
             moved_peg("    rule { when = highlight \"peg\", act = { log \"x\" } },", ""));
-  LuaHost host2({}, 1);
-  try {
-    load_scenario(host2, kind);
-    FAIL();
-  } catch (const ScenarioError& e) {
-    EXPECT_NE(std::string(e.what()).find(
-                  "kind.lua:17: rule 1: when must be an event; 'highlight' is an action"),
-              std::string::npos)
-        << e.what();
-  }
+  const std::string kind_error = load_error(kind);
+  EXPECT_NE(kind_error.find("kind.lua:17: rule 1: when must be an event; 'highlight' is an action"),
+            std::string::npos)
+      << kind_error;
 }
 
 TEST(ScenarioLoad, EveryUnknownFieldAndNameIsNamedAtOnceInLineOrder) {
@@ -115,18 +106,12 @@ TEST(ScenarioLoad, EveryUnknownFieldAndNameIsNamedAtOnceInLineOrder) {
                                     "\"x\" } },\n    rule { when = after(1), act = { log \"x\" }, "
                                     "cooldwn = 1 },",
                                     "    mate_made \"peg_in_hoel\","));
-  LuaHost host({}, 1);
-  try {
-    load_scenario(host, file);
-    FAIL() << "loaded";
-  } catch (const ScenarioError& e) {
-    const std::string what = e.what();
-    const std::string expected =
-        ".*three.lua:17: touches: no part 'blok' \\(did you mean 'block'\\?\\)\n"
-        ".*three.lua:18: rule 2: unknown field 'cooldwn' \\(did you mean 'cooldown'\\?\\)\n"
-        ".*three.lua:21: mate_made: no mate 'peg_in_hoel' \\(did you mean 'peg_in_hole'\\?\\)";
-    EXPECT_TRUE(std::regex_match(what, std::regex(expected))) << what;
-  }
+  const std::string what = load_error(file);
+  const std::string expected =
+      ".*three.lua:17: touches: no part 'blok' \\(did you mean 'block'\\?\\)\n"
+      ".*three.lua:18: rule 2: unknown field 'cooldwn' \\(did you mean 'cooldown'\\?\\)\n"
+      ".*three.lua:21: mate_made: no mate 'peg_in_hoel' \\(did you mean 'peg_in_hole'\\?\\)";
+  EXPECT_TRUE(std::regex_match(what, std::regex(expected))) << what;
 }
 
 TEST(ScenarioLoad, ARuleThatCanNeverFireIsAWarning) {
@@ -305,18 +290,13 @@ TEST(ScenarioLoad, NodesOfAMeshFileBecomeTheirOwnParts) {
   const auto& whole = *s.parts[2].mesh;
   EXPECT_GT(piston.triangles.size(), 100u);
   EXPECT_EQ(block.triangles.size() + piston.triangles.size(), whole.triangles.size());
-  LuaHost host2({}, 1);
-  try {
-    load_scenario(host2, write(dir, "typo.lua",
-                               "return scenario { name = \"n\", parts = { p = part { mesh = \"" +
-                                   engine + "\", nodes = { \"node[5]\" } } } }\n"));
-    FAIL();
-  } catch (const ScenarioError& e) {
-    EXPECT_NE(std::string(e.what()).find(
-                  "2CylinderEngine.glb has no node 'node[5]' (did you mean 'nodes[5]'?)"),
-              std::string::npos)
-        << e.what();
-  }
+  const std::string typo =
+      load_error(write(dir, "typo.lua",
+                       "return scenario { name = \"n\", parts = { p = part { mesh = \"" + engine +
+                           "\", nodes = { \"node[5]\" } } } }\n"));
+  EXPECT_NE(typo.find("2CylinderEngine.glb has no node 'node[5]' (did you mean 'nodes[5]'?)"),
+            std::string::npos)
+      << typo;
 }
 
 TEST(ScenarioRun, AGraspIsCheckedByItsType) {
