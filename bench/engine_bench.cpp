@@ -51,6 +51,7 @@ using Clock = std::chrono::steady_clock;
 struct RunResult {
   double box_pairs = 0, convex_tests = 0, cached_planes = 0;        ///< per frame
   double polygon_pairs = 0, colliding_pairs = 0, volume_tests = 0;  ///< per frame
+  double triangle_volume_tests = 0;                                 ///< per frame
   double wall_s = 0;                                                ///< the stepping loop
   double prepare_s = 0;    ///< building hulls and hierarchies before the loop
   double collision_s = 0;  ///< of wall_s, in the collision pipeline
@@ -78,6 +79,8 @@ RunResult run(engine::Simulation& sim, double seconds, Move&& move) {
     r.polygon_pairs += static_cast<double>(fr.collision.polygon_pairs) / frames;
     r.colliding_pairs += static_cast<double>(fr.collision.colliding_pairs) / frames;
     r.volume_tests += static_cast<double>(fr.collision.polygon.volume_tests) / frames;
+    r.triangle_volume_tests +=
+        static_cast<double>(fr.collision.polygon.triangle_volume_tests) / frames;
     for (const engine::Event& e : fr.events) {
       r.contact_events +=
           e.kind == engine::EventKind::kContactBegin || e.kind == engine::EventKind::kContactEnd;
@@ -111,9 +114,10 @@ void print(const char* name, std::size_t parts, double seconds,
   }
   std::printf(
       "%-28s per frame: %.1f overlapping boxes, %.1f separating-plane tests (%.1f settled by last "
-      "frame's plane), %.1f polygon-level pairs, %.1f in contact, %.0f volume tests\n",
+      "frame's plane), %.1f polygon-level pairs, %.1f in contact, %.0f volume tests (and %.0f of "
+      "a contact's triangle against a volume)\n",
       "", runs[0].box_pairs, runs[0].convex_tests, runs[0].cached_planes, runs[0].polygon_pairs,
-      runs[0].colliding_pairs, runs[0].volume_tests);
+      runs[0].colliding_pairs, runs[0].volume_tests, runs[0].triangle_volume_tests);
   std::printf(
       "%-28s collision pipeline %.3f s of the wall time; set-up before the loop (hulls and "
       "hierarchies) %.3f s\n",

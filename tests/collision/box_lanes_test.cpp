@@ -12,8 +12,10 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <vector>
 
 #include "dovetail/collision/types.h"
+#include "polygon/box_lanes_scalar.h"
 
 namespace dovetail::collision {
 namespace {
@@ -149,6 +151,99 @@ TEST_F(BoxLanes, TouchingBoxesOverlapAtAnyTurn) {
     const StoredBox sa = stored(a.axes, a.centre, a.half);
     const double margin = 0x1.0p-40 * 400.0;
     EXPECT_FALSE(ops.gap(sa.data.data(), lanes(ops, b), margin) > 0) << "turn " << n;
+  }
+}
+
+/// The widest gap between a box and a triangle over the thirteen
+/// separating axes (the box's three, the normal, the nine edge pairs),
+/// each normalized: negative exactly when they meet.
+double reference_triangle_gap(const Box& box, const std::array<Vec3, 3>& t, int axes = 13) {
+  std::vector<Vec3> normals;
+  for (int i = 0; i < 3; ++i) normals.push_back(box.axes.col(i));
+  normals.push_back((t[1] - t[0]).cross(t[2] - t[0]));
+  for (int i = 0; i < 3; ++i) {
+    for (int k = 0; k < 3; ++k) normals.push_back(box.axes.col(i).cross(t[(k + 1) % 3] - t[k]));
+  }
+  double widest = -std::numeric_limits<double>::infinity();
+  for (int a = 0; a < axes; ++a) {
+    const double length = normals[a].norm();
+    if (length < 1e-12) continue;
+    const Vec3 n = normals[a] / length;
+    double radius = 0;
+    for (int k = 0; k < 3; ++k) radius += box.half[k] * std::abs(n.dot(box.axes.col(k)));
+    const double c = n.dot(box.centre);
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Vec3& p : t) {
+      lo = std::min(lo, n.dot(p));
+      hi = std::max(hi, n.dot(p));
+    }
+    widest = std::max({widest, lo - (c + radius), (c - radius) - hi});
+  }
+  return widest;
+}
+
+TEST_F(BoxLanes, WideTriangleTestGivesTheScalarVerdict) {
+  const detail::BoxLaneOps wide = detail::box_lane_ops_avx2();
+  if (!wide.meets_triangle) GTEST_SKIP() << "no AVX2 lanes on this build or processor";
+  const detail::BoxLaneOps scalar = detail::box_lane_ops_scalar();
+  int meeting = 0;
+  for (int n = 0; n < 20000; ++n) {
+    const Box b = box(0.08);
+    const StoredBox s = stored(b.axes, b.centre, b.half);
+    const Vec3 at = Vec3(u_(rng_), u_(rng_), u_(rng_)) * 0.1;
+    const std::array<Vec3, 3> t{at + Vec3(u_(rng_), u_(rng_), u_(rng_)) * 0.2,
+                                at + Vec3(u_(rng_), u_(rng_), u_(rng_)) * 0.2,
+                                at + Vec3(u_(rng_), u_(rng_), u_(rng_)) * 0.2};
+    const detail::TriangleLanes lanes = detail::triangle_lanes(t, n % 2 ? 0.0 : 1e-12);
+    const bool w = wide.meets_triangle(s.data.data(), lanes);
+    ASSERT_EQ(w, scalar.meets_triangle(s.data.data(), lanes)) << "case " << n;
+    meeting += w;
+  }
+  EXPECT_GT(meeting, 4000);  // both verdicts, often
+  EXPECT_LT(meeting, 16000);
+}
+
+TEST_F(BoxLanes, TriangleTestNeverPassesOverATriangleThatMeetsTheBox) {
+  const detail::BoxLaneOps ops = detail::box_lane_ops();
+  int meet = 0, apart = 0;
+  for (int n = 0; n < 20000; ++n) {
+    const Box b = box(0.1);
+    const StoredBox s = stored(b.axes, b.centre, b.half);
+    const Vec3 at = Vec3(u_(rng_), u_(rng_), u_(rng_)) * 0.15;
+    const double size = std::pow(10.0, -2.0 * std::abs(u_(rng_)));  // slivers to large
+    const std::array<Vec3, 3> t{at + Vec3(u_(rng_), u_(rng_), u_(rng_)) * size,
+                                at + Vec3(u_(rng_), u_(rng_), u_(rng_)) * size,
+                                at + Vec3(u_(rng_), u_(rng_), u_(rng_)) * size};
+    const bool meets = ops.meets_triangle(s.data.data(), detail::triangle_lanes(t, 1e-12));
+    const double full = reference_triangle_gap(b, t);
+    const double own = reference_triangle_gap(b, t, 4);  // the axes the test tries
+    if (full < -1e-9) {
+      ++meet;
+      ASSERT_TRUE(meets) << "case " << n << ": they meet, gap " << full;
+    }
+    if (own > 1e-9) {
+      ++apart;
+      ASSERT_FALSE(meets) << "case " << n << ": apart on its own axes by " << own;
+    }
+  }
+  EXPECT_GT(meet, 2000);
+  EXPECT_GT(apart, 2000);
+}
+
+TEST_F(BoxLanes, ATriangleLyingOnAFaceMeetsTheBoxAtAnyTurn) {
+  const detail::BoxLaneOps ops = detail::box_lane_ops();
+  for (int n = 0; n < 2000; ++n) {
+    // A triangle in the plane of the box's +y face, far from the origin.
+    const Mat3 turn = rotation();
+    const Vec3 shift = Vec3(u_(rng_), u_(rng_), u_(rng_)) * 100.0;
+    const Box b{turn, shift, Vec3(0.5, 0.3, 0.2)};
+    const std::array<Vec3, 3> t{shift + turn * Vec3(0.4, 0.3, 0.1),
+                                shift + turn * Vec3(0.9, 0.3, -0.6),
+                                shift + turn * Vec3(-0.2, 0.3, 0.5)};
+    const double margin = 0x1.0p-36 * 400.0;
+    EXPECT_TRUE(ops.meets_triangle(stored(b.axes, b.centre, b.half).data.data(),
+                                   detail::triangle_lanes(t, margin)))
+        << "turn " << n;
   }
 }
 

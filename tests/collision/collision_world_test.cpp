@@ -251,6 +251,37 @@ TEST(CollisionWorld, APairStillTouchingAtItsLastTrianglesSkipsTheHullTest) {
   EXPECT_EQ(apart.colliding_pairs, 0u);
 }
 
+TEST(CollisionWorld, AContactThatMovesFarIsFoundAgainFromItsLargerTriangle) {
+  // A thin rod through a ball, then moved sideways by more than a ring of
+  // the ball's triangles: the rod's long side triangle still crosses the
+  // ball, elsewhere. Searching it against the ball's hierarchy finds the
+  // new contact without a traversal of the two hierarchies.
+  const auto ball = share(make_sphere(0.5, 3));
+  const auto rod = share(make_cylinder(0.02, 2.0, 64));
+  CollisionWorld world({.contacts = ContactDetail::kPairs});
+  world.add_part({.mesh = ball, .X_WP = Transform::identity()});
+  Transform X = Transform::identity();
+  X.t = Vec3(0.1, 0, 0);
+  const PartId b = world.add_part({.mesh = rod, .X_WP = X});
+  const StepStats first = world.step().stats;
+  EXPECT_EQ(first.colliding_pairs, 1u);
+  EXPECT_GT(first.polygon.volume_tests, 0u);
+
+  X.t.x() = 0.35;
+  world.set_pose(b, X);
+  const StepStats moved = world.step().stats;
+  EXPECT_EQ(moved.colliding_pairs, 1u);
+  EXPECT_EQ(moved.polygon.volume_tests, 0u);
+  EXPECT_GT(moved.polygon.triangle_volume_tests, 0u);
+  EXPECT_EQ(moved.convex_tests, 0u);
+
+  // Out of the ball, inside its box: searches and traversal find nothing.
+  X.t = Vec3(0.45, 0.45, 0);
+  world.set_pose(b, X);
+  const StepStats apart = world.step().stats;
+  EXPECT_EQ(apart.colliding_pairs, 0u);
+}
+
 TEST(CollisionWorld, ACacheUntestedForLongIsForgottenAndThePlanKept) {
   // A pair apart for 2,048 steps (its cache is freed by the first pass, every
   // 1,024 steps, after 1,024 steps untested) cannot start GJK warm any more,

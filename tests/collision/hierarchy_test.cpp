@@ -16,6 +16,7 @@
 #include "dovetail/collision/pose_sampling.h"
 #include "dovetail/collision/primitives.h"
 #include "dovetail/collision/task_system.h"
+#include "dovetail/collision/tri_tri.h"
 
 namespace dovetail::collision {
 namespace {
@@ -290,6 +291,56 @@ TEST(Hierarchies, RepeatedQueriesAreIdentical) {
       EXPECT_EQ(r1.stats.triangle_tests, r2.stats.triangle_tests);
     }
   }
+}
+
+TEST(Hierarchies, TriangleSearchVisitsEveryTriangleThatMeetsIt) {
+  // Triangles of every size thrown at a torus, in the torus's frame: the
+  // OBB tree's search must visit every triangle the exact test finds
+  // crossing, and pass over most of the rest.
+  const auto torus = share(make_torus(0.7, 0.25, 48, 24));
+  const auto model = build_model(Method::kObb, torus);
+  const auto plain = build_model(Method::kAabb, torus);
+  const std::vector<Transform> places = random_poses(600, 1.0, 31);
+  std::size_t crossing = 0, visited = 0, searched = 0;
+  for (std::size_t i = 0; i < places.size(); ++i) {
+    const Real size = std::ldexp(1.0, -static_cast<int>(i % 8));
+    const std::array<Vec3, 3> t{places[i].apply(Vec3(0, 0, 0)), places[i].apply(Vec3(size, 0, 0)),
+                                places[i].apply(Vec3(0, 0.6 * size, 0.1 * size))};
+    std::vector<bool> seen(torus->triangles.size(), false);
+    CollideStats stats;
+    const bool stopped = model->search_triangle(
+        t, 1e-12,
+        [&](std::uint32_t k) {
+          seen[k] = true;
+          ++visited;
+          return false;
+        },
+        stats);
+    EXPECT_FALSE(stopped);
+    searched += stats.triangle_volume_tests;
+    for (std::size_t k = 0; k < torus->triangles.size(); ++k) {
+      const TriangleIndices& f = torus->triangles[k];
+      if (!triangles_intersect(torus->vertices[f[0]], torus->vertices[f[1]], torus->vertices[f[2]],
+                               t[0], t[1], t[2])) {
+        continue;
+      }
+      ++crossing;
+      ASSERT_TRUE(seen[k]) << "triangle " << k << " crosses query " << i << " unvisited";
+    }
+    // The first visit that accepts ends the search.
+    int calls = 0;
+    if (std::find(seen.begin(), seen.end(), true) != seen.end()) {
+      EXPECT_TRUE(model->search_triangle(
+          t, 1e-12, [&](std::uint32_t) { return ++calls == 1; }, stats));
+      EXPECT_EQ(calls, 1);
+    }
+    // Hierarchies without the search visit nothing.
+    EXPECT_FALSE(plain->search_triangle(
+        t, 1e-12, [&](std::uint32_t) { return true; }, stats));
+  }
+  EXPECT_GT(crossing, 200u);  // the queries do cross the surface
+  EXPECT_LT(visited, places.size() * torus->triangles.size() / 20);
+  EXPECT_GT(searched, places.size());
 }
 
 TEST(Hierarchies, TraversalHintsNeverChangeTheVerdict) {

@@ -163,6 +163,44 @@ Real ObbTree::reach(const Transform& X_from, const Transform& X_to) const {
   return move * (1 + 0x1.0p-40) + 0x1.0p-40 * scale;
 }
 
+bool ObbTree::search_triangle(const std::array<Vec3, 3>& corners, Real margin,
+                              const std::function<bool(std::uint32_t)>& visit,
+                              CollideStats& stats) const {
+  if (nodes_.empty()) return false;
+  const detail::TriangleLanes triangle = detail::triangle_lanes(corners, margin);
+  const detail::BoxLaneOps lanes = detail::box_lane_ops();
+  const bool wide = detail::box_lanes_wide(lanes);
+  // Depth first: a node's two children replace it on the stack, which never
+  // holds more than one node a level and the root.
+  constexpr std::size_t kShallow = 64;
+  std::array<std::uint32_t, kShallow> shallow;
+  std::vector<std::uint32_t> deep;
+  std::uint32_t* stack = shallow.data();
+  if (depth_ + 2 > kShallow) {
+    deep.resize(depth_ + 2);
+    stack = deep.data();
+  }
+  std::size_t top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    ++stats.triangle_volume_tests;
+    const bool meets = wide ? lanes.meets_triangle(node.box, triangle)
+                            : detail::box_meets_triangle_scalar(node.box, triangle);
+    if (!meets) continue;
+    if (node.link.is_leaf()) {
+      const std::uint32_t* slots = order_.data() + node.link.first_slot();
+      for (int k = 0; k < node.link.count(); ++k) {
+        if (visit(slots[k])) return true;
+      }
+      continue;
+    }
+    stack[top++] = node.link.first_child() + 1;
+    stack[top++] = node.link.first_child();  // on top: searched first
+  }
+  return false;
+}
+
 std::size_t ObbTree::bytes() const {
   return sizeof(*this) + nodes_.capacity() * sizeof(Node) +
          order_.capacity() * sizeof(std::uint32_t);

@@ -6,7 +6,9 @@
 
 namespace dovetail::collision::detail {
 
-BoxLaneOps box_lane_ops_scalar() { return {box_gap_scalar, box_move_scalar}; }
+BoxLaneOps box_lane_ops_scalar() {
+  return {box_gap_scalar, box_move_scalar, box_meets_triangle_scalar};
+}
 
 bool box_lanes_wide(BoxLaneOps ops) { return ops.gap != box_gap_scalar; }
 
@@ -21,7 +23,7 @@ BoxLaneOps box_lane_ops() {
 }
 
 #ifndef DOVETAIL_BOX_LANES_AVX2
-BoxLaneOps box_lane_ops_avx2() { return {nullptr, nullptr}; }
+BoxLaneOps box_lane_ops_avx2() { return {nullptr, nullptr, nullptr}; }
 #endif
 
 }  // namespace dovetail::collision::detail

@@ -44,10 +44,31 @@ using BoxGapFn = double (*)(const double* a, const BoxLanes& b, double margin);
 using BoxMoveFn = void (*)(const double* box, const double* R_AB, const double* t_AB,
                            BoxLanes& out);
 
-/// The test and the move, in one form.
+/// A triangle, in the frame of the boxes it is tested against, laid out for
+/// the box-triangle test: a corner, the edges from it to the other two, and
+/// the normal (their cross product, not normalized), each with a zero fourth
+/// lane; the margin, and the margin times the normal's 1-norm.
+struct TriangleLanes {
+  double corner[4];
+  double edge1[4];
+  double edge2[4];
+  double normal[4];
+  double margin;
+  double normal_margin;
+};
+
+/// Whether box A (fifteen doubles, laid out as for BoxGapFn) and a triangle
+/// may meet: false when one of A's three face axes, or the triangle's
+/// normal, separates them by more than the margin. Conservative: the nine
+/// edge-edge axes, which could separate a few more pairs, are not tried.
+/// Both forms compute every value with the same operations in the same order.
+using BoxTriangleFn = bool (*)(const double* a, const TriangleLanes& t);
+
+/// The test, the move and the box-triangle test, in one form.
 struct BoxLaneOps {
   BoxGapFn gap;
   BoxMoveFn move;
+  BoxTriangleFn meets_triangle;
 };
 
 /// The wide form where the processor has AVX2, else the scalar form;

@@ -5,6 +5,8 @@
 // for operation, so both give the same bits.
 #include <immintrin.h>
 
+#include <cmath>
+
 #include "polygon/box_lanes.h"
 
 namespace dovetail::collision::detail {
@@ -99,12 +101,36 @@ void box_move_avx2(const double* box, const double* R_AB, const double* t_AB, Bo
   box_move_rest(box, R_AB, t_AB, out);
 }
 
+bool box_meets_triangle_avx2(const double* a, const TriangleLanes& t) {
+  const double* centre_a = a + 9;
+  const double* half_a = a + 12;
+  const V a0 = _mm256_loadu_pd(a), a1 = _mm256_loadu_pd(a + 3), a2 = _mm256_loadu_pd(a + 6);
+  const double d[3] = {t.corner[0] - centre_a[0], t.corner[1] - centre_a[1],
+                       t.corner[2] - centre_a[2]};
+  // Lane i: the corners' projections on a_i, and the normal's.
+  const V q0 = sum3(d[0], a0, d[1], a1, d[2], a2);
+  const V q1 = add(q0, sum3(t.edge1[0], a0, t.edge1[1], a1, t.edge1[2], a2));
+  const V q2 = add(q0, sum3(t.edge2[0], a0, t.edge2[1], a1, t.edge2[2], a2));
+  const V qn = sum3(t.normal[0], a0, t.normal[1], a1, t.normal[2], a2);
+  const V half = _mm256_maskload_pd(half_a, _mm256_setr_epi64x(-1, -1, -1, 0));
+  const V reach = add(half, spread(t.margin));
+  const V lo = _mm256_min_pd(q0, _mm256_min_pd(q1, q2));
+  const V hi = _mm256_max_pd(q0, _mm256_max_pd(q1, q2));
+  const V minus_reach = _mm256_xor_pd(reach, spread(-0.0));
+  if (positive(sub(lo, reach)) != 0 || positive(sub(minus_reach, hi)) != 0) return false;
+  alignas(32) double r[4];
+  _mm256_store_pd(r, mul(half, abs(qn)));
+  const double radius = ((0.0 + r[0]) + r[1]) + r[2];
+  const double s = t.normal[0] * d[0] + t.normal[1] * d[1] + t.normal[2] * d[2];
+  return !(std::abs(s) > radius + t.normal_margin);
+}
+
 }  // namespace
 
 BoxLaneOps box_lane_ops_avx2() {
   __builtin_cpu_init();
-  if (!__builtin_cpu_supports("avx2")) return {nullptr, nullptr};
-  return {box_gap_avx2, box_move_avx2};
+  if (!__builtin_cpu_supports("avx2")) return {nullptr, nullptr, nullptr};
+  return {box_gap_avx2, box_move_avx2, box_meets_triangle_avx2};
 }
 
 }  // namespace dovetail::collision::detail

@@ -3,8 +3,11 @@
 // OBB tree's traversal. Never included by the AVX2 file: an inline function
 // compiled there could stand in for this one on any processor.
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
+#include "dovetail/collision/types.h"
 #include "polygon/box_lanes.h"
 
 namespace dovetail::collision::detail {
@@ -50,6 +53,47 @@ inline double box_gap_scalar(const double* a, const BoxLanes& b, double margin) 
     }
   }
   return 0;
+}
+
+/// A triangle laid out for the box-triangle test.
+inline TriangleLanes triangle_lanes(const std::array<Vec3, 3>& corners, Real margin) {
+  TriangleLanes t{};
+  const Vec3 edge1 = corners[1] - corners[0];
+  const Vec3 edge2 = corners[2] - corners[0];
+  const Vec3 normal = edge1.cross(edge2);
+  for (int k = 0; k < 3; ++k) {
+    t.corner[k] = corners[0][k];
+    t.edge1[k] = edge1[k];
+    t.edge2[k] = edge2[k];
+    t.normal[k] = normal[k];
+  }
+  t.margin = margin;
+  t.normal_margin = margin * normal.lpNorm<1>();
+  return t;
+}
+
+/// One face axis of A at a time, then the normal. Each value is written as
+/// the wide form computes it (box_lanes_avx2.cpp).
+inline bool box_meets_triangle_scalar(const double* a, const TriangleLanes& t) {
+  const double* centre_a = a + 9;
+  const double* half_a = a + 12;
+  const double d[3] = {t.corner[0] - centre_a[0], t.corner[1] - centre_a[1],
+                       t.corner[2] - centre_a[2]};
+  // On axis a_i the corners project to q0, q0 + a_i . edge1 and q0 + a_i . edge2.
+  double radius = 0;  // of the box along the normal
+  for (int i = 0; i < 3; ++i) {
+    const double q0 = d[0] * a[i] + d[1] * a[3 + i] + d[2] * a[6 + i];
+    const double q1 = q0 + (t.edge1[0] * a[i] + t.edge1[1] * a[3 + i] + t.edge1[2] * a[6 + i]);
+    const double q2 = q0 + (t.edge2[0] * a[i] + t.edge2[1] * a[3 + i] + t.edge2[2] * a[6 + i]);
+    const double qn = t.normal[0] * a[i] + t.normal[1] * a[3 + i] + t.normal[2] * a[6 + i];
+    const double reach = half_a[i] + t.margin;
+    if (std::min(q0, std::min(q1, q2)) > reach || std::max(q0, std::max(q1, q2)) < -reach) {
+      return false;
+    }
+    radius = radius + half_a[i] * std::abs(qn);
+  }
+  const double s = t.normal[0] * d[0] + t.normal[1] * d[1] + t.normal[2] * d[2];
+  return !(std::abs(s) > radius + t.normal_margin);
 }
 
 inline void box_move_scalar(const double* box, const double* R_AB, const double* t_AB,

@@ -62,11 +62,27 @@ class StructureModel final : public CollisionModel {
     return structure_.split(mesh(), same_method(b).structure_, b.mesh(), X_AB, request);
   }
 
+  bool search_triangle(const std::array<Vec3, 3>& corners, Real margin,
+                       const std::function<bool(std::uint32_t)>& visit,
+                       CollideStats& stats) const override {
+    if constexpr (requires { structure_.search_triangle(corners, margin, visit, stats); }) {
+      return structure_.search_triangle(corners, margin, visit, stats);
+    } else {
+      return CollisionModel::search_triangle(corners, margin, visit, stats);
+    }
+  }
+
  private:
   Structure structure_;
 };
 
 }  // namespace
+
+bool CollisionModel::search_triangle(const std::array<Vec3, 3>&, Real,
+                                     const std::function<bool(std::uint32_t)>&,
+                                     CollideStats&) const {
+  return false;
+}
 
 CollideResult CollisionModel::collide_parallel(const CollisionModel& b, const Transform& X_AB,
                                                const CollideRequest& request,

@@ -446,15 +446,13 @@ struct CollisionWorld::Impl {
   /// contact at or next to the same triangles, and a hit there decides it
   /// (colliding, at the polygon level) without the hulls' test, which could
   /// not have separated it. Returns whether it did; a miss leaves its
-  /// triangle tests in w.result for evaluate_polygon to add.
+  /// work in w.result's statistics for evaluate_polygon to add.
   bool witness_holds(PairWork& w, const Transform& X_AB) {
     PairCache& cache = *w.state->cache;
     if (polygon_request().all_pairs || !cache.has_witness) return false;
-    std::uint64_t tests = 0;
-    const bool hit =
-        follow_witness(*parts[w.a].shape, *parts[w.b].shape, X_AB, cache.witness, tests);
     w.result = CollideResult{};
-    w.result.stats.triangle_tests = tests;
+    const PairTriangles pair{*parts[w.a].shape, *parts[w.b].shape, X_AB, w.result.stats};
+    const bool hit = follow_witness(pair, cache.witness) || search_witness(pair, cache.witness);
     if (hit) w.result.pairs = {cache.witness};
     w.result.colliding = hit;
     w.polygon = w.by_witness = w.colliding = hit;
@@ -469,63 +467,17 @@ struct CollisionWorld::Impl {
     PairCache& cache = *w.state->cache;
     CollideRequest request = polygon_request();
     request.max_size = w.state->plan.max_size;
-    const std::uint64_t witness_tests = w.result.stats.triangle_tests;
+    const CollideStats witness_work = w.result.stats;
     CollideRequest hinted = request;
     if (!request.all_pairs) hinted.hint = &cache.hint;
     if (w.state->plan.front) hinted.front = &cache.front;
     w.result = a.shape->model->collide(*b.shape->model, X_AB, hinted);
-    w.result.stats.triangle_tests += witness_tests;
+    w.result.stats.triangle_tests += witness_work.triangle_tests;
+    w.result.stats.triangle_volume_tests += witness_work.triangle_volume_tests;
     w.colliding = w.result.colliding;
     // A hit of the tolerance cut has no triangle pair to follow.
     cache.has_witness = !request.all_pairs && w.colliding && !w.result.pairs.empty();
     if (cache.has_witness) cache.witness = w.result.pairs.front();
-  }
-
-  /// Follows last step's contact: the witness pair itself, then each of its
-  /// triangles against the triangles around the other's vertices (the
-  /// contact usually moves to a neighbour), each neighbour once, in the order
-  /// of the vertices. On success `witness` is the pair found. A hit is a
-  /// proof; a miss proves nothing and the caller traverses. B's vertices are
-  /// mapped by Transform::apply, as the hierarchies do; the witness's own B
-  /// triangle once for all of A's candidates. As in the hierarchies' leaves,
-  /// a pair whose bounding boxes (of the very coordinates the exact test
-  /// reads) are apart is rejected before the exact test, which alone counts
-  /// in `tests`.
-  static bool follow_witness(const Shape& a, const Shape& b, const Transform& X_AB,
-                             TrianglePair& witness, std::uint64_t& tests) {
-    const Mesh& mesh_a = *a.mesh;
-    const Mesh& mesh_b = *b.mesh;
-    const auto corners_a = [&](std::uint32_t t) {
-      const TriangleIndices& ta = mesh_a.triangles[t];
-      return Corners{mesh_a.vertices[ta[0]], mesh_a.vertices[ta[1]], mesh_a.vertices[ta[2]]};
-    };
-    const auto corners_b = [&](std::uint32_t t) {
-      const TriangleIndices& tb = mesh_b.triangles[t];
-      return Corners{X_AB.apply(mesh_b.vertices[tb[0]]), X_AB.apply(mesh_b.vertices[tb[1]]),
-                     X_AB.apply(mesh_b.vertices[tb[2]])};
-    };
-    const auto hits = [&](const Corners& p, const Corners& q) {
-      if (!p.box_meets(q)) return false;
-      ++tests;
-      return triangles_intersect(p.v[0], p.v[1], p.v[2], q.v[0], q.v[1], q.v[2]);
-    };
-    const TrianglePair last = witness;
-    const Corners last_a = corners_a(last.a);
-    const Corners last_b = corners_b(last.b);
-    if (hits(last_a, last_b)) return true;
-    bool found = false;
-    around_once(a, mesh_a, last.a, [&](std::uint32_t t) {
-      found = hits(corners_a(t), last_b);
-      if (found) witness = {t, last.b};
-      return found;
-    });
-    if (found) return true;
-    around_once(b, mesh_b, last.b, [&](std::uint32_t t) {
-      found = hits(last_a, corners_b(t));
-      if (found) witness = {last.a, t};
-      return found;
-    });
-    return found;
   }
 
   /// A triangle's corners and their bounding box.
@@ -539,11 +491,119 @@ struct CollisionWorld::Impl {
     Vec3 lo, hi;
   };
 
+  /// A pair's triangles as the searches for its contact read them: A's as
+  /// they are, B's mapped into A's frame by Transform::apply, as the
+  /// hierarchies map them. As in the hierarchies' leaves, a pair whose
+  /// bounding boxes (of the very coordinates the exact test reads) are
+  /// apart is rejected before the exact test, which alone counts in
+  /// stats.triangle_tests.
+  struct PairTriangles {
+    const Shape& a;
+    const Shape& b;
+    const Transform& X_AB;
+    CollideStats& stats;
+
+    Corners in_a(std::uint32_t t) const {
+      const TriangleIndices& f = a.mesh->triangles[t];
+      return {a.mesh->vertices[f[0]], a.mesh->vertices[f[1]], a.mesh->vertices[f[2]]};
+    }
+    Corners in_b(std::uint32_t t) const {
+      const TriangleIndices& f = b.mesh->triangles[t];
+      return {X_AB.apply(b.mesh->vertices[f[0]]), X_AB.apply(b.mesh->vertices[f[1]]),
+              X_AB.apply(b.mesh->vertices[f[2]])};
+    }
+    bool meet(const Corners& p, const Corners& q) const {
+      if (!p.box_meets(q)) return false;
+      ++stats.triangle_tests;
+      return triangles_intersect(p.v[0], p.v[1], p.v[2], q.v[0], q.v[1], q.v[2]);
+    }
+  };
+
+  /// Follows last step's contact: the witness pair itself, then each of its
+  /// triangles against the triangles around the other's vertices (the
+  /// contact usually moves to a neighbour), each neighbour once, in the order
+  /// of the vertices. On success `witness` is the pair found. A hit is a
+  /// proof; a miss proves nothing and the caller searches on.
+  static bool follow_witness(const PairTriangles& pair, TrianglePair& witness) {
+    const TrianglePair last = witness;
+    const Corners last_a = pair.in_a(last.a);
+    const Corners last_b = pair.in_b(last.b);  // once for all of A's candidates
+    if (pair.meet(last_a, last_b)) return true;
+    bool found = false;
+    around_once(pair.a, last.a, [&](std::uint32_t t) {
+      found = pair.meet(pair.in_a(t), last_b);
+      if (found) witness = {t, last.b};
+      return found;
+    });
+    if (found) return true;
+    around_once(pair.b, last.b, [&](std::uint32_t t) {
+      found = pair.meet(last_a, pair.in_b(t));
+      if (found) witness = {last.a, t};
+      return found;
+    });
+    return found;
+  }
+
+  /// Parts with fewer triangles are not searched by search_witness: their
+  /// hierarchies are about six levels deep or less, and a traversal from
+  /// the roots costs about what the two searches cost (docs/engine.md, "A
+  /// fifth round").
+  static constexpr std::size_t kSearchedMesh = 64;
+
+  /// After follow_witness: each triangle of the lost witness searched for
+  /// against the other part's whole hierarchy (CollisionModel::
+  /// search_triangle), the larger triangle first. A part often moves by
+  /// more than a ring of the other's triangles in a step, and a large
+  /// triangle that crossed the other part's surface most often still does,
+  /// elsewhere. B's triangle is searched in A's frame, in which its corners
+  /// are the exact test's own; A's is searched in B's frame, and what that
+  /// search visits is tested in A's frame like every other pair. The margin
+  /// covers the rounding of the boxes and of the move into B's frame
+  /// (relative 2^-40, as the hierarchies' own margin) many times over. A hit
+  /// is a proof; a miss proves nothing and the caller traverses.
+  static bool search_witness(const PairTriangles& pair, TrianglePair& witness) {
+    if (pair.a.mesh->triangles.size() < kSearchedMesh ||
+        pair.b.mesh->triangles.size() < kSearchedMesh) {
+      return false;
+    }
+    const Transform& X_AB = pair.X_AB;
+    const Real margin = 0x1.0p-36 * (pair.a.max_abs + pair.b.max_abs + X_AB.t.cwiseAbs().sum());
+    const TrianglePair last = witness;
+    const Corners last_a = pair.in_a(last.a);
+    const Corners last_b = pair.in_b(last.b);
+    const auto b_in_a = [&] {
+      return pair.a.model->search_triangle(
+          last_b.v, margin,
+          [&](std::uint32_t t) {
+            if (!pair.meet(pair.in_a(t), last_b)) return false;
+            witness = {t, last.b};
+            return true;
+          },
+          pair.stats);
+    };
+    const auto a_in_b = [&] {
+      const Transform X_BA = X_AB.inverse();
+      const std::array<Vec3, 3> moved{X_BA.apply(last_a.v[0]), X_BA.apply(last_a.v[1]),
+                                      X_BA.apply(last_a.v[2])};
+      return pair.b.model->search_triangle(
+          moved, margin,
+          [&](std::uint32_t t) {
+            if (!pair.meet(last_a, pair.in_b(t))) return false;
+            witness = {last.a, t};
+            return true;
+          },
+          pair.stats);
+    };
+    const bool a_larger = (last_a.hi - last_a.lo).sum() > (last_b.hi - last_b.lo).sum();
+    return a_larger ? a_in_b() || b_in_a() : b_in_a() || a_in_b();
+  }
+
   /// Calls visit(t) for every triangle other than `f` that shares a vertex
   /// with it, once each, around f's first vertex, then its second, then its
   /// third, until visit returns true.
   template <typename Visit>
-  static void around_once(const Shape& shape, const Mesh& mesh, std::uint32_t f, Visit&& visit) {
+  static void around_once(const Shape& shape, std::uint32_t f, Visit&& visit) {
+    const Mesh& mesh = *shape.mesh;
     const TriangleIndices& corners = mesh.triangles[f];
     for (int i = 0; i < 3; ++i) {
       const std::uint32_t v = corners[i];
@@ -847,6 +907,7 @@ struct CollisionWorld::Impl {
       s.polygon_pairs += w.polygon;
       s.polygon.volume_tests += w.result.stats.volume_tests;
       s.polygon.triangle_tests += w.result.stats.triangle_tests;
+      s.polygon.triangle_volume_tests += w.result.stats.triangle_volume_tests;
       if (!w.colliding) continue;
       const PartPair pair{parts[w.a].id, parts[w.b].id};
       next.colliding.push_back(pair);

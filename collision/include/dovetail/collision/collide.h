@@ -124,6 +124,8 @@ struct CollideRequest {
 struct CollideStats {
   std::uint64_t volume_tests = 0;
   std::uint64_t triangle_tests = 0;
+  /// A triangle against one bounding volume (CollisionModel::search_triangle).
+  std::uint64_t triangle_volume_tests = 0;
 };
 
 /// Outcome of a query. `pairs` holds the first pair found (first-hit query) or

@@ -8,6 +8,8 @@
 /// type sits behind it. A built model is immutable and may be shared and
 /// queried from any number of threads at once.
 
+#include <array>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -72,6 +74,18 @@ class CollisionModel {
   /// A's frame. Throws std::invalid_argument when b was built for another Method.
   virtual CollideResult collide(const CollisionModel& b, const Transform& X_AB,
                                 const CollideRequest& request = {}) const = 0;
+
+  /// The triangles of this model that may meet one triangle: calls
+  /// visit(t) for each triangle t of each leaf whose volume meets `corners`
+  /// (given in this model's frame) widened by `margin`, depth first, until a
+  /// call returns true; returns whether one did. Conservative: a triangle
+  /// never visited does not meet `corners`. Proves nothing about those it
+  /// visits: the caller tests them. Each volume tested counts in
+  /// stats.triangle_volume_tests. Only the OBB tree has this search; the
+  /// other hierarchies visit nothing and return false.
+  virtual bool search_triangle(const std::array<Vec3, 3>& corners, Real margin,
+                               const std::function<bool(std::uint32_t)>& visit,
+                               CollideStats& stats) const;
 
   /// The same query divided into independent parts (the fine-grain
   /// parallelism for one heavy pair). `b`, the models' meshes and this model
