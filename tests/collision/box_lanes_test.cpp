@@ -20,17 +20,18 @@
 namespace dovetail::collision {
 namespace {
 
-/// A box as the OBB tree stores it (detail::store_box): the rotation into
-/// its frame (rows are its axes), centre, half extents, in floats that hold
-/// the box given; and one word after, as a node has its link.
+/// A box as the OBB tree stores it: the rotation into its frame (rows are
+/// its axes), centre, half extents; and one double after, as a node has.
 struct StoredBox {
-  std::array<float, 16> data{};
+  std::array<double, 16> data{};
 };
 
 StoredBox stored(const Mat3& axes, const Vec3& centre, const Vec3& half) {
   StoredBox s;
-  detail::store_box(axes, centre, half, 0.0, s.data.data());
-  s.data[15] = 12345.0f;  // what follows a node's box: its link, read as a float
+  Eigen::Map<Mat3>(s.data.data()) = axes.transpose();
+  Eigen::Map<Vec3>(s.data.data() + 9) = centre;
+  Eigen::Map<Vec3>(s.data.data() + 12) = half;
+  s.data[15] = 12345.0;  // what follows a node's box: its link, read as a double
   return s;
 }
 
@@ -117,10 +118,6 @@ TEST_F(BoxLanes, WideLanesGiveTheScalarLanesBits) {
 }
 
 TEST_F(BoxLanes, VerdictIsTheSeparatingAxisTestsAndTheGapNeverExceedsIt) {
-  // The stored boxes hold the given ones, a little larger (their floats,
-  // and the slack of about 2^-18 of the extents): the test never separates
-  // boxes that meet, and decides as the exact test does wherever the
-  // reference gap is clearly above that slack.
   const detail::BoxLaneOps ops = detail::box_lane_ops();
   int clear = 0, sep = 0;
   for (int n = 0; n < 20000; ++n) {
@@ -130,11 +127,8 @@ TEST_F(BoxLanes, VerdictIsTheSeparatingAxisTestsAndTheGapNeverExceedsIt) {
     const StoredBox sa = stored(a.axes, a.centre, a.half);
     const double gap = ops.gap(sa.data.data(), lanes(ops, b), 0.0);
     ASSERT_GE(gap, 0.0);
-    ASSERT_LE(gap, std::max(reference, 0.0) + 1e-6) << "pair " << n;
-    if (gap > 0) {
-      ASSERT_GT(reference, 0.0) << "pair " << n << " separated, but the boxes meet";
-    }
-    if (std::abs(reference) < 3e-5) continue;  // within the slack
+    ASSERT_LE(gap, std::max(reference, 0.0) + 1e-12) << "pair " << n;
+    if (std::abs(reference) < 1e-9) continue;  // rounding may go either way
     ++clear;
     sep += reference > 0;
     ASSERT_EQ(gap > 0, reference > 0) << "pair " << n << ", reference gap " << reference;
@@ -227,7 +221,7 @@ TEST_F(BoxLanes, TriangleTestNeverPassesOverATriangleThatMeetsTheBox) {
       ++meet;
       ASSERT_TRUE(meets) << "case " << n << ": they meet, gap " << full;
     }
-    if (own > 2e-5) {  // beyond the stored box's floats and slack
+    if (own > 1e-9) {
       ++apart;
       ASSERT_FALSE(meets) << "case " << n << ": apart on its own axes by " << own;
     }

@@ -74,23 +74,18 @@ class ObbTree {
  private:
   friend class ObbPolicy;
   /// A box as the lane test reads it (polygon/box_lanes.h): fifteen
-  /// floats, the rotation into the box's frame (column-major; its rows are
-  /// the box's axes in the mesh's frame), the centre less origin_, the half
-  /// extents; with its link, one cache line.
-  struct alignas(64) Node {
-    float box[15];
+  /// doubles, the rotation into the box's frame (column-major; its rows are
+  /// the box's axes in the mesh's frame), the centre, the half extents.
+  struct Node {
+    double box[15];
     detail::NodeLink link;
 
-    Vec3 centre() const { return {box[9], box[10], box[11]}; }
-    Vec3 half() const { return {box[12], box[13], box[14]}; }
+    Eigen::Map<const Mat3> to_box() const { return Eigen::Map<const Mat3>(box); }
+    Eigen::Map<const Vec3> centre() const { return Eigen::Map<const Vec3>(box + 9); }
+    Eigen::Map<const Vec3> half() const { return Eigen::Map<const Vec3>(box + 12); }
   };
-  static_assert(sizeof(Node) == 64);
   std::vector<Node> nodes_;
   std::vector<std::uint32_t> order_;
-  /// The root box's centre in the mesh's frame: the nodes' centres are
-  /// stored relative to it, so that their rounding to floats is relative to
-  /// the mesh's size, not to its distance from the frame's origin.
-  Vec3 origin_ = Vec3::Zero();
   Real max_abs_ = 0;
   std::size_t leaves_ = 0;
   std::size_t depth_ = 0;

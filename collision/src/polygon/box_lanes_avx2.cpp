@@ -19,19 +19,6 @@ V sub(V a, V b) { return _mm256_sub_pd(a, b); }
 V mul(V a, V b) { return _mm256_mul_pd(a, b); }
 V abs(V a) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), a); }
 V spread(double x) { return _mm256_set1_pd(x); }
-/// Four stored floats from p, as doubles.
-V widen(const float* p) { return _mm256_cvtps_pd(_mm_loadu_ps(p)); }
-/// A box's three half extents (p[0..2]) as doubles, lane 3 zero.
-V widen_half(const float* p) {
-  return _mm256_cvtps_pd(_mm_maskload_ps(p, _mm_setr_epi32(-1, -1, -1, 0)));
-}
-/// Lane i of v in every lane.
-template <int i>
-V lane(V v) {
-  return _mm256_permute4x64_pd(v, i * 0b01'01'01'01);
-}
-/// (x0 a) + (x1 b) + (x2 c), summed left to right, x0..x2 spread already.
-V sum3(V x0, V a, V x1, V b, V x2, V c) { return add(add(mul(x0, a), mul(x1, b)), mul(x2, c)); }
 /// (x0 a) + (x1 b) + (x2 c), summed left to right.
 V sum3(double x0, V a, double x1, V b, double x2, V c) {
   return add(add(mul(spread(x0), a), mul(spread(x1), b)), mul(spread(x2), c));
@@ -41,12 +28,12 @@ int positive(V a) {
   return _mm256_movemask_pd(_mm256_cmp_pd(a, _mm256_setzero_pd(), _CMP_GT_OQ)) & 7;
 }
 
-double box_gap_avx2(const float* a, const BoxLanes& b, double margin) {
-  const double centre_a[3] = {a[9], a[10], a[11]};
-  const double half_a[3] = {a[12], a[13], a[14]};
-  const V m = spread(margin + (kFrameSlack * ((half_a[0] + half_a[1]) + half_a[2]) + b.slack));
+double box_gap_avx2(const double* a, const BoxLanes& b, double margin) {
+  const double* centre_a = a + 9;
+  const double* half_a = a + 12;
+  const V m = spread(margin);
   // Rows of A's axes (lane i of row k: component k of a_i) and of B's (lane j).
-  const V a0 = widen(a), a1 = widen(a + 3), a2 = widen(a + 6);
+  const V a0 = _mm256_loadu_pd(a), a1 = _mm256_loadu_pd(a + 3), a2 = _mm256_loadu_pd(a + 6);
   const V b0 = _mm256_loadu_pd(b.row[0]), b1 = _mm256_loadu_pd(b.row[1]),
           b2 = _mm256_loadu_pd(b.row[2]);
   const double d0 = b.centre[0] - centre_a[0];
@@ -54,10 +41,8 @@ double box_gap_avx2(const float* a, const BoxLanes& b, double margin) {
   const double d2 = b.centre[2] - centre_a[2];
   const V T = sum3(d0, a0, d1, a1, d2, a2);  // lane i: a_i . d
   // R = A^T B by rows (lane j: a_i . b_j), and |R| by columns (lane i).
-  // a[3k + i] is lane i of a_k's row k.
-  const V R[3] = {sum3(lane<0>(a0), b0, lane<0>(a1), b1, lane<0>(a2), b2),
-                  sum3(lane<1>(a0), b0, lane<1>(a1), b1, lane<1>(a2), b2),
-                  sum3(lane<2>(a0), b0, lane<2>(a1), b1, lane<2>(a2), b2)};
+  const V R[3] = {sum3(a[0], b0, a[3], b1, a[6], b2), sum3(a[1], b0, a[4], b1, a[7], b2),
+                  sum3(a[2], b0, a[5], b1, a[8], b2)};
   const V absR[3] = {abs(R[0]), abs(R[1]), abs(R[2])};
   const V t0 = _mm256_unpacklo_pd(absR[0], absR[1]);  // r0[0] r1[0] r0[2] r1[2]
   const V t1 = _mm256_unpackhi_pd(absR[0], absR[1]);  // r0[1] r1[1] r0[3] r1[3]
@@ -71,7 +56,7 @@ double box_gap_avx2(const float* a, const BoxLanes& b, double margin) {
   // A's face axes: |T_i| > e^A_i + sum_j |R_ij| e^B_j.
   const V rb = add(add(mul(column0, spread(b.half[0])), mul(column1, spread(b.half[1]))),
                    mul(column2, spread(b.half[2])));
-  const V ea = widen_half(a + 12);
+  const V ea = _mm256_maskload_pd(half_a, _mm256_setr_epi64x(-1, -1, -1, 0));
   const V face_a = sub(abs(T), add(add(ea, rb), m));
   if (const int bits = positive(face_a)) {
     _mm256_store_pd(gaps, face_a);
@@ -106,32 +91,20 @@ double box_gap_avx2(const float* a, const BoxLanes& b, double margin) {
   return gaps[4 * (k / 3) + k % 3];
 }
 
-void box_move_avx2(const float* box, const double* R_AB, const double* t_AB, BoxLanes& out) {
+void box_move_avx2(const double* box, const double* R_AB, const double* t_AB, BoxLanes& out) {
   // Lane j of the box's row m: component m of its axis j, in B's frame.
-  const V r0 = widen(box), r1 = widen(box + 3), r2 = widen(box + 6);
+  const V r0 = _mm256_loadu_pd(box), r1 = _mm256_loadu_pd(box + 3), r2 = _mm256_loadu_pd(box + 6);
   for (int k = 0; k < 3; ++k) {
     const V row = sum3(R_AB[k], r0, R_AB[3 + k], r1, R_AB[6 + k], r2);
     _mm256_storeu_pd(out.row[k], _mm256_blend_pd(row, _mm256_setzero_pd(), 0b1000));
   }
-  // The centre, lane k: R_AB[k] c_0 + R_AB[3 + k] c_1 + R_AB[6 + k] c_2 + t_AB[k].
-  const __m256i three = _mm256_setr_epi64x(-1, -1, -1, 0);
-  const V centre =
-      add(sum3(double{box[9]}, _mm256_loadu_pd(R_AB), double{box[10]}, _mm256_loadu_pd(R_AB + 3),
-               double{box[11]}, _mm256_maskload_pd(R_AB + 6, three)),
-          _mm256_maskload_pd(t_AB, three));
-  _mm256_storeu_pd(out.centre, _mm256_blend_pd(centre, _mm256_setzero_pd(), 0b1000));
-  const V half = widen_half(box + 12);  // lane 3 zero
-  _mm256_storeu_pd(out.half, half);
-  _mm256_storeu_pd(out.half_next, _mm256_permute4x64_pd(half, 0b11'00'10'01));
-  _mm256_storeu_pd(out.half_after, _mm256_permute4x64_pd(half, 0b11'01'00'10));
-  const double h[3] = {box[12], box[13], box[14]};
-  out.slack = kFrameSlack * ((h[0] + h[1]) + h[2]);
+  box_move_rest(box, R_AB, t_AB, out);
 }
 
-bool box_meets_triangle_avx2(const float* a, const TriangleLanes& t) {
-  const double centre_a[3] = {a[9], a[10], a[11]};
-  const double half_a[3] = {a[12], a[13], a[14]};
-  const V a0 = widen(a), a1 = widen(a + 3), a2 = widen(a + 6);
+bool box_meets_triangle_avx2(const double* a, const TriangleLanes& t) {
+  const double* centre_a = a + 9;
+  const double* half_a = a + 12;
+  const V a0 = _mm256_loadu_pd(a), a1 = _mm256_loadu_pd(a + 3), a2 = _mm256_loadu_pd(a + 6);
   const double d[3] = {t.corner[0] - centre_a[0], t.corner[1] - centre_a[1],
                        t.corner[2] - centre_a[2]};
   // Lane i: the corners' projections on a_i, and the normal's.
@@ -139,7 +112,7 @@ bool box_meets_triangle_avx2(const float* a, const TriangleLanes& t) {
   const V q1 = add(q0, sum3(t.edge1[0], a0, t.edge1[1], a1, t.edge1[2], a2));
   const V q2 = add(q0, sum3(t.edge2[0], a0, t.edge2[1], a1, t.edge2[2], a2));
   const V qn = sum3(t.normal[0], a0, t.normal[1], a1, t.normal[2], a2);
-  const V half = widen_half(a + 12);
+  const V half = _mm256_maskload_pd(half_a, _mm256_setr_epi64x(-1, -1, -1, 0));
   const V reach = add(half, spread(t.margin));
   const V lo = _mm256_min_pd(q0, _mm256_min_pd(q1, q2));
   const V hi = _mm256_max_pd(q0, _mm256_max_pd(q1, q2));
@@ -149,8 +122,7 @@ bool box_meets_triangle_avx2(const float* a, const TriangleLanes& t) {
   _mm256_store_pd(r, mul(half, abs(qn)));
   const double radius = ((0.0 + r[0]) + r[1]) + r[2];
   const double s = t.normal[0] * d[0] + t.normal[1] * d[1] + t.normal[2] * d[2];
-  const double slack = t.normal_slack * ((half_a[0] + half_a[1]) + half_a[2]);
-  return !(std::abs(s) > radius + (t.normal_margin + slack));
+  return !(std::abs(s) > radius + t.normal_margin);
 }
 
 }  // namespace

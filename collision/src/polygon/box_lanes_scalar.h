@@ -9,19 +9,15 @@
 
 #include "dovetail/collision/types.h"
 #include "polygon/box_lanes.h"
-#include "polygon/hierarchy_common.h"
 
 namespace dovetail::collision::detail {
 
 /// The test one axis at a time, stopping at the first that separates. Each
 /// value is written as the wide form computes it (box_lanes_avx2.cpp):
 /// sums left to right, products in the same pairs.
-inline double box_gap_scalar(const float* stored, const BoxLanes& b, double margin_in) {
-  double a[15];
-  for (int k = 0; k < 15; ++k) a[k] = stored[k];
+inline double box_gap_scalar(const double* a, const BoxLanes& b, double margin) {
   const double* centre_a = a + 9;
   const double* half_a = a + 12;
-  const double margin = margin_in + (kFrameSlack * ((half_a[0] + half_a[1]) + half_a[2]) + b.slack);
   const double d[3] = {b.centre[0] - centre_a[0], b.centre[1] - centre_a[1],
                        b.centre[2] - centre_a[2]};
   double T[3], R[3][3], absR[3][3];
@@ -59,41 +55,6 @@ inline double box_gap_scalar(const float* stored, const BoxLanes& b, double marg
   return 0;
 }
 
-/// A box (its axes the columns of `axes`, orthonormal in double; its centre
-/// and half extents) stored as the lane tests read it, in floats: axes and
-/// centre rounded to the nearest, then half extents that make the three
-/// slabs of the rounded axes about the rounded centre hold the whole box,
-/// widened by `room` and rounded up. A point c + sum_k s_k h_k a_k
-/// (|s_k| <= 1) of the box is at most |a'_i . (c - c')| + sum_k h_k |a'_i . a_k|
-/// from c' along a'_i.
-inline void store_box(const Mat3& axes, const Vec3& centre, const Vec3& half, Real room,
-                      float* out) {
-  // Each rounding goes through a volatile float: GCC 12 (-O2 and above) was
-  // seen to drop the rounding from a vectorized Eigen expression that reads
-  // it back, which made the centre's offset below zero.
-  const auto to_float = [](Real x) -> Real {
-    volatile float f = static_cast<float>(x);
-    return f;
-  };
-  Mat3 rounded;  // rows: the rounded axes
-  Vec3 rounded_centre;
-  for (int i = 0; i < 3; ++i) {
-    for (int k = 0; k < 3; ++k) {
-      rounded(i, k) = to_float(axes(k, i));
-      out[3 * k + i] = static_cast<float>(rounded(i, k));  // exact
-    }
-    rounded_centre[i] = to_float(centre[i]);
-    out[9 + i] = static_cast<float>(rounded_centre[i]);  // exact
-  }
-  const Mat3 turn = rounded * axes;  // (i, k): a'_i . a_k
-  const Vec3 offset = rounded * (centre - rounded_centre);
-  for (int i = 0; i < 3; ++i) {
-    const Real reach = std::abs(offset[i]) + turn.row(i).cwiseAbs().dot(half);
-    // Room for the rounding of this bound (relative 2^-40).
-    out[12 + i] = round_up(reach * (1 + 0x1.0p-40) + room);
-  }
-}
-
 /// A triangle laid out for the box-triangle test.
 inline TriangleLanes triangle_lanes(const std::array<Vec3, 3>& corners, Real margin) {
   TriangleLanes t{};
@@ -106,18 +67,14 @@ inline TriangleLanes triangle_lanes(const std::array<Vec3, 3>& corners, Real mar
     t.edge2[k] = edge2[k];
     t.normal[k] = normal[k];
   }
-  const Real normal_l1 = normal.lpNorm<1>();
   t.margin = margin;
-  t.normal_margin = margin * normal_l1;
-  t.normal_slack = kFrameSlack * normal_l1;
+  t.normal_margin = margin * normal.lpNorm<1>();
   return t;
 }
 
 /// One face axis of A at a time, then the normal. Each value is written as
 /// the wide form computes it (box_lanes_avx2.cpp).
-inline bool box_meets_triangle_scalar(const float* stored, const TriangleLanes& t) {
-  double a[15];
-  for (int k = 0; k < 15; ++k) a[k] = stored[k];
+inline bool box_meets_triangle_scalar(const double* a, const TriangleLanes& t) {
   const double* centre_a = a + 9;
   const double* half_a = a + 12;
   const double d[3] = {t.corner[0] - centre_a[0], t.corner[1] - centre_a[1],
@@ -136,30 +93,18 @@ inline bool box_meets_triangle_scalar(const float* stored, const TriangleLanes& 
     radius = radius + half_a[i] * std::abs(qn);
   }
   const double s = t.normal[0] * d[0] + t.normal[1] * d[1] + t.normal[2] * d[2];
-  const double slack = t.normal_slack * ((half_a[0] + half_a[1]) + half_a[2]);
-  return !(std::abs(s) > radius + (t.normal_margin + slack));
+  return !(std::abs(s) > radius + t.normal_margin);
 }
 
-inline void box_move_scalar(const float* stored, const double* R_AB, const double* t_AB,
+inline void box_move_scalar(const double* box, const double* R_AB, const double* t_AB,
                             BoxLanes& out) {
-  double box[9];
-  for (int k = 0; k < 9; ++k) box[k] = stored[k];
   for (int k = 0; k < 3; ++k) {
     for (int j = 0; j < 3; ++j) {
       out.row[k][j] = R_AB[k] * box[j] + R_AB[3 + k] * box[3 + j] + R_AB[6 + k] * box[6 + j];
     }
     out.row[k][3] = 0.0;
   }
-  const double c[3] = {stored[9], stored[10], stored[11]};
-  const double h[3] = {stored[12], stored[13], stored[14]};
-  for (int k = 0; k < 3; ++k) {
-    out.centre[k] = R_AB[k] * c[0] + R_AB[3 + k] * c[1] + R_AB[6 + k] * c[2] + t_AB[k];
-    out.half[k] = h[k];
-    out.half_next[k] = h[(k + 1) % 3];
-    out.half_after[k] = h[(k + 2) % 3];
-  }
-  out.centre[3] = out.half[3] = out.half_next[3] = out.half_after[3] = 0.0;
-  out.slack = kFrameSlack * ((h[0] + h[1]) + h[2]);
+  box_move_rest(box, R_AB, t_AB, out);
 }
 
 }  // namespace dovetail::collision::detail
