@@ -163,8 +163,7 @@ Real ObbTree::reach(const Transform& X_from, const Transform& X_to) const {
   return move * (1 + 0x1.0p-40) + 0x1.0p-40 * scale;
 }
 
-bool ObbTree::search_triangle(const std::array<Vec3, 3>& corners, Real margin,
-                              const std::function<bool(std::uint32_t)>& visit,
+bool ObbTree::search_triangle(const std::array<Vec3, 3>& corners, Real margin, TriangleVisit visit,
                               CollideStats& stats) const {
   if (nodes_.empty()) return false;
   const detail::TriangleLanes triangle = detail::triangle_lanes(corners, margin);

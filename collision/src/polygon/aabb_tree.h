@@ -63,8 +63,8 @@ class ObbTree {
   /// CollisionModel::search_triangle: a box is passed over when one of its
   /// own three axes or the triangle's normal separates it from the triangle
   /// by more than `margin` (box_lanes.h); children in their order.
-  bool search_triangle(const std::array<Vec3, 3>& corners, Real margin,
-                       const std::function<bool(std::uint32_t)>& visit, CollideStats& stats) const;
+  bool search_triangle(const std::array<Vec3, 3>& corners, Real margin, TriangleVisit visit,
+                       CollideStats& stats) const;
 
   /// At least how far any point of any box of this tree moves when the
   /// tree's pose in another frame changes from X_from to X_to, with room for

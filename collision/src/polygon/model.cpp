@@ -62,8 +62,7 @@ class StructureModel final : public CollisionModel {
     return structure_.split(mesh(), same_method(b).structure_, b.mesh(), X_AB, request);
   }
 
-  bool search_triangle(const std::array<Vec3, 3>& corners, Real margin,
-                       const std::function<bool(std::uint32_t)>& visit,
+  bool search_triangle(const std::array<Vec3, 3>& corners, Real margin, TriangleVisit visit,
                        CollideStats& stats) const override {
     if constexpr (requires { structure_.search_triangle(corners, margin, visit, stats); }) {
       return structure_.search_triangle(corners, margin, visit, stats);
@@ -78,8 +77,7 @@ class StructureModel final : public CollisionModel {
 
 }  // namespace
 
-bool CollisionModel::search_triangle(const std::array<Vec3, 3>&, Real,
-                                     const std::function<bool(std::uint32_t)>&,
+bool CollisionModel::search_triangle(const std::array<Vec3, 3>&, Real, TriangleVisit,
                                      CollideStats&) const {
   return false;
 }

@@ -9,11 +9,11 @@
 /// queried from any number of threads at once.
 
 #include <array>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string_view>
+#include <type_traits>
 
 #include "dovetail/collision/collide.h"
 #include "dovetail/collision/mesh.h"
@@ -59,6 +59,28 @@ class SplitQuery {
 };
 
 /// A mesh with its hierarchy for one Method. Immutable after build.
+/// What CollisionModel::search_triangle calls for each triangle it visits:
+/// a reference to a callable `bool(std::uint32_t)`, which it does not own
+/// or copy (the callable must outlive the call that takes it, as a lambda
+/// written in the call's arguments does). Unlike std::function it never
+/// allocates: the search runs in the pipeline's inner loop.
+class TriangleVisit {
+ public:
+  template <typename F>
+  requires(!std::is_same_v<std::remove_cvref_t<F>, TriangleVisit>)
+      TriangleVisit(F&& f)  // NOLINT(google-explicit-constructor): a reference, as a lambda
+      : object_(const_cast<void*>(static_cast<const void*>(std::addressof(f)))),
+        call_([](void* object, std::uint32_t t) -> bool {
+          return (*static_cast<std::remove_reference_t<F>*>(object))(t);
+        }) {}
+
+  bool operator()(std::uint32_t t) const { return call_(object_, t); }
+
+ private:
+  void* object_;
+  bool (*call_)(void*, std::uint32_t);
+};
+
 class CollisionModel {
  public:
   virtual ~CollisionModel() = default;
@@ -83,8 +105,7 @@ class CollisionModel {
   /// visits: the caller tests them. Each volume tested counts in
   /// stats.triangle_volume_tests. Only the OBB tree has this search; the
   /// other hierarchies visit nothing and return false.
-  virtual bool search_triangle(const std::array<Vec3, 3>& corners, Real margin,
-                               const std::function<bool(std::uint32_t)>& visit,
+  virtual bool search_triangle(const std::array<Vec3, 3>& corners, Real margin, TriangleVisit visit,
                                CollideStats& stats) const;
 
   /// The same query divided into independent parts (the fine-grain
