@@ -15,6 +15,7 @@
 #include <lua.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dovetail/scripting/lua_host.h"
@@ -55,6 +56,11 @@ struct HostState {
   char exhausted_message[256] = {};
   // "chunk:line: " of the Lua function the count hook last saw.
   char where[LUA_IDSIZE + 24] = {};
+
+  // Files whose name Lua shortens in positions and tracebacks (to
+  // LUA_IDSIZE, keeping the end behind "..."): the shortened name and the
+  // path as given, which error messages get back (take_error).
+  std::vector<std::pair<std::string, std::string>> shortened_sources;
 
   Xoshiro256 random;
 

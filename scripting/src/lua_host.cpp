@@ -161,6 +161,18 @@ class CallScope {
 
 // Pops the error object on top of the stack and makes the ScriptError: the
 // exhausted limit's kind and message when one is set, else `kind`.
+// Every "shortened:" in text (a position, a traceback line) back to the
+// file's path as given.
+void restore_sources(const HostState& host, std::string& text) {
+  for (const auto& [shortened, full] : host.shortened_sources) {
+    const std::string from = shortened + ':';
+    for (std::size_t at = text.find(from); at != std::string::npos;
+         at = text.find(from, at + full.size() + 1)) {
+      text.replace(at, shortened.size(), full);
+    }
+  }
+}
+
 ScriptError take_error(HostState& host, ScriptError::Kind kind) {
   lua_State* L = host.L;
   std::string text;
@@ -172,12 +184,34 @@ ScriptError take_error(HostState& host, ScriptError::Kind kind) {
     text = std::string("(error object is a ") + luaL_typename(L, -1) + " value)";
   }
   lua_pop(L, 1);
-  if (!limit_exhausted(host)) return ScriptError(kind, text);
+  if (!limit_exhausted(host)) {
+    restore_sources(host, text);
+    return ScriptError(kind, text);
+  }
   // A memory error carries Lua's own text, and an error re-raised through a
   // coroutine a position prefix; the limit's message replaces both.
   const std::string limit_message = host.exhausted_message;
   if (text.compare(0, limit_message.size(), limit_message) != 0) text = limit_message;
+  restore_sources(host, text);
   return ScriptError(*host.exhausted, text);
+}
+
+// A chunk name too long for Lua's positions, with the short form Lua gives
+// it: Lua's own, from a function loaded under that name.
+void remember_shortened(HostState& host, const std::string& chunk_name) {
+  for (const auto& known : host.shortened_sources) {
+    if (known.second == chunk_name.substr(1)) return;
+  }
+  lua_State* L = host.L;
+  if (luaL_loadbufferx(L, "", 0, chunk_name.c_str(), "t") != LUA_OK) {
+    lua_pop(L, 1);
+    return;
+  }
+  lua_Debug ar;
+  lua_getinfo(L, ">S", &ar);  // pops the function
+  if (chunk_name.compare(1, std::string::npos, ar.short_src) != 0) {
+    host.shortened_sources.emplace_back(ar.short_src, chunk_name.substr(1));
+  }
 }
 
 // '@' names a file, '=' any other source ("@" + name trips GCC 12's -Wrestrict).
@@ -320,6 +354,7 @@ void LuaHost::load_chunk(std::string_view code, const std::string& chunk_name) {
   if (!lua_checkstack(L, 2)) {
     throw ScriptError(ScriptError::Kind::kMemory, chunk_name.substr(1) + ": Lua stack overflow");
   }
+  if (chunk_name.size() + 4 >= LUA_IDSIZE) remember_shortened(*host_, chunk_name);
   const int status = luaL_loadbufferx(L, code.data(), code.size(), chunk_name.c_str(), "t");
   if (status != LUA_OK) {
     if (status == LUA_ERRMEM) note_memory_error(*host_);

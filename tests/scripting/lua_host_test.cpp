@@ -572,6 +572,36 @@ TEST(LuaHostErrors, RunFileNamesThePath) {
   expect_works(host);
 }
 
+TEST(LuaHostErrors, ALongPathIsGivenWholeInPositionsAndTracebacks) {
+  // Lua shortens a chunk name to 59 characters ("..." and the end); the
+  // host gives the path back as it was given.
+  LuaHost host(small_limits(), 1);
+  const test::TempDir folder("dovetail_lua_host");
+  const auto deep = folder / "a_rather_long_folder_name" / "another_long_folder_name_here";
+  std::filesystem::create_directories(deep);
+  const auto script = deep / "scenario_with_an_error.lua";
+  ASSERT_GT(script.string().size(), 80u);
+  std::ofstream(script) << "local function f()\n  error('bad')\nend\nf()\n";
+  try {
+    host.run_file(script, 0);
+    ADD_FAILURE() << "no error";
+  } catch (const ScriptError& error) {
+    EXPECT_EQ(error.message(), script.string() + ":2: bad");
+    const std::string all = error.what();
+    EXPECT_NE(all.find(script.string() + ":2: in"), std::string::npos) << all;
+    EXPECT_EQ(all.find("..."), std::string::npos) << all;
+  }
+  std::ofstream(script) << "local t = {\n";
+  try {
+    host.run_file(script, 0);
+    ADD_FAILURE() << "no error";
+  } catch (const ScriptError& error) {
+    EXPECT_EQ(error.kind(), Kind::kSyntax);
+    EXPECT_EQ(error.message().rfind(script.string() + ":", 0), 0u) << error.message();
+  }
+  expect_works(host);
+}
+
 // ---- 5 and 6. determinism: random, pairs, sort
 
 TEST(LuaHostRandom, SeededSequenceWithLuaSemantics) {
