@@ -192,11 +192,9 @@ void check_outputs(const Args& args, const std::filesystem::path& scenario,
 
 int run_scenario_command(const Args& args, const std::filesystem::path& scenario,
                          std::optional<std::filesystem::path> trace) {
+  // A missing scenario or trace is the run's error, like any other: the
+  // report is written with it.
   scripting::RunOptions options = run_options(args, std::move(trace));
-  if (!std::filesystem::exists(scenario)) throw InputError(scenario.string() + ": no such file");
-  if (options.trace && !std::filesystem::exists(*options.trace)) {
-    throw InputError(options.trace->string() + ": no such file");
-  }
   check_outputs(args, scenario, options);
   if (auto path = args.value("report")) options.outputs.emplace_back(*path);
   const scripting::RunOutcome outcome = scripting::run_scenario(scenario, options);

@@ -33,7 +33,13 @@ add_test(NAME cli.replay_same_report
          COMMAND ${CMAKE_COMMAND} -E compare_files ${out}/peg_recorded.json ${out}/peg_replayed.json)
 set_tests_properties(cli.replay_same_report PROPERTIES FIXTURES_REQUIRED "peg_recorded;peg_replayed")
 dovetail_cli_test(replay_missing_trace EXIT 1 ARGS replay ${scenarios}/01_peg_in_hole.lua ${out}/no_such.csv
-                  STDERR "no_such.csv: no such file")
+                  --report ${out}/missing_trace.json STDERR "no_such.csv: file not found"
+                  FILE ${out}/missing_trace.json
+                  MATCHES "\"outcome\": \"error\"&&\"error\": \".*no_such.csv: file not found\""
+                  REMOVE ${out}/missing_trace.json)
+dovetail_cli_test(run_missing_scenario EXIT 1 ARGS run ${out}/no_such.lua --report ${out}/missing.json
+                  STDERR "no_such.lua: file not found" FILE ${out}/missing.json
+                  MATCHES "\"outcome\": \"error\"" REMOVE ${out}/missing.json)
 
 # check and new
 dovetail_cli_test(check_shipped EXIT 0 ARGS check ${scenarios}/01_peg_in_hole.lua
