@@ -130,8 +130,18 @@ int plan(std::span<const std::string> argv) {
   args.expect_positional(1, "one plan file PLAN");
   const std::string& path = args.positional()[0];
   const std::string out = args.required("out");
-  const double rate = args.number("rate", 0).value_or(90);
-  if (!(rate > 0) || rate > 1e5) throw UsageError("glove plan: --rate must be in (0, 100000] Hz");
+  double rate = 90;
+  if (const std::optional<std::string> text = args.value("rate")) {
+    try {
+      rate = *args.number("rate", 0);
+    } catch (const UsageError&) {
+      rate = -1;  // not a number: the range's message below
+    }
+    if (!(rate > 0) || rate > 1e5) {
+      throw UsageError("glove plan: --rate must be a number of Hz in (0, 100000], not '" + *text +
+                       "'");
+    }
+  }
   const std::string inputs[] = {path};
   refuse_overwriting_input("glove plan", out, inputs);
 

@@ -125,7 +125,10 @@ dovetail_cli_test(glove_plan_too_long EXIT 1
                   REMOVE ${out}/too_long.csv)
 dovetail_cli_test(glove_plan_rate_zero EXIT 2
                   ARGS glove plan ${data}/glove/too_long.plan --out ${out}/too_long.csv --rate 0
-                  STDERR "--rate must be in \\(0, 100000\\] Hz")
+                  STDERR "--rate must be a number of Hz in \\(0, 100000\\], not '0'")
+dovetail_cli_test(glove_plan_rate_not_a_number EXIT 2
+                  ARGS glove plan ${data}/glove/too_long.plan --out ${out}/too_long.csv --rate abc
+                  STDERR "--rate must be a number of Hz in \\(0, 100000\\], not 'abc'")
 
 # A byte-order mark before the header is not part of the first column's name,
 # and a control byte in a bad field is shown escaped, not sent to the terminal.
