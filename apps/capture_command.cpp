@@ -23,7 +23,8 @@ and runs it again: every polygon-level method and the convex level against
 brute force for a disagreement, GJK and the separating-plane search for an
 iteration cap, every method for a value that is not finite. Prints one line
 per file: "reproduced" or "not reproduced" and what the replay saw.
-Exits 0 when none reproduces, 3 when one does, 1 on a file that cannot be read.
+Exits 0 when none reproduces, 3 when one does, 1 when a file cannot be read
+(the others are replayed all the same).
 )";
 
 }  // namespace
@@ -36,12 +37,17 @@ int capture_command(std::span<const std::string> argv) {
   }
   if (args.positional().empty()) throw UsageError("capture: give one or more capture files");
   int exit_code = kExitOk;
+  bool unreadable = false;
   for (const std::string& file : args.positional()) {
     collision::Capture capture;
     try {
       capture = collision::read_capture(file);
     } catch (const collision::CaptureError& e) {
-      throw InputError(e.what());
+      // Said, and the other files replayed all the same.
+      std::fflush(stdout);
+      std::fprintf(stderr, "dovetail: %s\n", e.what());
+      unreadable = true;
+      continue;
     }
     const collision::CaptureReplay replay = collision::replay_capture(capture);
     std::printf("%s: %s %s: %s (%s)\n", file.c_str(),
@@ -50,7 +56,8 @@ int capture_command(std::span<const std::string> argv) {
                 capture.context.c_str());
     if (replay.reproduced) exit_code = kExitCheckFailed;
   }
-  return exit_code;
+  // A file that cannot be read is an input error, whatever the others did.
+  return unreadable ? kExitInputError : exit_code;
 }
 
 }  // namespace dovetail::cli

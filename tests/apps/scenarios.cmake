@@ -173,3 +173,8 @@ dovetail_cli_test(capture_replay_checked_in EXIT 0
                   STDOUT "methods-disagree not reproduced: every method says intersecting&&iteration-cap not reproduced")
 dovetail_cli_test(capture_bad_file EXIT 1 ARGS capture ${data}/cube.obj
                   STDERR "cube.obj:1: not a capture file")
+# An unreadable file is said, and the files after it are replayed all the same.
+dovetail_cli_test(capture_bad_files_and_a_good_one EXIT 1
+                  ARGS capture ${out}/no_such.capture ${data} ${data}/captures/touching-hulls.capture
+                  STDERR "no_such.capture: cannot be opened&&/data: is a folder"
+                  STDOUT "touching-hulls.capture: iteration-cap not reproduced")

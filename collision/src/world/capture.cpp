@@ -57,9 +57,15 @@ void put_mesh(std::string& out, char name, const Mesh& mesh) {
 /// Reads the capture file line by line, naming the file and line in every error.
 class LineReader {
  public:
-  explicit LineReader(const fs::path& file) : file_(file), in_(file) {
-    if (!in_)
-      fail_at(0, "cannot be opened: " + std::error_code(errno, std::generic_category()).message());
+  explicit LineReader(const fs::path& file) : file_(file) {
+    // Errors about the file as a whole name no line.
+    std::error_code error;
+    if (fs::is_directory(file, error)) throw CaptureError(file.string() + ": is a folder");
+    in_.open(file);
+    if (!in_) {
+      throw CaptureError(file.string() + ": cannot be opened: " +
+                         std::error_code(errno, std::generic_category()).message());
+    }
   }
 
   std::string next(std::string_view expecting) {
