@@ -3,7 +3,7 @@
 /// The fixed-step simulation loop over a Scene and a collision::CollisionWorld.
 ///
 /// Why: one frame runs the same stages in the same order every time (see
-/// DESIGN.md, "One frame, in order"): queued actions and the frame hook
+/// docs/engine.md, "One frame, in order"): queued actions and the frame hook
 /// (where input, hand and interaction plug in), commit of the poses,
 /// collision pipeline, events, output. Simulated time is frame * time step,
 /// never wall time, so a headless run goes as fast as it can and gives the

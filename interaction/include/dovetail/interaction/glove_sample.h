@@ -26,7 +26,7 @@ using collision::Transform;
 using collision::Vec3;
 using engine::Quaternion;
 
-/// The 22 joint angles in the order of DESIGN.md's glove-trace columns
+/// The 22 joint angles in the order of the glove-trace columns (docs/cli.md)
 /// (abductions after the pinky, unlike the CyberGlove's native order).
 enum class Joint : std::uint8_t {
   kThumbRoll,

@@ -1,7 +1,7 @@
 #pragma once
 /// \file glove_trace.h
 /// Glove traces: the CSV format in which glove samples are recorded,
-/// replayed and handed to outside tools (DESIGN.md, "Glove traces").
+/// replayed and handed to outside tools (docs/cli.md, "Glove traces").
 ///
 /// Format: a header row naming the 30 columns, then one sample per row,
 /// comma separated. Columns `t` (s), `x y z` (m, tracker position in the

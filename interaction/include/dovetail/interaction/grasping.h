@@ -1,7 +1,7 @@
 #pragma once
 /// \file grasping.h
 /// Natural grasping, rubber-band sliding and mates for one hand in a
-/// simulation (frame step 3 of DESIGN.md, "Interaction").
+/// simulation (frame step 3, docs/engine.md "One frame, in order").
 ///
 /// Why: the glove says how far the user closes the hand, not what the hand
 /// touches. Each frame the fingers close from their last free posture toward

@@ -7,7 +7,7 @@
 /// events that name the segment's part (`hand.index_distal`); every sample it
 /// used is recorded.
 ///
-/// Why: frame steps 1 and 2 of DESIGN.md ("Input", "Hand") belong together
+/// Why: frame steps 1 and 2 (input, hand; docs/engine.md) belong together
 /// and to nobody else. The segments are ordinary scene parts (named
 /// `<name>.<segment>`, tagged `hand`, in one collision group so they are never
 /// tested against each other, drawn in the hand's colour), so the pipeline,
