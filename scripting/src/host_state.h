@@ -108,6 +108,12 @@ void note_memory_error(HostState& host, lua_State* L = nullptr);
 /// the Lua caller of the C function running in `L` (when given).
 bool limit_exhausted(HostState& host, lua_State* L = nullptr);
 
+/// Raises the wall-clock limit, placed at the Lua caller of the C function
+/// running in `L`, when a host call has passed its deadline (or another
+/// limit is exhausted); else returns. For library functions that can run
+/// long between two of the count hook's looks (the pattern search).
+void check_deadline(lua_State* L);
+
 /// Writes "chunk:line: " of the first Lua function at `level` of L's stack
 /// or above (a C function has no line) into `buffer`, empty when there is
 /// none. Never allocates.

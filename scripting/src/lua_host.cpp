@@ -293,6 +293,18 @@ bool limit_exhausted(HostState& host, lua_State* L) {
   return host.exhausted.has_value();
 }
 
+void check_deadline(lua_State* L) {
+  HostState& host = host_of(L);
+  if (!host.active()) return;
+  if (!limit_exhausted(host, L) && Clock::now() > host.deadline) {
+    char here[sizeof(host.where)];
+    write_where(L, 1, here, sizeof(here));
+    set_exhausted(host, ScriptError::Kind::kTime, here, "wall-clock limit of %g s exceeded",
+                  host.limits.wall_seconds_per_call);
+  }
+  if (host.exhausted) raise_exhausted(L);
+}
+
 void write_where(lua_State* L, int level, char* buffer, std::size_t size) {
   lua_Debug ar;
   buffer[0] = '\0';

@@ -379,7 +379,10 @@ int sandbox_string_rep(lua_State* L) {
 // pattern follows; the + 1 is every start. A pattern whose bound exceeds
 // kMaxPatternSteps is refused before it runs, the same way on every run; the
 // bounds of ordinary patterns on names and log lines are far below it.
-constexpr double kMaxPatternSteps = 1e9;
+// At about 6 ns a try, 10^8 tries are about 0.6 s; the wall clock is
+// looked at again when the search returns (check_deadline), so a script of
+// many long searches stops within one search of its limit.
+constexpr double kMaxPatternSteps = 1e8;
 
 /// What makes a pattern's search long (see above).
 struct PatternCost {
@@ -454,7 +457,7 @@ void check_pattern(lua_State* L, const char* name) {
     luaL_error(L,
                "string.%s: the pattern '%s' has %d repetitions and %d optional items that "
                "more pattern follows; on a subject of %I characters it could search for a "
-               "very long time (the sandbox allows about 10^9 tries): shorten the subject "
+               "very long time (the sandbox allows about 10^8 tries): shorten the subject "
                "or the pattern",
                name, pattern, cost.repetitions, cost.optionals, static_cast<LUAI_UACINT>(n));
   }
@@ -464,11 +467,15 @@ void check_pattern(lua_State* L, const char* name) {
 // so their errors name the function and the caller's line as they would.
 int sandbox_string_find(lua_State* L) {
   if (!lua_toboolean(L, 4)) check_pattern(L, "find");  // a plain search has no pattern
-  return host_of(L).string_find(L);
+  const int results = host_of(L).string_find(L);
+  check_deadline(L);
+  return results;
 }
 int sandbox_string_match(lua_State* L) {
   check_pattern(L, "match");
-  return host_of(L).string_match(L);
+  const int results = host_of(L).string_match(L);
+  check_deadline(L);
+  return results;
 }
 int sandbox_string_gmatch(lua_State* L) {
   check_pattern(L, "gmatch");
@@ -476,7 +483,9 @@ int sandbox_string_gmatch(lua_State* L) {
 }
 int sandbox_string_gsub(lua_State* L) {
   check_pattern(L, "gsub");
-  return host_of(L).string_gsub(L);
+  const int results = host_of(L).string_gsub(L);
+  check_deadline(L);
+  return results;
 }
 
 // Names objects by serial number in '%s' and refuses '%p': both would

@@ -364,6 +364,23 @@ TEST(LuaHostBudget, BacktrackingPatternsAreRefusedByTheirBound) {
   expect_works(host);
 }
 
+TEST(LuaHostBudget, LongSearchesInAShortLoopMeetTheWallClock) {
+  // Each search is allowed (about 5 * 10^7 tries) and the loop runs too few
+  // instructions for the count hook to look at the clock: the guard looks
+  // again when a search returns.
+  SandboxLimits limits = small_limits();
+  limits.wall_seconds_per_call = 0.2;
+  LuaHost host(limits, 1);
+  const ScriptError error = run_error(host,
+                                      "local s = string.rep('a', 9999)\n"
+                                      "for i = 1, 20 do\n"
+                                      "  s:find('a-b')\n"
+                                      "end");
+  EXPECT_EQ(error.kind(), Kind::kTime) << error.message();
+  EXPECT_EQ(error.message(), "script.lua:3: wall-clock limit of 0.2 s exceeded");
+  expect_works(host);
+}
+
 // ---- 3. memory cap
 
 TEST(LuaHostMemory, StringRepBombIsRefusedByName) {
