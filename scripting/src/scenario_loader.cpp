@@ -857,8 +857,12 @@ void Loader::read_mates(int map, const SourceLocation& where) {
     m.axis_O = field(t, word, "along", spec.where, what).vector;
     if (const Arg a = field(t, word, "tolerance", spec.where, what); a.given)
       m.position_tolerance = a.number;
-    if (const Arg a = field(t, word, "angle", spec.where, what); a.given)
+    if (const Arg a = field(t, word, "angle", spec.where, what); a.given) {
+      if (!(a.number > 0 && a.number <= 180))
+        fail(spec.where, what + ": angle must be above 0 and at most 180 degrees, not " +
+                             format_number(a.number));
       m.angle_tolerance_deg = a.number;
+    }
     if (m.part == m.other) fail(spec.where, what + ": a part cannot mate with itself");
     lua_pop(L_, 2);
     scenario_.mates.push_back(std::move(spec));

@@ -35,7 +35,7 @@ return scenario {
   },
 
   -- Uncomment to let a simulated hand carry the peg (a plan file, in metres,
-  -- as described in docs/cli.md), or use trace = "recorded.csv".
+  -- as described in docs/interaction.md), or use trace = "recorded.csv".
   -- hand = glove { plan = "my.plan", holding = "peg" },
 
   steps = {

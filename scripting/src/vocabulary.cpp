@@ -21,7 +21,7 @@ std::vector<Word> make_vocabulary() {
         {"units", kText, kOptional, "\"mm\" (default), \"cm\" or \"m\": the unit of every length"},
         {"seed", kCount, kOptional, "seeds math.random in custom actions (default 1)"},
         {"duration", kSeconds, kOptional,
-         "simulated seconds to run (default: the glove's plan or trace, plus 1 s)"},
+         "simulated seconds to run (default: the glove's plan plus 1 s, or its trace's length)"},
         {"time_step", kSeconds, kOptional, "seconds per frame (default 1/90)"},
         {"accuracy", kText, kOptional,
          "\"exact\" (default): parts touch exactly when their triangles meet; or a length, a "
@@ -67,16 +67,19 @@ std::vector<Word> make_vocabulary() {
         {"at", kVector, kOptional, "that part's feature point, in its frame (default origin)"},
         {"along", kDirection, kRequired, "that part's feature axis, in its frame"},
         {"tolerance", kLength, kOptional, "position tolerance (default 2 mm)"},
-        {"angle", kNumber, kOptional, "angle tolerance in degrees (default 5)"}},
+        {"angle", kNumber, kOptional,
+         "angle tolerance in degrees, above 0 and at most 180 (default 5)"}},
        "A fit: released within the tolerances, the part snaps so its point and axis meet "
        "the other's, and `mated` fires. While carried near it, the part is drawn onto the axis.",
        "peg_in_hole = mate { part = \"peg\", point = { 0, 0, 60 }, axis = \"z\", into = "
        "\"block\", at = { 0, -10, 0 }, along = \"-y\" }"});
   w.push_back({"glove",
                WordKind::kDeclaration,
-               {{"plan", kFile, kOptional, "a simulated-glove plan (docs/cli.md, in metres)"},
+               {{"plan", kFile, kOptional,
+                 "a simulated-glove plan (docs/interaction.md, \"Sources\"; in metres)"},
                 {"trace", kFile, kOptional, "or a recorded glove trace (CSV)"},
-                {"holding", kPart, kOptional, "a part the hand holds from the start"},
+                {"holding", kPart, kOptional,
+                 "a part the hand holds from the start (no grasp event: it was never grasped)"},
                 {"grasp", kGraspType, kOptional, "the grasp it is held with (default \"power\")"},
                 {"noise", kTable, kOptional,
                  "glove noise: { position = length, angle = deg, joints = deg, seed = n }"},
@@ -108,7 +111,7 @@ std::vector<Word> make_vocabulary() {
                {{"min", kVector, kRequired, "lowest corner"},
                 {"max", kVector, kRequired, "highest corner"},
                 {"parts", kNames, kOptional, "only these parts (default: all)"}},
-               "A box in the world; parts overlapping it are inside.",
+               "A box in the world; a part whose bounding box overlaps it is inside.",
                "tray = region { min = { -50, 0, -50 }, max = { 50, 20, 50 } }"});
   // ---- shapes
   w.push_back({"box",
@@ -332,7 +335,9 @@ std::vector<Word> make_vocabulary() {
                "no_contact(\"piston\", \"crankcase\")"});
   w.push_back({"warnings_at_most",
                WordKind::kExpectation,
-               {{"count", kCount, kRequired, "how many `warn` actions may happen"}},
+               {{"count", kCount, kRequired,
+                 "how many warnings may be written (`warn` actions and the run's own, such as a "
+                 "move of a fixed part)"}},
                "At most this many warnings.",
                "warnings_at_most(0)"});
   w.push_back({"mate_made",

@@ -77,6 +77,22 @@ TEST(ScenarioLoad, AMisspeltPartIsAnErrorWithFileLineAndASuggestion) {
       << what;
 }
 
+TEST(ScenarioLoad, AMateAngleOutsideItsRangeIsNamed) {
+  const test::TempDir dir("dovetail_scenario");
+  for (const char* angle : {"-5", "0", "720"}) {
+    std::string text = moved_peg("", "");
+    const std::string along = "along = \"-y\" }";
+    text.replace(text.find(along), along.size(),
+                 std::string("along = \"-y\", angle = ") + angle + " }");
+    const std::string what = load_error(write(dir, "angle.lua", text));
+    EXPECT_NE(what.find("angle.lua:9: mate 'peg_in_hole': angle must be above 0 and at most 180 "
+                        "degrees, not " +
+                        std::string(angle)),
+              std::string::npos)
+        << what;
+  }
+}
+
 TEST(ScenarioLoad, AnUnknownFieldAndAWrongKindAreNamed) {
   const test::TempDir dir("dovetail_scenario");
   const auto typo =
