@@ -117,6 +117,15 @@ dovetail_cli_test(check_every_zero EXIT 1 ARGS check ${scenario_data}/invalid/ev
                   STDERR "every_zero.lua:5: every: the period must be more than 0 seconds")
 dovetail_cli_test(check_missing_plan EXIT 1 ARGS check ${scenario_data}/invalid/missing_plan.lua
                   STDERR "missing_plan.lua:5: glove: no_such.plan: file not found")
+# An absolute plan path beside a relative scenario path is named whole.
+file(WRITE ${out}/absolute_plan/absolute_plan.lua
+     "return scenario { name = \"absolute plan\", parts = { b = part { shape = box { size = { 1, 1, 1 } } } },\n"
+     "  hand = glove { plan = \"${out}/absolute_plan/no_such.plan\" } }\n")
+add_test(NAME cli.check_absolute_plan_beside_a_relative_scenario
+         COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:dovetail> "-DARGS=check|absolute_plan.lua"
+                 -DEXPECT_EXIT=1 "-DEXPECT_STDERR=absolute_plan.lua:2: glove: /.*/no_such.plan: file not found"
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/check_command.cmake
+         WORKING_DIRECTORY ${out}/absolute_plan)
 dovetail_cli_test(check_error_nil EXIT 1 ARGS check ${scenario_data}/invalid/error_nil.lua
                   STDERR "error_nil.lua:3: \\(error object is a nil value\\)")
 
