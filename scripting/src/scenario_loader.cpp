@@ -8,9 +8,11 @@
 // loader's errors without crossing Lua's C frames.
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <lua.hpp>
 #include <map>
 #include <numbers>
@@ -64,6 +66,27 @@ int where_function(lua_State* L) {
   }
   lua_pushstring(L, buffer);
   return 1;
+}
+
+/// The line of the file's last `return scenario` outside a comment: where
+/// a scenario returned directly was declared. Lua keeps no line for it (the
+/// call in a `return` is a tail call, whose caller's frame is gone). 0 when
+/// there is none.
+int return_line(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string text;
+  int number = 0, found = 0;
+  while (std::getline(in, text)) {
+    ++number;
+    const std::size_t at = text.find("return");
+    if (at == std::string::npos || text.rfind("--", at) != std::string::npos) continue;
+    if (at > 0 && !std::isspace(static_cast<unsigned char>(text[at - 1])) && text[at - 1] != ';')
+      continue;
+    std::size_t k = at + 6;
+    while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
+    if (text.compare(k, 8, "scenario") == 0) found = number;
+  }
+  return found;
 }
 
 SourceLocation parse_where(const std::string& text, const std::string& fallback_file) {
@@ -621,7 +644,8 @@ Scenario Loader::load() {
     fail(file_only,
          "the file must end with `return scenario { ... }`; it returned " + describe(top));
   }
-  const SourceLocation where = open_declaration(top, "scenario", file_only, "the file's result");
+  SourceLocation where = open_declaration(top, "scenario", file_only, "the file's result");
+  if (where.line == 0) where.line = return_line(file_);
   read_scenario_fields(lua_gettop(L_), where);
   lua_settop(L_, base);
   resolve();

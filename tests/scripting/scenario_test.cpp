@@ -77,6 +77,18 @@ TEST(ScenarioLoad, AMisspeltPartIsAnErrorWithFileLineAndASuggestion) {
       << what;
 }
 
+TEST(ScenarioLoad, TheScenarioTablesOwnFieldsAreNamedAtItsReturnLine) {
+  // `return scenario { ... }` is a tail call, which keeps no line: the
+  // loader names the line of the file's `return scenario`.
+  const test::TempDir dir("dovetail_scenario");
+  const std::string what = load_error(
+      write(dir, "own.lua",
+            "-- return scenario in a comment\n" + moved_peg("", "", "  durration = 1,\n")));
+  EXPECT_NE(what.find("own.lua:2: scenario: unknown field 'durration' (did you mean 'duration'?)"),
+            std::string::npos)
+      << what;
+}
+
 TEST(ScenarioLoad, AMateAngleOutsideItsRangeIsNamed) {
   const test::TempDir dir("dovetail_scenario");
   for (const char* angle : {"-5", "0", "720"}) {
