@@ -25,6 +25,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "dovetail/engine/paths.h"
+#include "dovetail/scripting/scenario_run.h"
 
 extern char** environ;
 
@@ -174,15 +175,13 @@ void finish(Job& job, int wait_status, const std::filesystem::path& out) {
     // The run wrote no report: the log and a report say why it stopped.
     std::ofstream(log, std::ios::binary | std::ios::app) << job.stopped << "\n";
     if (!std::filesystem::exists(report)) {
-      const nlohmann::json stub = {{"format", "dovetail-scenario-report"},
-                                   {"version", 1},
-                                   {"scenario", job.stem},
-                                   {"file", job.file.generic_string()},
-                                   {"outcome", "error"},
-                                   {"error", job.stopped},
-                                   {"expectations", nlohmann::json::array()},
-                                   {"steps", nlohmann::json::array()}};
-      std::ofstream(report, std::ios::binary) << stub.dump(2) << "\n";
+      // The scenario report's own schema, with nothing simulated.
+      scripting::RunOutcome stopped;
+      stopped.status = scripting::RunOutcome::Status::kError;
+      stopped.name = job.stem;
+      stopped.file = job.file;
+      stopped.error = job.stopped;
+      std::ofstream(report, std::ios::binary) << stopped.to_json();
     }
   }
   job.log = read_file(log);
@@ -413,22 +412,36 @@ int regress_command(std::span<const std::string> argv) {
   const int threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
   const double timeout = args.number("timeout", 1).value_or(900);
   const auto [shard_k, shard_n] = parse_shard(args);
-  make_folder(out);
-  // The summaries are checked before any scenario runs: neither a scenario
-  // nor each other, and writable.
+  // The summaries are checked before any scenario runs, and before the
+  // output folder is made: neither a scenario nor each other, and writable.
   std::vector<std::string> scenarios;
   for (const std::filesystem::path& f : scenario_files(folder)) scenarios.push_back(f.string());
   const std::optional<std::string> junit = args.value("junit");
   const std::optional<std::string> html = args.value("html");
+  // A summary inside the output folder is checked for writing once the
+  // folder is made.
+  const auto inside_out = [&](const std::string& summary) {
+    const std::filesystem::path parent =
+        std::filesystem::weakly_canonical(std::filesystem::absolute(summary).parent_path());
+    const std::filesystem::path folder =
+        std::filesystem::weakly_canonical(std::filesystem::absolute(out));
+    const auto [end, at] =
+        std::mismatch(folder.begin(), folder.end(), parent.begin(), parent.end());
+    return end == folder.end();
+  };
   for (const std::optional<std::string>& summary : {junit, html}) {
     if (!summary) continue;
     refuse_overwriting_input("regress", *summary, scenarios);
-    check_writable(*summary);
+    if (!inside_out(*summary)) check_writable(*summary);
   }
   if (junit && html && engine::same_file(*junit, *html)) {
     throw UsageError("regress: --junit and --html name the same file '" + *junit + "'");
   }
   std::vector<Job> jobs = shard_jobs(folder, shard_k, shard_n);
+  make_folder(out);
+  for (const std::optional<std::string>& summary : {junit, html}) {
+    if (summary && inside_out(*summary)) check_writable(*summary);
+  }
 
   const auto begin = std::chrono::steady_clock::now();
   run_jobs(jobs, out, parallel, threads, timeout);

@@ -78,7 +78,8 @@ set_tests_properties(cli.regress_hostile_reports_written PROPERTIES FIXTURES_REQ
 dovetail_cli_test(regress_timeout EXIT 3
                   ARGS regress ${scenario_data}/slow --out ${out}/slow --timeout 1
                   STDOUT "ERROR  slow .*stopped after the timeout of 1 s"
-                  FILE ${out}/slow/slow.json MATCHES "\"outcome\": \"error\"&&stopped after the timeout")
+                  FILE ${out}/slow/slow.json
+                  MATCHES "\"outcome\": \"error\"&&stopped after the timeout&&\"simulation\": {&&\"max_penetration\"")
 
 # Outputs are never inputs: not a scenario, not a file a scenario reads (a
 # copy of the test data, so that a failing test cannot damage it), not each other.
