@@ -423,11 +423,11 @@ int regress_command(std::span<const std::string> argv) {
   const auto inside_out = [&](const std::string& summary) {
     const std::filesystem::path parent =
         std::filesystem::weakly_canonical(std::filesystem::absolute(summary).parent_path());
-    const std::filesystem::path folder =
+    const std::filesystem::path out_folder =
         std::filesystem::weakly_canonical(std::filesystem::absolute(out));
     const auto [end, at] =
-        std::mismatch(folder.begin(), folder.end(), parent.begin(), parent.end());
-    return end == folder.end();
+        std::mismatch(out_folder.begin(), out_folder.end(), parent.begin(), parent.end());
+    return end == out_folder.end();
   };
   for (const std::optional<std::string>& summary : {junit, html}) {
     if (!summary) continue;
