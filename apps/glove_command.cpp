@@ -163,7 +163,7 @@ int plan(std::span<const std::string> argv) {
     std::snprintf(text, sizeof text,
                   ": the plan lasts %g s, %g samples at %g Hz; a trace holds at most 10^7 "
                   "(lower --rate or shorten the plan)",
-                  end, std::floor(end * rate) + 1, rate);
+                  end, std::floor(end * rate) + 2, rate);
     throw InputError(path + text);
   }
   const auto count = static_cast<std::uint64_t>(std::floor(end * rate + 1e-9)) + 1;
@@ -172,6 +172,8 @@ int plan(std::span<const std::string> argv) {
   for (std::uint64_t k = 0; k < count; ++k) {
     samples.push_back(source->sample(static_cast<double>(k) / rate));
   }
+  // The plan's end is a sample too when it falls between two of the rate's.
+  if (samples.back().t < end) samples.push_back(source->sample(end));
   input_step([&] {
     interaction::write_trace(out, samples);
     return 0;

@@ -81,7 +81,14 @@ set_tests_properties(cli.glove_plan PROPERTIES FIXTURES_SETUP reach_trace)
 dovetail_cli_test(glove_plan_noisy EXIT 0
                   ARGS glove plan ${PROJECT_SOURCE_DIR}/assets/glove/reach_engine.plan
                        --out ${out}/reach_noisy.csv --noise --seed 4
-                  STDOUT "\"samples\":181" REMOVE ${out}/reach_noisy.csv)
+                  STDOUT "\"samples\":182,\"start\":0,\"duration\":2.005" REMOVE ${out}/reach_noisy.csv)
+# A plan whose end falls between two samples ends with a sample at its end.
+file(WRITE ${out}/short_wait.plan "start 0 0 0 1 0 0 0 open\nwait 0.02\n")
+dovetail_cli_test(glove_plan_ends_at_the_plans_end EXIT 0
+                  ARGS glove plan ${out}/short_wait.plan --out ${out}/short_wait.csv
+                  STDOUT "\"samples\":3,\"start\":0,\"duration\":0.02,"
+                  FILE ${out}/short_wait.csv MATCHES "\n0.02,0,0,0,1,"
+                  REMOVE ${out}/short_wait.csv)
 dovetail_cli_test(glove_plan_bad_rate EXIT 2
                   ARGS glove plan ${PROJECT_SOURCE_DIR}/assets/glove/reach_engine.plan
                        --out ${out}/x.csv --rate 0
