@@ -156,14 +156,17 @@ int plan(std::span<const std::string> argv) {
     throw UsageError("glove plan: --seed needs --noise");
   }
   const double end = source->end_time();
-  // Checked as a double first: a plan of 1e300 s would not fit any integer.
-  // Every sample is held until the trace is written (about 400 bytes each).
-  if (!(end * rate < kMaxPlanSamples)) {
+  // Counted as a double first: a plan of 1e300 s would not fit any integer.
+  // Every sample is held until the trace is written (about 400 bytes each):
+  // one at each multiple of 1/rate up to the end, and the end itself.
+  const double on_grid = std::floor(end * rate + 1e-9);
+  const double wanted = on_grid + (on_grid / rate < end ? 2 : 1);
+  if (!(wanted <= kMaxPlanSamples)) {
     char text[160];
     std::snprintf(text, sizeof text,
                   ": the plan lasts %g s, %g samples at %g Hz; a trace holds at most 10^7 "
                   "(lower --rate or shorten the plan)",
-                  end, std::floor(end * rate) + 2, rate);
+                  end, wanted, rate);
     throw InputError(path + text);
   }
   const auto count = static_cast<std::uint64_t>(std::floor(end * rate + 1e-9)) + 1;

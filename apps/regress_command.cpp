@@ -420,11 +420,13 @@ int regress_command(std::span<const std::string> argv) {
   const std::optional<std::string> html = args.value("html");
   // A summary inside the output folder is checked for writing once the
   // folder is made.
+  const auto full = [](const std::filesystem::path& p) {
+    std::filesystem::path f = std::filesystem::weakly_canonical(std::filesystem::absolute(p));
+    return f.has_filename() ? f : f.parent_path();  // "results/" is "results"
+  };
   const auto inside_out = [&](const std::string& summary) {
-    const std::filesystem::path parent =
-        std::filesystem::weakly_canonical(std::filesystem::absolute(summary).parent_path());
-    const std::filesystem::path out_folder =
-        std::filesystem::weakly_canonical(std::filesystem::absolute(out));
+    const std::filesystem::path parent = full(std::filesystem::absolute(summary).parent_path());
+    const std::filesystem::path out_folder = full(out);
     const auto [end, at] =
         std::mismatch(out_folder.begin(), out_folder.end(), parent.begin(), parent.end());
     return end == out_folder.end();

@@ -159,12 +159,11 @@ class CallScope {
   HostState& host_;
 };
 
-// Pops the error object on top of the stack and makes the ScriptError: the
-// exhausted limit's kind and message when one is set, else `kind`.
 // Every "shortened:" in text (a position, a traceback line) back to the
 // file's path as given.
 void restore_sources(const HostState& host, std::string& text) {
   for (const auto& [shortened, full] : host.shortened_sources) {
+    if (full.empty()) continue;  // ambiguous
     const std::string from = shortened + ':';
     for (std::size_t at = text.find(from); at != std::string::npos;
          at = text.find(from, at + full.size() + 1)) {
@@ -173,6 +172,8 @@ void restore_sources(const HostState& host, std::string& text) {
   }
 }
 
+// Pops the error object on top of the stack and makes the ScriptError: the
+// exhausted limit's kind and message when one is set, else `kind`.
 ScriptError take_error(HostState& host, ScriptError::Kind kind) {
   lua_State* L = host.L;
   std::string text;
@@ -199,8 +200,9 @@ ScriptError take_error(HostState& host, ScriptError::Kind kind) {
 // A chunk name too long for Lua's positions, with the short form Lua gives
 // it: Lua's own, from a function loaded under that name.
 void remember_shortened(HostState& host, const std::string& chunk_name) {
+  const std::string full = chunk_name.substr(1);
   for (const auto& known : host.shortened_sources) {
-    if (known.second == chunk_name.substr(1)) return;
+    if (known.second == full) return;
   }
   lua_State* L = host.L;
   if (luaL_loadbufferx(L, "", 0, chunk_name.c_str(), "t") != LUA_OK) {
@@ -209,9 +211,16 @@ void remember_shortened(HostState& host, const std::string& chunk_name) {
   }
   lua_Debug ar;
   lua_getinfo(L, ">S", &ar);  // pops the function
-  if (chunk_name.compare(1, std::string::npos, ar.short_src) != 0) {
-    host.shortened_sources.emplace_back(ar.short_src, chunk_name.substr(1));
+  if (full == ar.short_src) return;
+  // Two paths of one shortened name cannot be told apart: neither is given
+  // back (an empty path marks the name as ambiguous).
+  for (auto& known : host.shortened_sources) {
+    if (known.first == ar.short_src) {
+      known.second.clear();
+      return;
+    }
   }
+  host.shortened_sources.emplace_back(ar.short_src, full);
 }
 
 // '@' names a file, '=' any other source ("@" + name trips GCC 12's -Wrestrict).

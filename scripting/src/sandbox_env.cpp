@@ -477,9 +477,21 @@ int sandbox_string_match(lua_State* L) {
   check_deadline(L);
   return results;
 }
+// One step of a gmatch iterator: the library's (upvalue 1), then the
+// wall clock, as after any other search.
+int gmatch_step(lua_State* L) {
+  const int base = lua_gettop(L);
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_call(L, 0, LUA_MULTRET);
+  check_deadline(L);
+  return lua_gettop(L) - base;
+}
 int sandbox_string_gmatch(lua_State* L) {
   check_pattern(L, "gmatch");
-  return host_of(L).string_gmatch(L);
+  const int results = host_of(L).string_gmatch(L);
+  if (results != 1 || !lua_isfunction(L, -1)) return results;
+  lua_pushcclosure(L, gmatch_step, 1);
+  return 1;
 }
 int sandbox_string_gsub(lua_State* L) {
   check_pattern(L, "gsub");

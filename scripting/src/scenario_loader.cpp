@@ -76,15 +76,34 @@ int return_line(const std::string& file) {
   std::ifstream in(file, std::ios::binary);
   std::string text;
   int number = 0, found = 0;
+  bool in_block_comment = false;  // --[[ ... ]], as scenarios write them
+  const auto word_char = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_';
+  };
   while (std::getline(in, text)) {
     ++number;
-    const std::size_t at = text.find("return");
-    if (at == std::string::npos || text.rfind("--", at) != std::string::npos) continue;
-    if (at > 0 && !std::isspace(static_cast<unsigned char>(text[at - 1])) && text[at - 1] != ';')
-      continue;
-    std::size_t k = at + 6;
-    while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
-    if (text.compare(k, 8, "scenario") == 0) found = number;
+    if (number == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);  // a BOM
+    std::size_t from = 0;
+    if (in_block_comment) {
+      const std::size_t close = text.find("]]");
+      if (close == std::string::npos) continue;
+      in_block_comment = false;
+      from = close + 2;
+    }
+    const std::size_t comment = text.find("--", from);
+    if (comment != std::string::npos && text.compare(comment, 4, "--[[") == 0 &&
+        text.find("]]", comment + 4) == std::string::npos) {
+      in_block_comment = true;
+    }
+    const std::size_t end = comment == std::string::npos ? text.size() : comment;
+    for (std::size_t at = text.find("return", from); at < end; at = text.find("return", at + 1)) {
+      if (at > 0 && word_char(text[at - 1])) continue;
+      std::size_t k = at + 6;
+      if (k < text.size() && word_char(text[k])) continue;
+      while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
+      if (text.compare(k, 8, "scenario") == 0 && (k + 8 >= text.size() || !word_char(text[k + 8])))
+        found = number;
+    }
   }
   return found;
 }

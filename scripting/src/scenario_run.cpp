@@ -995,10 +995,10 @@ Scenario check_scenario(const std::filesystem::path& file, const SandboxLimits& 
     const std::filesystem::path& source = glove.plan.empty() ? glove.trace : glove.plan;
     std::error_code ec;
     if (!std::filesystem::is_regular_file(source, ec)) {
-      // As written in the scenario where that can be told (an absolute
-      // path beside a relative scenario cannot), else as the run names it.
+      // Relative to the scenario's folder when inside it (as a scenario
+      // usually names it), else as the run names it.
       std::filesystem::path shown = source.lexically_relative(file.parent_path());
-      if (shown.empty()) shown = source;
+      if (shown.empty() || *shown.begin() == "..") shown = source;  // outside the folder
       throw ScenarioError(
           glove.where.str() + ": glove: " + shown.string() +
           (std::filesystem::exists(source, ec) ? ": not a file" : ": file not found"));

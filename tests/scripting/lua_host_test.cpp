@@ -365,19 +365,20 @@ TEST(LuaHostBudget, BacktrackingPatternsAreRefusedByTheirBound) {
 }
 
 TEST(LuaHostBudget, LongSearchesInAShortLoopMeetTheWallClock) {
-  // Each search is allowed (about 5 * 10^7 tries) and the loop runs too few
-  // instructions for the count hook to look at the clock: the guard looks
-  // again when a search returns.
+  // Each search is allowed (a bound of 9001^2, below 10^8 tries) and the
+  // loop runs too few instructions for the count hook to look at the
+  // clock: the guard looks again when a search returns, and after each
+  // step of a gmatch.
   SandboxLimits limits = small_limits();
   limits.wall_seconds_per_call = 0.2;
   LuaHost host(limits, 1);
-  const ScriptError error = run_error(host,
-                                      "local s = string.rep('a', 9999)\n"
-                                      "for i = 1, 20 do\n"
-                                      "  s:find('a-b')\n"
-                                      "end");
-  EXPECT_EQ(error.kind(), Kind::kTime) << error.message();
-  EXPECT_EQ(error.message(), "script.lua:3: wall-clock limit of 0.2 s exceeded");
+  for (const char* search : {"  s:find('a-b')", "  for w in s:gmatch('a-b') do end"}) {
+    const ScriptError error = run_error(host, std::string("local s = string.rep('a', 9000)\n"
+                                                          "for i = 1, 30 do\n") +
+                                                  search + "\nend");
+    EXPECT_EQ(error.kind(), Kind::kTime) << error.message();
+    EXPECT_EQ(error.message(), "script.lua:3: wall-clock limit of 0.2 s exceeded");
+  }
   expect_works(host);
 }
 

@@ -58,7 +58,6 @@ class SplitQuery {
   virtual CollideResult result() = 0;
 };
 
-/// A mesh with its hierarchy for one Method. Immutable after build.
 /// What CollisionModel::search_triangle calls for each triangle it visits:
 /// a reference to a callable `bool(std::uint32_t)`, which it does not own
 /// or copy (the callable must outlive the call that takes it, as a lambda
@@ -67,7 +66,8 @@ class SplitQuery {
 class TriangleVisit {
  public:
   template <typename F>
-  requires(!std::is_same_v<std::remove_cvref_t<F>, TriangleVisit>)
+  requires(!std::is_same_v<std::remove_cvref_t<F>, TriangleVisit> &&
+           std::is_invocable_r_v<bool, F&, std::uint32_t>)
       TriangleVisit(F&& f)  // NOLINT(google-explicit-constructor): a reference, as a lambda
       : object_(const_cast<void*>(static_cast<const void*>(std::addressof(f)))),
         call_([](void* object, std::uint32_t t) -> bool {
@@ -81,6 +81,7 @@ class TriangleVisit {
   bool (*call_)(void*, std::uint32_t);
 };
 
+/// A mesh with its hierarchy for one Method. Immutable after build.
 class CollisionModel {
  public:
   virtual ~CollisionModel() = default;
