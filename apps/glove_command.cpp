@@ -159,8 +159,9 @@ int plan(std::span<const std::string> argv) {
   // Counted as a double first: a plan of 1e300 s would not fit any integer.
   // Every sample is held until the trace is written (about 400 bytes each):
   // one at each multiple of 1/rate up to the end, and the end itself.
-  const double on_grid = std::floor(end * rate + 1e-9);
-  const double wanted = on_grid + (on_grid / rate < end ? 2 : 1);
+  const double on_grid = std::floor(end * rate + 1e-9);  // the last multiple of 1/rate
+  const bool end_between = on_grid / rate < end;
+  const double wanted = on_grid + (end_between ? 2 : 1);
   if (!(wanted <= kMaxPlanSamples)) {
     char text[160];
     std::snprintf(text, sizeof text,
@@ -169,14 +170,14 @@ int plan(std::span<const std::string> argv) {
                   end, wanted, rate);
     throw InputError(path + text);
   }
-  const auto count = static_cast<std::uint64_t>(std::floor(end * rate + 1e-9)) + 1;
+  const auto count = static_cast<std::uint64_t>(on_grid) + 1;
   std::vector<GloveSample> samples;
   samples.reserve(count);
   for (std::uint64_t k = 0; k < count; ++k) {
     samples.push_back(source->sample(static_cast<double>(k) / rate));
   }
   // The plan's end is a sample too when it falls between two of the rate's.
-  if (samples.back().t < end) samples.push_back(source->sample(end));
+  if (end_between) samples.push_back(source->sample(end));
   input_step([&] {
     interaction::write_trace(out, samples);
     return 0;

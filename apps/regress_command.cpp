@@ -424,9 +424,9 @@ int regress_command(std::span<const std::string> argv) {
     std::filesystem::path f = std::filesystem::weakly_canonical(std::filesystem::absolute(p));
     return f.has_filename() ? f : f.parent_path();  // "results/" is "results"
   };
+  const std::filesystem::path out_folder = full(out);
   const auto inside_out = [&](const std::string& summary) {
     const std::filesystem::path parent = full(std::filesystem::absolute(summary).parent_path());
-    const std::filesystem::path out_folder = full(out);
     const auto [end, at] =
         std::mismatch(out_folder.begin(), out_folder.end(), parent.begin(), parent.end());
     return end == out_folder.end();

@@ -54,9 +54,10 @@ collision::Mesh normalized(collision::Mesh mesh);
 std::vector<Contender> exact_contenders(const MeshPtr& a, const MeshPtr& b);
 
 /// The approximate settings: each hierarchy's root volume alone (aabb: the
-/// bounding box; not the Boxtree, whose traversal has no depth cut), the OBB, 18-DOP and AABB trees cut at depths 2 to 48
-/// (time-critical detection), the convex hulls (GJK), and the separating-plane
-/// search capped at 1 to 64 iterations (giving up counts as colliding).
+/// bounding box; not the Boxtree, whose traversal has no depth cut), the
+/// OBB, 18-DOP and AABB trees cut at depths 2 to 48 (time-critical
+/// detection), the convex hulls (GJK), and the separating-plane search capped
+/// at 1 to 64 iterations (giving up counts as colliding).
 std::vector<Contender> approximate_contenders(const MeshPtr& a, const MeshPtr& b);
 
 /// The convex level as the pipeline runs it: the hulls' separating-plane

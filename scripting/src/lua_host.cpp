@@ -79,6 +79,13 @@ void* allocate(void* data, void* block, std::size_t old_size, std::size_t new_si
   return moved;
 }
 
+// The wall-clock limit, placed at `where` ("chunk:line: "): the count hook
+// and check_deadline find it passed.
+void exhaust_time(HostState& host, const char* where) {
+  set_exhausted(host, ScriptError::Kind::kTime, where, "wall-clock limit of %g s exceeded",
+                host.limits.wall_seconds_per_call);
+}
+
 // Counts instructions in steps of kHookInterval and, during a host call,
 // raises once the budget or the deadline is passed. Coroutines inherit the
 // hook from the thread that creates them, so they are counted too.
@@ -100,8 +107,7 @@ void count_hook(lua_State* L, lua_Debug* ar) {
                     "instruction budget of %llu exceeded",
                     static_cast<unsigned long long>(host.limits.instructions_per_call));
     } else if (Clock::now() > host.deadline) {
-      set_exhausted(host, ScriptError::Kind::kTime, host.where, "wall-clock limit of %g s exceeded",
-                    host.limits.wall_seconds_per_call);
+      exhaust_time(host, host.where);
     }
   }
   // Once exhausted, every further hook raises again: a swallowed error
@@ -185,16 +191,15 @@ ScriptError take_error(HostState& host, ScriptError::Kind kind) {
     text = std::string("(error object is a ") + luaL_typename(L, -1) + " value)";
   }
   lua_pop(L, 1);
-  if (!limit_exhausted(host)) {
-    restore_sources(host, text);
-    return ScriptError(kind, text);
+  if (limit_exhausted(host)) {
+    // A memory error carries Lua's own text, and an error re-raised through
+    // a coroutine a position prefix; the limit's message replaces both.
+    const std::string limit_message = host.exhausted_message;
+    if (text.compare(0, limit_message.size(), limit_message) != 0) text = limit_message;
+    kind = *host.exhausted;
   }
-  // A memory error carries Lua's own text, and an error re-raised through a
-  // coroutine a position prefix; the limit's message replaces both.
-  const std::string limit_message = host.exhausted_message;
-  if (text.compare(0, limit_message.size(), limit_message) != 0) text = limit_message;
   restore_sources(host, text);
-  return ScriptError(*host.exhausted, text);
+  return ScriptError(kind, text);
 }
 
 // A chunk name too long for Lua's positions, with the short form Lua gives
@@ -308,8 +313,7 @@ void check_deadline(lua_State* L) {
   if (!limit_exhausted(host, L) && Clock::now() > host.deadline) {
     char here[sizeof(host.where)];
     write_where(L, 1, here, sizeof(here));
-    set_exhausted(host, ScriptError::Kind::kTime, here, "wall-clock limit of %g s exceeded",
-                  host.limits.wall_seconds_per_call);
+    exhaust_time(host, here);
   }
   if (host.exhausted) raise_exhausted(L);
 }

@@ -465,17 +465,19 @@ void check_pattern(lua_State* L, const char* name) {
 
 // The library's functions are called directly, in this function's own call,
 // so their errors name the function and the caller's line as they would.
-int sandbox_string_find(lua_State* L) {
-  if (!lua_toboolean(L, 4)) check_pattern(L, "find");  // a plain search has no pattern
-  const int results = host_of(L).string_find(L);
+// The library's search, then the wall clock (check_deadline).
+int timed_search(lua_State* L, lua_CFunction search) {
+  const int results = search(L);
   check_deadline(L);
   return results;
 }
+int sandbox_string_find(lua_State* L) {
+  if (!lua_toboolean(L, 4)) check_pattern(L, "find");  // a plain search has no pattern
+  return timed_search(L, host_of(L).string_find);
+}
 int sandbox_string_match(lua_State* L) {
   check_pattern(L, "match");
-  const int results = host_of(L).string_match(L);
-  check_deadline(L);
-  return results;
+  return timed_search(L, host_of(L).string_match);
 }
 // One step of a gmatch iterator: the library's (upvalue 1), then the
 // wall clock, as after any other search.
@@ -495,9 +497,7 @@ int sandbox_string_gmatch(lua_State* L) {
 }
 int sandbox_string_gsub(lua_State* L) {
   check_pattern(L, "gsub");
-  const int results = host_of(L).string_gsub(L);
-  check_deadline(L);
-  return results;
+  return timed_search(L, host_of(L).string_gsub);
 }
 
 // Names objects by serial number in '%s' and refuses '%p': both would

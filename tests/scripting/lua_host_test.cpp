@@ -48,6 +48,19 @@ ScriptError run_error(LuaHost& host, const std::string& code,
   return ScriptError(Kind::kRuntime, "");
 }
 
+// The error of running `file`, as run_error's of a string.
+ScriptError run_file_error(LuaHost& host, const std::filesystem::path& file) {
+  const int top = lua_gettop(host.state());
+  try {
+    host.run_file(file, 0);
+  } catch (const ScriptError& error) {
+    EXPECT_EQ(lua_gettop(host.state()), top) << "the stack is left as it was";
+    return error;
+  }
+  ADD_FAILURE() << "no error from " << file;
+  return ScriptError(Kind::kRuntime, "");
+}
+
 // A fresh chunk still runs correctly on `host`.
 void expect_works(LuaHost& host) {
   EXPECT_EQ(
@@ -562,31 +575,17 @@ TEST(LuaHostErrors, RunFileNamesThePath) {
   const test::TempDir folder("dovetail_lua_host");
   const auto script = folder / "scenario.lua";
   std::ofstream(script) << "#!/usr/bin/env lua\nlocal x = 1\nerror('bad ' .. x)\n";
-  try {
-    host.run_file(script, 0);
-    ADD_FAILURE() << "no error";
-  } catch (const ScriptError& error) {
-    EXPECT_EQ(error.message(), script.string() + ":3: bad 1");
-  }
+  EXPECT_EQ(run_file_error(host, script).message(), script.string() + ":3: bad 1");
   std::ofstream(script) << "return 6 * 7\n";
   host.run_file(script, 1);
   EXPECT_EQ(lua_tointeger(host.state(), -1), 42);
   lua_pop(host.state(), 1);
   std::ofstream(script, std::ios::binary) << "\x1bLua\x54";
-  try {
-    host.run_file(script, 0);
-    ADD_FAILURE() << "no error";
-  } catch (const ScriptError& error) {
-    EXPECT_EQ(error.kind(), Kind::kSyntax);
-    EXPECT_NE(error.message().find("binary chunk"), std::string::npos) << error.message();
-  }
+  const ScriptError binary = run_file_error(host, script);
+  EXPECT_EQ(binary.kind(), Kind::kSyntax);
+  EXPECT_NE(binary.message().find("binary chunk"), std::string::npos) << binary.message();
   const auto missing = folder / "missing.lua";
-  try {
-    host.run_file(missing, 0);
-    ADD_FAILURE() << "no error";
-  } catch (const ScriptError& error) {
-    EXPECT_EQ(error.message(), missing.string() + ": file not found");
-  }
+  EXPECT_EQ(run_file_error(host, missing).message(), missing.string() + ": file not found");
   expect_works(host);
 }
 
@@ -600,23 +599,15 @@ TEST(LuaHostErrors, ALongPathIsGivenWholeInPositionsAndTracebacks) {
   const auto script = deep / "scenario_with_an_error.lua";
   ASSERT_GT(script.string().size(), 80u);
   std::ofstream(script) << "local function f()\n  error('bad')\nend\nf()\n";
-  try {
-    host.run_file(script, 0);
-    ADD_FAILURE() << "no error";
-  } catch (const ScriptError& error) {
-    EXPECT_EQ(error.message(), script.string() + ":2: bad");
-    const std::string all = error.what();
-    EXPECT_NE(all.find(script.string() + ":2: in"), std::string::npos) << all;
-    EXPECT_EQ(all.find("..."), std::string::npos) << all;
-  }
+  const ScriptError runtime = run_file_error(host, script);
+  EXPECT_EQ(runtime.message(), script.string() + ":2: bad");
+  const std::string all = runtime.what();
+  EXPECT_NE(all.find(script.string() + ":2: in"), std::string::npos) << all;
+  EXPECT_EQ(all.find("..."), std::string::npos) << all;
   std::ofstream(script) << "local t = {\n";
-  try {
-    host.run_file(script, 0);
-    ADD_FAILURE() << "no error";
-  } catch (const ScriptError& error) {
-    EXPECT_EQ(error.kind(), Kind::kSyntax);
-    EXPECT_EQ(error.message().rfind(script.string() + ":", 0), 0u) << error.message();
-  }
+  const ScriptError syntax = run_file_error(host, script);
+  EXPECT_EQ(syntax.kind(), Kind::kSyntax);
+  EXPECT_EQ(syntax.message().rfind(script.string() + ":", 0), 0u) << syntax.message();
   expect_works(host);
 }
 
