@@ -288,7 +288,11 @@ std::vector<std::filesystem::path> scenario_files(const std::filesystem::path& f
   std::error_code ec;
   for (auto it = std::filesystem::directory_iterator(folder, ec);
        !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
-    if (it->is_regular_file(ec) && it->path().extension() == ".lua") files.push_back(it->path());
+    std::error_code kind;
+    if (it->path().extension() == ".lua" && !it->is_directory(kind)) files.push_back(it->path());
+  }
+  if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory) {
+    throw InputError(folder.string() + ": cannot be read: " + ec.message());
   }
   std::sort(files.begin(), files.end());
   return files;

@@ -125,8 +125,10 @@ struct BuiltModel {
 };
 BuiltModel build_timed(collision::Method method, std::shared_ptr<const collision::Mesh> mesh);
 
-/// The `*.lua` files directly in `folder` (not its subfolders), in file-name
-/// order; none when it is not a readable folder.
+/// The `*.lua` entries directly in `folder` (not its subfolders) that are not
+/// folders, in file-name order: a link to a missing file is listed, so that
+/// running it names the problem. None when `folder` is not a folder;
+/// InputError naming it when it exists and cannot be read.
 std::vector<std::filesystem::path> scenario_files(const std::filesystem::path& folder);
 
 /// Creates `folder` and its parents when missing; InputError naming it when

@@ -11,11 +11,18 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <cerrno>
+#include <charconv>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -24,6 +31,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "dovetail/engine/json.h"
 #include "dovetail/engine/paths.h"
 #include "dovetail/scripting/scenario_run.h"
 
@@ -73,7 +81,7 @@ std::string read_file(const std::filesystem::path& path) {
 
 std::string xml_escape(const std::string& text) {
   std::string out;
-  for (const char c : text) {
+  for (const char c : engine::valid_utf8(text)) {
     switch (c) {
       case '<':
         out += "&lt;";
@@ -130,51 +138,75 @@ std::string first_reason(const Job& job) {
   return job.stopped.empty() ? job.status : job.stopped;
 }
 
-void start(Job& job, const std::filesystem::path& out, int threads) {
+/// Starts the run of `job` with its standard error in OUT/STEM.log; false,
+/// with the reason in job.stopped, when it cannot start.
+bool start(Job& job, const std::filesystem::path& out, int threads) {
   const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe");
   const std::filesystem::path folder = out / job.stem;  // `run --render` makes it
   std::vector<std::string> args = {self.string(),
                                    "run",
-                                   job.file.string(),
                                    "--report",
                                    (out / (job.stem + ".json")).string(),
                                    "--render",
                                    folder.string(),
                                    "--threads",
                                    std::to_string(threads),
-                                   "--quiet"};
+                                   "--quiet",
+                                   "--",  // a file named "-x.lua" is a scenario, not an option
+                                   job.file.string()};
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  const std::string log = (out / (job.stem + ".log")).string();
-  std::error_code ec;  // a report left by an earlier regress must not pass for this run's
+  // What an earlier regress left must not pass for this run's.
+  std::error_code ec;
   std::filesystem::remove(out / (job.stem + ".json"), ec);
+  std::filesystem::remove(folder / "final.png", ec);
+  job.start = std::chrono::steady_clock::now();
+  const std::string log = (out / (job.stem + ".log")).string();
+  const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    job.stopped = "not run: " + log + " cannot be written: " + std::strerror(errno);
+    return false;
+  }
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  job.start = std::chrono::steady_clock::now();
+  posix_spawn_file_actions_adddup2(&actions, fd, STDERR_FILENO);
   const int rc = posix_spawn(&job.pid, self.c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) throw InputError("regress: cannot start '" + self.string() + "'");
+  ::close(fd);
+  if (rc != 0) {
+    job.pid = -1;
+    job.stopped = "not run: " + self.string() + " cannot be started: " + std::strerror(rc);
+    return false;
+  }
+  return true;
 }
 
-void finish(Job& job, int wait_status, const std::filesystem::path& out) {
+/// Gathers what the run of `job` left, given how its process ended
+/// (nothing when it never started).
+void finish(Job& job, std::optional<int> wait_status, const std::filesystem::path& out) {
   job.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - job.start).count();
-  job.exit_code = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : 128 + WTERMSIG(wait_status);
-  if (WIFSIGNALED(wait_status) && job.stopped.empty()) {
-    job.stopped = "the run ended with signal " + std::to_string(WTERMSIG(wait_status));
+  if (!wait_status) {
+    job.exit_code = kExitInputError;
+  } else if (WIFEXITED(*wait_status)) {
+    job.exit_code = WEXITSTATUS(*wait_status);
+  } else {
+    job.exit_code = 128 + WTERMSIG(*wait_status);
+    if (job.stopped.empty()) {
+      job.stopped = "the run ended with signal " + std::to_string(WTERMSIG(*wait_status));
+    }
   }
   job.status = job.exit_code == kExitOk            ? "passed"
                : job.exit_code == kExitCheckFailed ? "failed"
                                                    : "error";
   const std::filesystem::path log = out / (job.stem + ".log");
   const std::filesystem::path report = out / (job.stem + ".json");
+  std::error_code ec;
   if (!job.stopped.empty()) {
     // The run wrote no report: the log and a report say why it stopped.
     std::ofstream(log, std::ios::binary | std::ios::app) << job.stopped << "\n";
-    if (!std::filesystem::exists(report)) {
+    if (!std::filesystem::exists(report, ec)) {
       // The scenario report's own schema, with nothing simulated.
       scripting::RunOutcome stopped;
       stopped.status = scripting::RunOutcome::Status::kError;
@@ -185,7 +217,8 @@ void finish(Job& job, int wait_status, const std::filesystem::path& out) {
     }
   }
   job.log = read_file(log);
-  if (std::filesystem::exists(report)) {
+  if (job.log.empty() && !job.stopped.empty()) job.log = job.stopped + "\n";  // no log to read
+  if (std::filesystem::is_regular_file(report, ec)) {
     job.report = nlohmann::json::parse(read_file(report), nullptr, false);
     if (job.report.is_discarded()) job.report = nlohmann::json();
   }
@@ -227,16 +260,18 @@ std::string html_text(const nlohmann::json& value) {
 
 /// One scenario's part of the HTML report: outcome, log, final frame,
 /// expectations, steps and event timeline.
-std::string html_scenario(const Job& j, const std::filesystem::path& out) {
+std::string html_scenario(const Job& j, std::size_t index, const std::filesystem::path& out) {
   std::string h;
   const nlohmann::json& r = j.report;
-  h += "<div class=\"scenario\" id=\"" + xml_escape(j.stem) + "\"><h2>" + xml_escape(j.stem);
+  h += "<div class=\"scenario\" id=\"scenario-" + std::to_string(index + 1) + "\"><h2>" +
+       xml_escape(j.stem);
   if (r.contains("scenario")) h += ": " + html_text(r["scenario"]);
   h += " <span class=\"" + j.status + "\">" + j.status + "</span></h2>\n";
   h += "<p>" + xml_escape(j.file.generic_string()) + "</p>\n";
   if (!j.log.empty()) h += "<pre>" + xml_escape(j.log) + "</pre>\n";
   const std::filesystem::path png = out / j.stem / "final.png";
-  if (std::filesystem::exists(png)) {
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(png, ec)) {
     h += "<img alt=\"final frame of " + xml_escape(j.stem) + "\" src=\"data:image/png;base64," +
          base64(read_file(png)) + "\">\n";
   }
@@ -298,14 +333,15 @@ details{margin:.5em 0}
        " scenarios "
        "passed.</p>\n<table><tr><th>scenario</th><th>outcome</th><th>seconds</th><th>reason</th></"
        "tr>\n";
-  for (const Job& j : jobs) {
-    h += "<tr><td><a href=\"#" + xml_escape(j.stem) + "\">" + xml_escape(j.stem) +
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    const Job& j = jobs[i];
+    h += "<tr><td><a href=\"#scenario-" + std::to_string(i + 1) + "\">" + xml_escape(j.stem) +
          "</a></td><td class=\"" + j.status + "\">" + j.status + "</td><td>" +
          format_seconds(j.seconds) + "</td><td>" +
          (j.status == "passed" ? "" : xml_escape(first_reason(j))) + "</td></tr>\n";
   }
   h += "</table>\n";
-  for (const Job& j : jobs) h += html_scenario(j, out);
+  for (std::size_t i = 0; i < jobs.size(); ++i) h += html_scenario(jobs[i], i, out);
   h += "</body></html>\n";
   std::ofstream file(path, std::ios::binary);
   file << h;
@@ -316,9 +352,17 @@ details{margin:.5em 0}
 std::pair<std::size_t, std::size_t> parse_shard(const Args& args) {
   const std::optional<std::string> shard = args.value("shard");
   if (!shard) return {1, 1};
-  unsigned long k = 0, n = 0;
-  char extra = 0;
-  if (std::sscanf(shard->c_str(), "%lu/%lu%c", &k, &n, &extra) != 2 || n == 0 || k == 0 || k > n) {
+  // Digits only, each number within std::size_t: no sign, no wrap-around.
+  const auto number = [&](std::string_view text, std::size_t& value) {
+    if (text.empty() || text.find_first_not_of("0123456789") != std::string_view::npos)
+      return false;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    return error == std::errc() && end == text.data() + text.size();
+  };
+  const std::size_t slash = shard->find('/');
+  std::size_t k = 0, n = 0;
+  if (slash == std::string::npos || !number(std::string_view(*shard).substr(0, slash), k) ||
+      !number(std::string_view(*shard).substr(slash + 1), n) || n == 0 || k == 0 || k > n) {
     throw UsageError("regress: --shard must be K/N with 1 <= K <= N, not '" + *shard + "'");
   }
   return {k, n};
@@ -337,10 +381,21 @@ std::vector<Job> shard_jobs(const std::filesystem::path& folder, std::size_t sha
     jobs.push_back(std::move(job));
   }
   if (jobs.empty()) {
-    std::fprintf(stderr, "regress: no scenarios in %s%s\n", folder.string().c_str(),
+    std::fprintf(stderr, "dovetail: note: regress: no scenarios in %s%s\n", folder.string().c_str(),
                  shard_n > 1 ? " for this shard" : "");
   }
   return jobs;
+}
+
+/// Prints the line of a finished job.
+void print_line(const Job& job) {
+  std::printf("%-6s %-32s %8.2f s  %s\n",
+              job.status == "passed"   ? "PASS"
+              : job.status == "failed" ? "FAIL"
+                                       : "ERROR",
+              job.stem.c_str(), job.seconds,
+              job.status == "passed" ? "" : first_reason(job).c_str());
+  std::fflush(stdout);
 }
 
 /// Collects the child `pid` that ended with `wait_status` and prints its
@@ -348,50 +403,134 @@ std::vector<Job> shard_jobs(const std::filesystem::path& folder, std::size_t sha
 bool collect(std::vector<Job>& jobs, pid_t pid, int wait_status, const std::filesystem::path& out) {
   for (Job& job : jobs) {
     if (job.pid != pid) continue;
-    finish(job, wait_status, out);
     job.pid = -1;
-    std::printf("%-6s %-32s %8.2f s  %s\n",
-                job.status == "passed"   ? "PASS"
-                : job.status == "failed" ? "FAIL"
-                                         : "ERROR",
-                job.stem.c_str(), job.seconds,
-                job.status == "passed" ? "" : first_reason(job).c_str());
-    std::fflush(stdout);
+    finish(job, wait_status, out);
+    print_line(job);
     return true;
   }
   return false;
 }
 
-/// Runs the jobs, `parallel` at a time, each in its own process killed after
-/// `timeout` seconds.
-void run_jobs(std::vector<Job>& jobs, const std::filesystem::path& out, std::size_t parallel,
-              int threads, double timeout) {
-  std::size_t next = 0, running = 0, done = 0;
-  while (done < jobs.size()) {
-    while (running < parallel && next < jobs.size()) {
-      start(jobs[next++], out, threads);
-      ++running;
+/// The signal that asked regress to stop (SIGINT, SIGTERM, SIGHUP), or 0.
+volatile std::sig_atomic_t g_interrupted = 0;
+
+extern "C" void on_interrupt(int signal_number) { g_interrupted = signal_number; }
+
+/// While it lives, an interrupt stops the runs rather than regress itself,
+/// so that no run is left behind and the summaries are still written.
+class InterruptHandlers {
+ public:
+  InterruptHandlers() {
+    struct sigaction action {};
+    action.sa_handler = on_interrupt;
+    sigemptyset(&action.sa_mask);
+    for (std::size_t i = 0; i < kSignals.size(); ++i) {
+      sigaction(kSignals[i], nullptr, &previous_[i]);
+      // A signal ignored by whoever started regress (nohup) stays ignored.
+      if (previous_[i].sa_handler != SIG_IGN) sigaction(kSignals[i], &action, nullptr);
     }
+  }
+  ~InterruptHandlers() {
+    for (std::size_t i = 0; i < kSignals.size(); ++i)
+      sigaction(kSignals[i], &previous_[i], nullptr);
+  }
+  InterruptHandlers(const InterruptHandlers&) = delete;
+  InterruptHandlers& operator=(const InterruptHandlers&) = delete;
+
+ private:
+  static constexpr std::array<int, 3> kSignals = {SIGINT, SIGTERM, SIGHUP};
+  std::array<struct sigaction, 3> previous_{};
+};
+
+/// Stops every run still going and waits for it, `why` in its log: on an
+/// interrupt, and when regress itself fails, no run outlives it.
+void stop_running(std::vector<Job>& jobs, const std::filesystem::path& out,
+                  const std::string& why) {
+  for (Job& job : jobs) {
+    if (job.pid <= 0) continue;
+    if (job.stopped.empty()) job.stopped = why;
+    kill(job.pid, SIGKILL);
     int wait_status = 0;
-    const pid_t pid = waitpid(-1, &wait_status, WNOHANG);
-    if (pid > 0) {
-      if (collect(jobs, pid, wait_status, out)) {
-        --running;
-        ++done;
-      }
-      continue;
+    while (waitpid(job.pid, &wait_status, 0) < 0 && errno == EINTR) {
     }
-    const auto now = std::chrono::steady_clock::now();
-    for (Job& job : jobs) {
-      if (job.pid > 0 && job.stopped.empty() &&
-          std::chrono::duration<double>(now - job.start).count() > timeout) {
-        char reason[96];
-        std::snprintf(reason, sizeof reason, "stopped after the timeout of %g s", timeout);
-        job.stopped = reason;
-        kill(job.pid, SIGKILL);
+    job.pid = -1;
+    finish(job, wait_status, out);
+    print_line(job);
+  }
+}
+
+/// Runs the jobs, `parallel` at a time, each in its own process killed after
+/// `timeout` seconds. Returns the signal that interrupted them, or 0; the
+/// jobs not run then are reported as such.
+int run_jobs(std::vector<Job>& jobs, const std::filesystem::path& out, std::size_t parallel,
+             int threads, double timeout) {
+  const InterruptHandlers handlers;
+  std::size_t next = 0, running = 0, done = 0;
+  try {
+    while (done < jobs.size() && g_interrupted == 0) {
+      while (running < parallel && next < jobs.size()) {
+        Job& job = jobs[next++];
+        if (start(job, out, threads)) {
+          ++running;
+        } else {
+          finish(job, std::nullopt, out);
+          print_line(job);
+          ++done;
+        }
+      }
+      int wait_status = 0;
+      const pid_t pid = waitpid(-1, &wait_status, WNOHANG);
+      if (pid > 0) {
+        if (collect(jobs, pid, wait_status, out)) {
+          --running;
+          ++done;
+        }
+        continue;
+      }
+      const auto now = std::chrono::steady_clock::now();
+      for (Job& job : jobs) {
+        if (job.pid > 0 && job.stopped.empty() &&
+            std::chrono::duration<double>(now - job.start).count() > timeout) {
+          char reason[96];
+          std::snprintf(reason, sizeof reason, "stopped after the timeout of %g s", timeout);
+          job.stopped = reason;
+          kill(job.pid, SIGKILL);
+        }
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  } catch (...) {
+    stop_running(jobs, out, "stopped: regress failed");
+    throw;
+  }
+  const int signal_number = g_interrupted;
+  if (signal_number == 0) return 0;
+  const std::string why = "regress was interrupted by signal " + std::to_string(signal_number);
+  stop_running(jobs, out, "stopped: " + why);
+  for (; next < jobs.size(); ++next) {
+    Job& job = jobs[next];
+    job.start = std::chrono::steady_clock::now();
+    job.stopped = "not run: " + why;
+    finish(job, std::nullopt, out);
+    print_line(job);
+  }
+  return signal_number;
+}
+
+/// Refuses a folder in which two scenarios would write one output: the
+/// report, log and frames folder of "a.lua" are a.json, a.log and a/, so
+/// "a.log.lua" or "a.json.lua" beside it would write over them.
+void check_output_names(const std::vector<std::filesystem::path>& files) {
+  std::map<std::string, std::filesystem::path> owner;
+  for (const std::filesystem::path& f : files) {
+    const std::string stem = f.stem().string();
+    for (const std::string& name : {stem + ".json", stem + ".log", stem}) {
+      const auto [it, fresh] = owner.emplace(name, f);
+      if (!fresh && it->second != f) {
+        throw InputError("regress: " + it->second.string() + " and " + f.string() +
+                         " would both write OUT/" + name + "; rename one of them");
       }
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
 }
 
@@ -439,21 +578,27 @@ int regress_command(std::span<const std::string> argv) {
   if (junit && html && engine::same_file(*junit, *html)) {
     throw UsageError("regress: --junit and --html name the same file '" + *junit + "'");
   }
+  check_output_names(scenario_files(folder));
   std::vector<Job> jobs = shard_jobs(folder, shard_k, shard_n);
   make_folder(out);
+  if (::access(out.c_str(), W_OK | X_OK) != 0) {
+    throw InputError(out.string() + ": cannot be written: " + std::strerror(errno));
+  }
   for (const std::optional<std::string>& summary : {junit, html}) {
     if (summary && inside_out(*summary)) check_writable(*summary);
   }
 
   const auto begin = std::chrono::steady_clock::now();
-  run_jobs(jobs, out, parallel, threads, timeout);
+  const int interrupted = run_jobs(jobs, out, parallel, threads, timeout);
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   std::size_t passed = 0;
   for (const Job& j : jobs) passed += j.status == "passed";
-  std::printf("%zu of %zu scenarios passed (%.1f s)\n", passed, jobs.size(), total);
+  std::printf("%zu of %zu scenarios passed (%.1f s)%s\n", passed, jobs.size(), total,
+              interrupted != 0 ? ", interrupted" : "");
   if (junit) write_junit(jobs, *junit, total);
   if (html) write_html(jobs, *html, out);
+  if (interrupted != 0) return 128 + interrupted;
   return passed == jobs.size() ? kExitOk : kExitCheckFailed;
 }
 

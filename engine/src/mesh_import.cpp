@@ -478,7 +478,14 @@ ImportReport import_file(const fs::path& path, const ImportOptions& options) {
     fail(path, *wrong);
   }
 
-  const fs::path absolute = fs::absolute(path).lexically_normal();
+  // The folder resolved as the file system does: "link/../x" is x beside
+  // the link's target, not beside the link, as a textual normalisation would
+  // have it. The file keeps its name, so a linked mesh finds its companion
+  // files (materials, buffers) beside the link.
+  std::error_code ec;
+  fs::path absolute = fs::absolute(path);
+  const fs::path folder = fs::weakly_canonical(absolute.parent_path(), ec);
+  absolute = ec ? absolute.lexically_normal() : folder / absolute.filename();
   Assimp::Importer importer;
   // The importer owns and deletes the IO system; `io` stays valid while it lives.
   auto* io = new detail::FolderIOSystem(absolute.parent_path());

@@ -130,6 +130,31 @@ add_test(NAME cli.check_absolute_plan_beside_a_relative_scenario
 dovetail_cli_test(check_error_nil EXIT 1 ARGS check ${scenario_data}/invalid/error_nil.lua
                   STDERR "error_nil.lua:3: \\(error object is a nil value\\)")
 
+# Two scenarios whose outputs would be one file are refused before anything runs.
+file(WRITE ${out}/regress_clash/a.lua "return scenario { name = \"a\", duration = 0.1, parts = { b = part { shape = box { size = { 1, 1, 1 } } } } }\n")
+file(COPY ${out}/regress_clash/a.lua DESTINATION ${out}/regress_clash/more)
+file(RENAME ${out}/regress_clash/more/a.lua ${out}/regress_clash/a.log.lua)
+dovetail_cli_test(regress_output_names_clash EXIT 1 ARGS regress ${out}/regress_clash --out ${out}/regress_clash_out
+                  STDERR "a.log.lua and .*a.lua would both write OUT/a.log; rename one of them")
+# A folder whose name starts with '-', a link to a missing scenario (named, not
+# skipped), and a report that is UTF-8 whatever bytes the scenario's error holds.
+file(WRITE ${out}/regress_odd/-dash/ok.lua "return scenario { name = \"ok\", duration = 0.1, parts = { b = part { shape = box { size = { 1, 1, 1 } } } } }\n")
+file(WRITE ${out}/regress_odd/-dash/not_utf8.lua "error(\"bad \\255\\254\")\n")
+file(CREATE_LINK ${out}/regress_odd/no_such_file.lua ${out}/regress_odd/-dash/broken.lua SYMBOLIC)
+add_test(NAME cli.regress_odd_names
+         COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:dovetail>
+                 "-DARGS=regress|--out|odd_out|--html|odd.html|--|-dash" -DEXPECT_EXIT=3
+                 "-DEXPECT_STDOUT=ERROR  broken .*broken.lua: file not found&&ERROR  not_utf8 &&PASS   ok"
+                 -DEXPECT_FILE=${out}/regress_odd/odd_out/not_utf8.json "-DEXPECT_FILE_MATCHES=bad ��"
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/check_command.cmake
+         WORKING_DIRECTORY ${out}/regress_odd)
+dovetail_cli_test(regress_shard_too_large EXIT 2 ARGS regress ${scenarios} --shard 1/18446744073709551618
+                  STDERR "--shard must be K/N")
+add_test(NAME cli.regress_interrupted
+         COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/regress_interrupt.sh $<TARGET_FILE:dovetail>
+                 ${out}/regress_interrupted)
+set_tests_properties(cli.regress_interrupted PROPERTIES TIMEOUT 300)
+
 dovetail_cli_test(regress_bad_jobs EXIT 2 ARGS regress ${scenarios} -j 0 STDERR "regress: -j must be an integer from 1 to 256")
 dovetail_cli_test(regress_bad_shard EXIT 2 ARGS regress ${scenarios} --shard 3/2 STDERR "--shard must be K/N")
 dovetail_cli_test(regress_not_a_folder EXIT 1 ARGS regress ${out}/no_such_folder STDERR "not a folder")

@@ -29,5 +29,19 @@ TEST(Json, NonFiniteNumbersAreNull) {
 
 TEST(Json, StringsAreEscaped) { EXPECT_EQ(json_string("a\"b\\c\n"), "\"a\\\"b\\\\c\\n\""); }
 
+TEST(Json, TextThatIsNotUtf8IsReplacedByteByByte) {
+  const std::string fffd = "\xEF\xBF\xBD";
+  // Well-formed text of one to four bytes a character is kept as it is.
+  const std::string good = "a \xC3\xA9 \xE2\x82\xAC \xF0\x9F\x94\xA9";
+  EXPECT_EQ(valid_utf8(good), good);
+  EXPECT_EQ(valid_utf8("bad \xFF\xFE"), "bad " + fffd + fffd);
+  EXPECT_EQ(valid_utf8("\xC3"), fffd);                                   // cut short
+  EXPECT_EQ(valid_utf8("\xC0\xAF"), fffd + fffd);                        // overlong '/'
+  EXPECT_EQ(valid_utf8("\xED\xA0\x80"), fffd + fffd + fffd);             // a surrogate
+  EXPECT_EQ(valid_utf8("\xF4\x90\x80\x80"), fffd + fffd + fffd + fffd);  // above U+10FFFF
+  EXPECT_EQ(valid_utf8("\xE2\x82x"), fffd + fffd + "x");
+  EXPECT_EQ(json_string("n\xFF"), "\"n" + fffd + "\"");
+}
+
 }  // namespace
 }  // namespace dovetail::engine
