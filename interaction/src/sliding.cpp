@@ -6,6 +6,7 @@
 #include <numbers>
 #include <optional>
 
+#include "dovetail/collision/contacts.h"
 #include "dovetail/collision/tri_tri.h"
 #include "dovetail/engine/scene.h"
 
@@ -233,6 +234,49 @@ bool proves_free(const SlideProof* proof, const SlideRequest& request) {
                      });
 }
 
+/// A part that starts touching obstacles, its surfaces meeting theirs but
+/// nowhere deeper than the contacts' touching tolerance (placed face on face,
+/// a held part resting where it was grasped), is moved out to the skin along
+/// the contacts' normals by the least motion (project_motion from rest), so
+/// that it can move on, and away from them. The pose off the contacts, with
+/// the contacts met, once the exact test finds it free; nothing when the part
+/// penetrates an obstacle or that pose still collides.
+std::optional<Transform> off_touching(const SlideRequest& request, const SlidingSettings& settings,
+                                      std::vector<SlideContact>& touching, int& queries) {
+  const Vec3 c = request.X_WP.apply(request.p_PC);
+  std::vector<Motion> constraints;
+  for (const SlideObstacle& o : request.obstacles) {
+    const Transform X_OP = engine::compose(o.X_WO.inverse(), request.X_WP);
+    ++queries;
+    for (const collision::ContactPatch& patch :
+         collision::compute_contacts(*o.model, *request.part, X_OP)) {
+      if (patch.penetrating) return std::nullopt;
+      SlideContact k;
+      k.obstacle = o.id;
+      k.p_W = o.X_WO.apply(patch.point);
+      k.n_W = o.X_WO.R * patch.normal;
+      k.kind = patch.kind;
+      Motion a;
+      a << k.n_W, (k.p_W - c).cross(k.n_W);
+      constraints.push_back(a);
+      touching.push_back(k);
+    }
+  }
+  if (constraints.empty()) return std::nullopt;
+  const std::vector<Real> clearance(constraints.size(), settings.skin_m);
+  const std::optional<Motion> away = project_motion(Motion::Zero(), constraints, clearance,
+                                                    settings.turn_stiffness * request.size);
+  if (!away) return std::nullopt;
+  const Transform X_WP = moved(request.X_WP, c, away->head<3>(), away->tail<3>());
+  if (first_hit(request, X_WP, queries)) return std::nullopt;
+  for (SlideContact& k : touching) {
+    const Vec3 p = c + away->head<3>() + rotation_from_vector(away->tail<3>()) * (k.p_W - c);
+    k.separation = k.n_W.dot(p - k.p_W);
+    k.p_W = p;
+  }
+  return X_WP;
+}
+
 }  // namespace
 
 // Goldfarb and Idnani's dual method: from the unconstrained minimum it adds the most
@@ -353,10 +397,16 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
     result.status = SlideStatus::kOverstretched;
     return result;
   }
+  std::vector<SlideContact> touching;
   if (!proves_free(request.start_proof, request) &&
       first_hit(request, result.X_WP, result.collision_queries)) {
-    result.status = SlideStatus::kBlocked;
-    return result;
+    const std::optional<Transform> off =
+        off_touching(request, settings, touching, result.collision_queries);
+    if (!off) {
+      result.status = SlideStatus::kBlocked;
+      return result;
+    }
+    result.X_WP = *off;
   }
   auto add_contact = [&](const SlideContact& k) {
     for (const SlideContact& c : result.contacts) {
@@ -369,6 +419,7 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
     return true;
   };
   for (const SlideContact& k : request.previous_contacts) add_contact(k);
+  for (const SlideContact& k : touching) add_contact(k);
 
   // The contacts move with the part; those it moves away from expire.
   auto follow_contacts = [&](const Vec3& c, const Vec3& v, const Vec3& w) {

@@ -87,6 +87,37 @@ TEST(SlidingCases, ACubePressedOntoABlockSlidesAlongItsTopAndOverItsSharpEdge) {
   EXPECT_TRUE(grasping.held());
 }
 
+TEST(SlidingCases, APartHeldWhileTouchingAnotherMovesOffIt) {
+  // The cube starts resting face on face on the block (touching counts as colliding,
+  // so every step used to be blocked at its start). The hand first presses it 5 mm
+  // down and 20 mm along, then lifts it 50 mm. Expected: it slides along the top face
+  // without entering it, then leaves it, still held.
+  engine::Scene scene;
+  scene.add_part({.name = "block", .movable = false, .render_mesh = box(Vec3(0.03, 0.02, 0.03))});
+  scene.add_part({.name = "cube",
+                  .X_QP = {Mat3::Identity(), Vec3(-0.01, 0.025, 0)},
+                  .render_mesh = box(Vec3::Constant(0.005))});
+  engine::Simulation sim(std::move(scene));
+  Hand hand(sim, std::make_shared<SimulatedGlove>(moves_by(
+                     Vec3(-0.01, 0.2, 0), {Vec3(0.02, -0.005, 0), Vec3(0, 0.055, 0)}, 1.0)));
+  Grasping grasping(sim, hand);
+  grasping.hold("cube", GraspType::kPower);
+  Real max_depth = 0;
+  Real lowest = 1;
+  for (int frame = 0; frame < 90; ++frame) {  // pressed and carried along
+    sim.step();
+    max_depth = std::max(max_depth, depth_between(sim, "block", "cube"));
+    lowest = std::min(lowest, sim.scene().world_pose("cube").t.y() - 0.005);
+  }
+  EXPECT_GE(lowest, 0.02) << "never into the top face";
+  EXPECT_NEAR(sim.scene().world_pose("cube").t.x(), 0.01, 1e-4) << "slid along it";
+  for (int frame = 0; frame < 120; ++frame) sim.step();  // lifted
+  const Vec3 c = sim.scene().world_pose("cube").t;
+  EXPECT_NEAR(c.y(), 0.075, 1e-4) << "lifted off, where the hand wants it";
+  EXPECT_LT(max_depth, 1e-5);
+  EXPECT_TRUE(grasping.held());
+}
+
 TEST(SlidingCases, APartHeldWhileOverlappingAnotherStaysWhereItIsAndIsNeverLost) {
   // The cube starts 1 mm inside the block (as a part just snapped into a seat may be
   // at the skin's scale) and the hand pulls it further in: every step is blocked at
