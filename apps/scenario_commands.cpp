@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -95,23 +96,25 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
   }
   options.render_every = args.unsigned_integer("every").value_or(0);
   if (options.render_every > 0 && !options.render_dir)
-    throw UsageError("run: --every needs --render DIR");
+    throw UsageError(args.command() + ": --every needs --render DIR");
   options.threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
   options.progress = !args.flag("quiet") && stderr_is_terminal();
   if (auto v = args.value("method")) {
     options.method = collision::parse_method(*v);
     if (!options.method)
-      throw UsageError("run: unknown --method '" + *v + "' (" + method_list() + ")");
+      throw UsageError(args.command() + ": unknown --method '" + *v + "' (" + method_list() + ")");
   }
   if (auto v = args.value("capture")) {
     options.capture_dir = *v;
     make_folder(*v);
   }
   if (auto v = args.value("cross-check")) {
-    if (!options.capture_dir) throw UsageError("run: --cross-check needs --capture DIR");
+    if (!options.capture_dir)
+      throw UsageError(args.command() + ": --cross-check needs --capture DIR");
     options.cross_check = collision::parse_method(*v);
     if (!options.cross_check) {
-      throw UsageError("run: unknown --cross-check method '" + *v + "' (" + method_list() + ")");
+      throw UsageError(args.command() + ": unknown --cross-check method '" + *v + "' (" +
+                       method_list() + ")");
     }
   }
   return options;
@@ -264,13 +267,17 @@ int new_command(std::span<const std::string> argv) {
     return kExitOk;
   }
   args.expect_positional(1, "a name");
-  const std::string name = args.positional()[0];
+  std::string name = args.positional()[0];
+  // "dovetail new peg.lua" means the scenario peg in peg.lua.
+  if (name.size() > 4 && name.ends_with(".lua")) name.resize(name.size() - 4);
   const std::filesystem::path out = args.value("out").value_or(name + ".lua");
   if (std::filesystem::exists(out)) throw InputError(out.string() + ": exists; not overwritten");
+  check_writable(out.string());
   std::ofstream file(out, std::ios::binary);
-  file << scripting::starting_scenario(name);
+  file << scripting::starting_scenario(std::filesystem::path(name).filename().string(),
+                                       out.string());
   file.flush();
-  if (!file) throw InputError(out.string() + ": cannot be written");
+  if (!file) throw InputError(out.string() + ": cannot be written: " + std::strerror(errno));
   std::printf("wrote %s; try 'dovetail check %s', then 'dovetail run %s'\n", out.string().c_str(),
               out.string().c_str(), out.string().c_str());
   return kExitOk;

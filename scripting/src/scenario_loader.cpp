@@ -31,9 +31,6 @@ using collision::Mat3;
 using collision::Real;
 
 constexpr const char* kPreludeName = "dovetail prelude";
-/// The longest run a scenario may ask for, in simulated seconds.
-constexpr double kMaxDuration = 3600;
-
 /// Defines one constructor per word: it packs its arguments and marks the
 /// table with the word's name and where it was called.
 constexpr const char* kPrelude = R"lua(
@@ -694,8 +691,8 @@ void Loader::read_scenario_fields(int table, const SourceLocation& where) {
     scenario_.seed = static_cast<std::uint64_t>(a.number);
   }
   if (const Arg a = field(table, word, "duration", where, "scenario"); a.given) {
-    if (a.number > kMaxDuration) {
-      fail(where, "scenario: duration must be at most " + format_number(kMaxDuration) + " s");
+    if (a.number > kMaxRunSeconds) {
+      fail(where, "scenario: duration must be at most " + format_number(kMaxRunSeconds) + " s");
     }
     scenario_.duration = a.number;
   }

@@ -64,6 +64,42 @@ std::pair<std::string, std::string> ordered(const std::string& a, const std::str
   return a < b ? std::pair(a, b) : std::pair(b, a);
 }
 
+/// The glove's samples: the trace to replay when given, else the glove's
+/// trace or plan, with its noise. Errors name the file (and line) and, for
+/// the scenario's own file, the glove that asked for it.
+std::shared_ptr<const interaction::GloveSource> glove_source(
+    const Scenario& scenario, const std::optional<std::filesystem::path>& replay) {
+  const GloveSpec glove = scenario.glove.value_or(GloveSpec{});
+  std::shared_ptr<const interaction::GloveSource> source;
+  try {
+    if (replay) {
+      source = std::make_shared<interaction::TraceSource>(interaction::read_trace(*replay));
+    } else if (!glove.trace.empty()) {
+      source = std::make_shared<interaction::TraceSource>(interaction::read_trace(glove.trace));
+    } else {
+      source = std::make_shared<interaction::SimulatedGlove>(interaction::read_plan(glove.plan));
+    }
+  } catch (const std::exception& e) {
+    // The file's own message names it (and its line); say which glove asked for it.
+    throw ScenarioError(replay ? std::string(e.what())
+                               : glove.where.str() + ": glove: " + e.what());
+  }
+  if (glove.noise && !replay)
+    source = std::make_shared<interaction::NoisyGlove>(source, *glove.noise);
+  // Without a duration the run lasts as long as the glove: no longer than a
+  // scenario's duration may be.
+  if (!scenario.duration && !(source->end_time() <= kMaxRunSeconds)) {
+    const bool trace = replay || !glove.trace.empty();
+    const std::filesystem::path& file = replay ? *replay : trace ? glove.trace : glove.plan;
+    throw ScenarioError((replay ? std::string() : glove.where.str() + ": glove: ") + file.string() +
+                        ": the " + (trace ? "trace" : "plan") + " lasts " +
+                        format_time(source->end_time()) + " s, more than the " +
+                        format_time(kMaxRunSeconds) +
+                        " s a run may last; give the scenario a duration");
+  }
+  return source;
+}
+
 constexpr const char* kRunnerKey = "dovetail.runner";
 constexpr std::array<float, 3> kHighlight = {1.0F, 0.55F, 0.0F};
 
@@ -346,24 +382,9 @@ void Runner::build() {
       [this](engine::Simulation&, std::uint64_t frame, double t) { start_frame(frame, t); });
 
   if (scenario_.glove || options_.trace) {
-    std::shared_ptr<const interaction::GloveSource> source;
     const GloveSpec glove = scenario_.glove.value_or(GloveSpec{});
-    try {
-      if (options_.trace) {
-        source =
-            std::make_shared<interaction::TraceSource>(interaction::read_trace(*options_.trace));
-      } else if (!glove.trace.empty()) {
-        source = std::make_shared<interaction::TraceSource>(interaction::read_trace(glove.trace));
-      } else {
-        source = std::make_shared<interaction::SimulatedGlove>(interaction::read_plan(glove.plan));
-      }
-    } catch (const std::exception& e) {
-      // The file's own message names it (and its line); say which glove asked for it.
-      throw ScenarioError(options_.trace ? std::string(e.what())
-                                         : glove.where.str() + ": glove: " + e.what());
-    }
-    if (glove.noise && !options_.trace)
-      source = std::make_shared<interaction::NoisyGlove>(source, *glove.noise);
+    const std::shared_ptr<const interaction::GloveSource> source =
+        glove_source(scenario_, options_.trace);
     interaction::HandSettings hand_settings;
     hand_settings.model.hand_length = glove.hand_length;
     // Every sample is kept only when the run is recorded (a simulated hour is 80 MB of them).
@@ -372,6 +393,10 @@ void Runner::build() {
     grasping_ = std::make_unique<interaction::Grasping>(*sim_, *hand_);
     for (const MateSpec& m : scenario_.mates) grasping_->add_mate(m.mate);
     if (!glove.holding.empty()) grasping_->hold(glove.holding, glove.grasp);
+  }
+  if (options_.record && !hand_) {
+    throw ScenarioError(file_.string() +
+                        ": --record: the scenario has no glove, so there are no samples to record");
   }
   // Mates snapped by a rule appear among the frame's events.
   sim_->add_event_filter([this](engine::Simulation&, std::vector<Event>& events) {
@@ -669,7 +694,12 @@ void Runner::render(const std::filesystem::path& path) {
   settings.width = options_.render_width;
   settings.height = options_.render_height;
   settings.camera = "dovetail.run";
-  engine::write_png(engine::render(scene, settings), path);
+  try {
+    engine::write_png(engine::render(scene, settings), path);
+  } catch (const std::exception& e) {
+    throw ScenarioError(path.string() + ": the frame at t=" + format_time(sim_->time()) +
+                        " s cannot be drawn: " + e.what());
+  }
 }
 
 void Runner::evaluate_expectations() {
@@ -729,7 +759,7 @@ void Runner::evaluate_expectations() {
                            "' overlapped " + format_length(out_.max_penetration, out_) +
                            " at t=" + format_time(out_.max_penetration_time) + " s (allowed " +
                            format_length(args[0].number, out_) + ")"
-                     : "no two parts overlapped";
+                     : "no vertex of a part was inside another";
     } else if (w == "no_contact") {
       const auto it = first_contact_.find(ordered(args[0].text, args[1].text));
       if (it != first_contact_.end()) {
@@ -886,11 +916,25 @@ void Runner::run() {
     out_.error = e.what();
   }
   out_.report = sim_->report();
-  if (options_.record && hand_) interaction::write_trace(*options_.record, hand_->recorded());
+  // An output that cannot be made is the run's error; the report still
+  // holds everything simulated.
+  const auto output = [&](const auto& make) {
+    try {
+      make();
+    } catch (const std::exception& e) {
+      out_.status = RunOutcome::Status::kError;
+      out_.error += (out_.error.empty() ? "" : "\n") + std::string(e.what());
+    }
+  };
+  if (options_.record && hand_) {
+    output([&] { interaction::write_trace(*options_.record, hand_->recorded()); });
+  }
   if (options_.render_dir) {
-    const std::filesystem::path final_frame = *options_.render_dir / "final.png";
-    render(final_frame);
-    out_.final_frame = final_frame;
+    output([&] {
+      const std::filesystem::path final_frame = *options_.render_dir / "final.png";
+      render(final_frame);
+      out_.final_frame = final_frame;
+    });
   }
   if (capture_) {
     out_.captures = capture_->files();
@@ -989,7 +1033,7 @@ Scenario check_scenario(const std::filesystem::path& file, const SandboxLimits& 
   LuaHost host(limits, 1);
   Scenario scenario = load_scenario(host, file);
   // The glove's plan or trace is read when the run starts (unless it replays
-  // another trace); a check finds it missing now.
+  // another trace); a check reads it now, and names it missing or wrong.
   if (scenario.glove) {
     const GloveSpec& glove = *scenario.glove;
     const std::filesystem::path& source = glove.plan.empty() ? glove.trace : glove.plan;
@@ -1003,6 +1047,7 @@ Scenario check_scenario(const std::filesystem::path& file, const SandboxLimits& 
           glove.where.str() + ": glove: " + shown.string() +
           (std::filesystem::exists(source, ec) ? ": not a file" : ": file not found"));
     }
+    glove_source(scenario, std::nullopt);  // read as the run reads it
   }
   return scenario;
 }

@@ -2,12 +2,12 @@
 
 namespace dovetail::scripting {
 
-std::string starting_scenario(const std::string& name) {
+std::string starting_scenario(const std::string& name, const std::string& file) {
   std::string text = R"lua(-- A Dovetail scenario. It describes an assembly: the parts, how they fit
 -- (mates), the hand and its glove, the steps, what should happen when (rules)
 -- and what must hold for the scenario to pass (expect). Run it with
---   dovetail check NAME.lua    (loads it and checks every name)
---   dovetail run NAME.lua --render out   (simulates it; out/final.png)
+--   dovetail check FILE    (loads it and checks every name)
+--   dovetail run FILE --render out   (simulates it; out/final.png)
 -- Every word is explained in docs/authoring.md.
 return scenario {
   name = "NAME",
@@ -56,10 +56,20 @@ return scenario {
   duration = 2,
 }
 )lua";
-  for (std::size_t at = text.find("NAME"); at != std::string::npos;
-       at = text.find("NAME", at + name.size())) {
-    text.replace(at, 4, name);
+  // The name goes into a Lua string: its quotes and backslashes escaped.
+  std::string quoted;
+  for (const char c : name) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
   }
+  const auto put = [&](std::string_view placeholder, const std::string& value) {
+    for (std::size_t at = text.find(placeholder); at != std::string::npos;
+         at = text.find(placeholder, at + value.size())) {
+      text.replace(at, placeholder.size(), value);
+    }
+  };
+  put("FILE", file);
+  put("NAME", quoted);
   return text;
 }
 

@@ -21,8 +21,9 @@ std::vector<Word> make_vocabulary() {
         {"units", kText, kOptional, "\"mm\" (default), \"cm\" or \"m\": the unit of every length"},
         {"seed", kCount, kOptional, "seeds math.random in custom actions (default 1)"},
         {"duration", kSeconds, kOptional,
-         "simulated seconds to run (default: the glove's plan plus 1 s, or its trace's length)"},
-        {"time_step", kSeconds, kOptional, "seconds per frame (default 1/90)"},
+         "simulated seconds to run, at most 3600 (default: the glove's plan plus 1 s, or its "
+         "trace's length)"},
+        {"time_step", kSeconds, kOptional, "seconds per frame, 0.0001 to 1 (default 1/90)"},
         {"accuracy", kText, kOptional,
          "\"exact\" (default): parts touch exactly when their triangles meet; or a length, a "
          "tolerance: parts that far apart may count as touching, and the pipeline picks "
@@ -83,7 +84,8 @@ std::vector<Word> make_vocabulary() {
                 {"grasp", kGraspType, kOptional, "the grasp it is held with (default \"power\")"},
                 {"noise", kTable, kOptional,
                  "glove noise: { position = length, angle = deg, joints = deg, seed = n }"},
-                {"hand_length", kLength, kOptional, "wrist to middle fingertip (default 190 mm)"}},
+                {"hand_length", kLength, kOptional,
+                 "wrist to middle fingertip, 120 to 260 mm (default 190 mm)"}},
                "The hand, driven by a simulated glove (a plan) or a recorded trace.",
                "hand = glove { plan = \"../assets/glove/peg_in_hole.plan\", holding = \"peg\" }"});
   w.push_back(
@@ -123,7 +125,7 @@ std::vector<Word> make_vocabulary() {
                WordKind::kShape,
                {{"diameter", kLength, kRequired, "diameter"},
                 {"length", kLength, kRequired, "length along z, from z = 0"},
-                {"sides", kCount, kOptional, "facets around (default 64)"}},
+                {"sides", kCount, kOptional, "facets around, 3 to 4096 (default 64)"}},
                "A closed cylinder along z from 0 to its length.",
                "cylinder { diameter = 20, length = 60 }"});
   w.push_back({"block_with_hole",
@@ -131,17 +133,18 @@ std::vector<Word> make_vocabulary() {
                {{"size", kVector, kRequired, "edge lengths; the top face is at y = size.y / 2"},
                 {"hole", kLength, kRequired, "the hole's diameter, down along -y from the top"},
                 {"depth", kLength, kRequired, "the hole's depth (less than size.y)"},
-                {"sides", kCount, kOptional, "facets of the hole's wall (default 64)"}},
+                {"sides", kCount, kOptional, "facets of the hole's wall, 3 to 4096 (default 64)"}},
                "A block centred on the origin with a blind round hole down from its top.",
                "block_with_hole { size = { 80, 60, 80 }, hole = 20.5, depth = 40 }"});
-  w.push_back({"tube",
-               WordKind::kShape,
-               {{"outer", kLength, kRequired, "outer diameter"},
-                {"inner", kLength, kRequired, "inner diameter (the bore)"},
-                {"length", kLength, kRequired, "length along z, from z = 0"},
-                {"sides", kCount, kOptional, "facets around (default 64; 6 gives a hexagon)"}},
-               "A tube, ring or nut: a prism around z with a bore.",
-               "tube { outer = 24, inner = 10.5, length = 3 }"});
+  w.push_back(
+      {"tube",
+       WordKind::kShape,
+       {{"outer", kLength, kRequired, "outer diameter"},
+        {"inner", kLength, kRequired, "inner diameter (the bore)"},
+        {"length", kLength, kRequired, "length along z, from z = 0"},
+        {"sides", kCount, kOptional, "facets around, 3 to 4096 (default 64; 6 gives a hexagon)"}},
+       "A tube, ring or nut: a prism around z with a bore.",
+       "tube { outer = 24, inner = 10.5, length = 3 }"});
   w.push_back({"sphere",
                WordKind::kShape,
                {{"diameter", kLength, kRequired, "diameter, centred on the origin"}},
@@ -324,8 +327,11 @@ std::vector<Word> make_vocabulary() {
   w.push_back({"max_penetration",
                WordKind::kExpectation,
                {{"depth", kLength, kRequired, "the deepest allowed, in the scenario's units"}},
-               "No two parts ever overlap deeper than this (measured every frame with the "
-               "collision layer's contact depth; the hand's segments are not counted).",
+               "No vertex of a part ever lies deeper inside another part than this "
+               "(measured every frame: the deepest vertex's distance to the other's surface; "
+               "parts that cross with no vertex inside the other, two bars laid crosswise, "
+               "measure 0, so check those with no_contact; the hand's segments are not "
+               "counted).",
                "max_penetration(0.01)"});
   w.push_back({"no_contact",
                WordKind::kExpectation,

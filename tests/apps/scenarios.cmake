@@ -55,6 +55,45 @@ dovetail_cli_test(new_scenario_runs EXIT 0 ARGS run ${out}/my_first.lua STDOUT "
 dovetail_cli_test(new_refuses_to_overwrite EXIT 1 ARGS new x --out ${scenarios}/01_peg_in_hole.lua
                   STDERR "exists; not overwritten")
 set_tests_properties(cli.new_scenario_checks cli.new_scenario_runs PROPERTIES FIXTURES_REQUIRED new_scenario)
+# "new peg.lua" is the scenario peg in peg.lua; its comments name the file as written.
+file(MAKE_DIRECTORY ${out}/new_named)
+add_test(NAME cli.new_with_the_extension
+         COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:dovetail> "-DARGS=new|peg.lua" -DEXPECT_EXIT=0
+                 "-DEXPECT_STDOUT=wrote peg.lua;" -DEXPECT_FILE=${out}/new_named/peg.lua
+                 "-DEXPECT_FILE_MATCHES=dovetail check peg.lua &&name = \"peg\"" -DREMOVE_FIRST=${out}/new_named/peg.lua
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/check_command.cmake
+         WORKING_DIRECTORY ${out}/new_named)
+dovetail_cli_test(new_quotes_in_the_name EXIT 0 ARGS new "a\"b" --out ${out}/new_named/quoted.lua
+                  FILE ${out}/new_named/quoted.lua MATCHES "name = \"a\\\\\"b\"&&dovetail check .*quoted.lua"
+                  REMOVE ${out}/new_named/quoted.lua)
+dovetail_cli_test(new_into_a_missing_folder EXIT 1 ARGS new x --out ${out}/no_such_folder/x.lua
+                  STDERR "cannot be written: the folder .*no_such_folder does not exist")
+
+# check reads the glove's plan or trace as the run does: a wrong line is named.
+file(WRITE ${out}/check_plan/bad.plan "start 0 0.1 0 1 0 0 0 power\nreach 2.0 0 0.06\n")
+file(WRITE ${out}/check_plan/bad_plan.lua
+     "return scenario { name = \"bad plan\", parts = { b = part { shape = box { size = { 1, 1, 1 } } } },\n"
+     "  hand = glove { plan = \"bad.plan\" } }\n")
+dovetail_cli_test(check_reads_the_plan EXIT 1 ARGS check ${out}/check_plan/bad_plan.lua
+                  STDERR "bad_plan.lua:2: glove: .*bad.plan:2: reach expects DURATION X Y Z QW QX QY QZ, found 3 fields")
+# A glove lasting longer than a run may is refused, by check and by the run, whose report says why.
+file(WRITE ${out}/check_plan/long.plan "start 0 0.1 0 1 0 0 0 power\nwait 1e12\n")
+file(WRITE ${out}/check_plan/long_plan.lua
+     "return scenario { name = \"long plan\", parts = { b = part { shape = box { size = { 1, 1, 1 } } } },\n"
+     "  hand = glove { plan = \"long.plan\" } }\n")
+dovetail_cli_test(check_plan_too_long EXIT 1 ARGS check ${out}/check_plan/long_plan.lua
+                  STDERR "long_plan.lua:2: glove: .*long.plan: the plan lasts 1000000000000.000 s, more than the 3600.000 s a run may last; give the scenario a duration")
+dovetail_cli_test(run_plan_too_long EXIT 1 ARGS run ${out}/check_plan/long_plan.lua --report ${out}/check_plan/long.json
+                  STDERR "the plan lasts 1000000000000.000 s"
+                  FILE ${out}/check_plan/long.json MATCHES "\"outcome\": \"error\"&&more than the 3600.000 s")
+add_test(NAME cli.replay_final_frame_cannot_be_drawn
+         COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/render_failure.sh $<TARGET_FILE:dovetail>
+                 ${scenarios}/06_peg_replay.lua ${PROJECT_SOURCE_DIR}/assets/traces/peg_in_hole.csv
+                 ${out}/render_failure)
+# --record needs a glove to record.
+dovetail_cli_test(run_record_without_a_glove EXIT 1
+                  ARGS run ${out}/regress_clash/a.lua --record ${out}/check_plan/none.csv
+                  STDERR "a.lua: --record: the scenario has no glove, so there are no samples to record")
 
 # Scenarios that should fail say which expectation, when, with which parts.
 dovetail_cli_test(fails_mate_impossible EXIT 3 ARGS run ${scenario_data}/failing/mate_impossible.lua --quiet
@@ -206,6 +245,8 @@ dovetail_cli_test(capture_replay_checked_in EXIT 0
                   ARGS capture ${data}/captures/resting-boxes-turned.capture
                        ${data}/captures/touching-hulls.capture
                   STDOUT "methods-disagree not reproduced: every method says intersecting&&iteration-cap not reproduced")
+file(WRITE ${out}/empty.capture "")
+dovetail_cli_test(capture_empty_file EXIT 1 ARGS capture ${out}/empty.capture STDERR "empty.capture: empty")
 dovetail_cli_test(capture_bad_file EXIT 1 ARGS capture ${data}/cube.obj
                   STDERR "cube.obj:1: not a capture file")
 # An unreadable file is said, and the files after it are replayed all the same.

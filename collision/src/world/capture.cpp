@@ -70,7 +70,10 @@ class LineReader {
 
   std::string next(std::string_view expecting) {
     std::string line;
-    if (!std::getline(in_, line)) fail("ends early, expecting " + std::string(expecting));
+    if (!std::getline(in_, line)) {
+      if (line_number_ == 0) throw CaptureError(file_.string() + ": empty");
+      fail("ends early, expecting " + std::string(expecting));
+    }
     ++line_number_;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     return line;

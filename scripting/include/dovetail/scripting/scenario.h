@@ -115,6 +115,10 @@ struct RuleSpec {
 };
 
 /// A loaded scenario; lengths are in metres whatever the file's units.
+/// The longest a run may last, in simulated seconds: a scenario's duration,
+/// or without one its glove's plan or trace.
+inline constexpr double kMaxRunSeconds = 3600;
+
 struct Scenario {
   std::filesystem::path file{};
   std::string name{};
@@ -148,7 +152,8 @@ struct Scenario {
 Scenario load_scenario(LuaHost& host, const std::filesystem::path& file,
                        std::vector<std::filesystem::path>* files_read = nullptr);
 
-/// A commented starting scenario named `name`, for `dovetail new`.
-std::string starting_scenario(const std::string& name);
+/// A commented starting scenario named `name`, to be written to `file` (as
+/// its comments tell to run it), for `dovetail new`.
+std::string starting_scenario(const std::string& name, const std::string& file);
 
 }  // namespace dovetail::scripting
