@@ -25,7 +25,13 @@ sleep 0.5
 kill -TERM $regress
 wait $regress
 code=$?
-fail() { echo "$1"; cat "$out/stdout.txt"; exit 1; }
+fail() {
+  echo "$1"
+  cat "$out/stdout.txt"
+  ls -l "$out/reports"
+  ps -eo pid,ppid,stat,args | grep "[d]ovetail"
+  exit 1
+}
 [ $code -eq 143 ] || fail "exit code $code, expected 143"
 if pgrep -f "$out/scenarios" > /dev/null; then fail "a run outlived regress"; fi
 grep -q "stopped: regress was interrupted by signal 15" "$out/stdout.txt" || fail "no stopped run"
