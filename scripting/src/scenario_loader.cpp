@@ -135,6 +135,27 @@ const std::map<std::string, std::array<float, 3>, std::less<>>& color_names() {
   return names;
 }
 
+/// A call of an unknown global that is nearly a word of the vocabulary
+/// (`touchs(...)`) gets the word suggested after Lua's own message.
+ScriptError with_word_suggested(const ScriptError& e) {
+  constexpr std::string_view kCall = "attempt to call a nil value (global '";
+  const std::string& first = e.message();
+  const std::size_t at = first.find(kCall);
+  if (at == std::string::npos) return e;
+  const std::size_t from = at + kCall.size();
+  const std::size_t to = first.find('\'', from);
+  if (to == std::string::npos) return e;
+  std::vector<std::string> words;
+  for (const Word& w : vocabulary()) words.emplace_back(w.name);
+  const std::string hint = did_you_mean(first.substr(from, to - from), words);
+  if (hint.empty()) return e;
+  const std::string what = e.what();
+  const std::size_t end = what.find('\n');
+  return ScriptError(e.kind(), end == std::string::npos
+                                   ? what + hint
+                                   : what.substr(0, end) + hint + what.substr(end));
+}
+
 class Loader {
  public:
   Loader(LuaHost& host, const std::filesystem::path& file,
@@ -442,28 +463,53 @@ class Loader {
     return arg;
   }
 
+  /// The vocabulary word whose constructor the value at `index` is (a word
+  /// written without its arguments, `mate_made,`), or "".
+  std::string word_function(int index) {
+    if (lua_type(L_, index) != LUA_TFUNCTION) return "";
+    index = lua_absindex(L_, index);
+    host_.push_env();
+    std::string found;
+    for (const Word& w : vocabulary()) {
+      lua_pushlstring(L_, w.name.data(), w.name.size());
+      lua_rawget(L_, -2);
+      const bool same = lua_rawequal(L_, -1, index) != 0;
+      lua_pop(L_, 1);
+      if (same) {
+        found = w.name;
+        break;
+      }
+    }
+    lua_pop(L_, 1);
+    return found;
+  }
+
   /// A use of an event/state/action/expectation word at `index`, of one of `kinds`.
   Clause clause_at(int index, std::initializer_list<WordKind> kinds, const SourceLocation& outer,
                    const std::string& what) {
     const std::string word_name = word_of(index);
     const Word* word = word_name.empty() ? nullptr : find_word(word_name);
+    const auto with_article = [](std::string_view noun) {
+      return std::string(std::string_view("aeiou").find(noun.front()) != std::string_view::npos
+                             ? "an "
+                             : "a ") +
+             std::string(noun);
+    };
     std::string expected;
     for (const WordKind k : kinds) {
-      expected += (expected.empty() ? "" : " or ") +
-                  std::string(k == WordKind::kEvent ? "an " : "a ") +
-                  std::string(word_kind_name(k));
+      expected += (expected.empty() ? "" : " or ") + with_article(word_kind_name(k));
     }
     if (word == nullptr) {
+      if (const std::string bare = word_function(index); !bare.empty()) {
+        fail(outer, what + " is the word '" + bare + "' without its arguments: write, say, " +
+                        std::string(find_word(bare)->example));
+      }
       fail(outer, what + " must be " + expected + ", not " + describe(index));
     }
     const SourceLocation where = where_of(index, outer);
     if (std::find(kinds.begin(), kinds.end(), word->kind) == kinds.end()) {
       fail(where, what + " must be " + expected + "; '" + word_name + "' is " +
-                      (word->kind == WordKind::kEvent || word->kind == WordKind::kAction ||
-                               word->kind == WordKind::kExpectation
-                           ? "an "
-                           : "a ") +
-                      std::string(word_kind_name(word->kind)));
+                      with_article(word_kind_name(word->kind)));
     }
     Clause clause;
     clause.word = word;
@@ -653,7 +699,11 @@ Scenario Loader::load() {
   host_.call(2, 0);
 
   const int base = lua_gettop(L_);
-  host_.run_file(file_, 1);
+  try {
+    host_.run_file(file_, 1);
+  } catch (const ScriptError& e) {
+    throw with_word_suggested(e);
+  }
   const int top = base + 1;
   const SourceLocation file_only{file_, 0};
   if (word_of(top) != "scenario") {

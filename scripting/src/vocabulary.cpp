@@ -207,7 +207,9 @@ std::vector<Word> make_vocabulary() {
       {"every",
        WordKind::kEvent,
        {{"seconds", kSeconds, kRequired, "the period, > 0"}},
-       "In the first frame at or after each multiple of the period, t = p, 2p, ... (not at 0).",
+       "In the first frame at or after each multiple of the period, t = p, 2p, ... (not at 0). "
+       "A rule fires at most once per its cooldown (default 0.1 s): for a shorter period give "
+       "the rule cooldown = 0.",
        "every(1)"});
   w.push_back({"completed",
                WordKind::kEvent,

@@ -105,6 +105,34 @@ TEST(ScenarioLoad, AMateAngleOutsideItsRangeIsNamed) {
   }
 }
 
+TEST(ScenarioLoad, AMisspeltWordAndAWordWithoutArgumentsAreNamed) {
+  const test::TempDir dir("dovetail_scenario");
+  // A call of an unknown global that is nearly a word: Lua's message and the word.
+  const auto call_file =
+      write(dir, "call.lua",
+            moved_peg("    rule { when = touchs(\"peg\", \"block\"), act = { log \"x\" } },", ""));
+  std::string call;
+  try {
+    LuaHost host({}, 1);
+    load_scenario(host, call_file);
+    ADD_FAILURE() << "loaded";
+  } catch (const ScriptError& e) {  // a Lua error, not a scenario mistake
+    call = e.what();
+  }
+  EXPECT_NE(call.find("call.lua:17: attempt to call a nil value (global 'touchs') (did you mean "
+                      "'touches'?)"),
+            std::string::npos)
+      << call;
+  // A word written without its arguments, with "an" before a vowel.
+  const std::string bare = load_error(write(dir, "bare.lua", moved_peg("", "    mate_made,")));
+  EXPECT_NE(bare.find("expect item 1 is the word 'mate_made' without its arguments: write, say, "
+                      "mate_made \"peg_in_hole\""),
+            std::string::npos)
+      << bare;
+  const std::string kind = load_error(write(dir, "kind.lua", moved_peg("", "    after(1),")));
+  EXPECT_NE(kind.find("must be an expectation; 'after' is an event"), std::string::npos) << kind;
+}
+
 TEST(ScenarioLoad, AnUnknownFieldAndAWrongKindAreNamed) {
   const test::TempDir dir("dovetail_scenario");
   const auto typo =
