@@ -230,8 +230,19 @@ std::optional<std::string> check_binary_stl(std::string_view head, std::uintmax_
   for (int k = 3; k >= 0; --k) {
     count = (count << 8) | static_cast<unsigned char>(head[80 + static_cast<std::size_t>(k)]);
   }
+  const std::uintmax_t needed = kHeader + kPerTriangle * std::uintmax_t{count};
+  // Text that does not start with "solid": neither kind of STL.
+  const bool text = std::all_of(head.begin(), head.begin() + kHeader, [](char c) {
+    return std::isprint(static_cast<unsigned char>(c)) ||
+           std::isspace(static_cast<unsigned char>(c));
+  });
+  if (text && needed != file_size) {
+    return "is not an STL file: it is text but does not start with 'solid' (an ASCII STL), "
+           "and read as a binary STL its header declares " +
+           std::to_string(count) + " triangles, " + std::to_string(needed) +
+           " bytes, where the file has " + std::to_string(file_size);
+  }
   if (count > limits.max_triangles) return too_many(count, "triangles", limits.max_triangles);
-  const std::uintmax_t needed = kHeader + kPerTriangle * count;
   if (needed > file_size) {
     return "binary STL declares " + std::to_string(count) + " triangles (" +
            std::to_string(needed) + " bytes) but the file has " + std::to_string(file_size) +

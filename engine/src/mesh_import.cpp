@@ -332,6 +332,10 @@ std::string refused_message(const detail::FolderIOSystem& io) {
     fail(path, refused_message(io) + (what.empty() ? "" : " (" + what + ")"));
   }
   if (what.empty()) what = "unknown reason";
+  if (what.find("mNumMeshes is 0") != std::string::npos) {
+    fail(path, "cannot be read as a mesh: the importer found no mesh in it (is it a " +
+                   path.extension().string() + " file?)");
+  }
   fail(path, "cannot be read as a mesh: " + what);
 }
 

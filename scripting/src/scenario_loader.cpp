@@ -913,14 +913,21 @@ std::shared_ptr<const collision::Mesh> Loader::read_shape(int index, const Sourc
       mesh = collision::make_block_with_hole(size / 2, positive(get("hole"), "hole") / 2,
                                              positive(get("depth"), "depth"), sides(64));
     } else if (word_name == "tube") {
-      mesh = collision::make_tube(positive(get("outer"), "outer") / 2,
-                                  positive(get("inner"), "inner") / 2,
-                                  positive(get("length"), "length"), sides(64));
+      const double outside = positive(get("outer"), "outer");
+      const double inside = positive(get("inner"), "inner");
+      if (!(inside < outside)) fail(where, "tube: inner must be less than outer");
+      mesh = collision::make_tube(outside / 2, inside / 2, positive(get("length"), "length"),
+                                  sides(64));
     } else {
       mesh = collision::make_sphere(positive(get("diameter"), "diameter") / 2, 3);
     }
   } catch (const std::invalid_argument& e) {
-    fail(where, word_name + ": " + e.what());
+    // The mesh maker's message, without its own function name.
+    std::string message = e.what();
+    if (message.rfind("make_", 0) == 0 && message.find(": ") != std::string::npos) {
+      message.erase(0, message.find(": ") + 2);
+    }
+    fail(where, word_name + ": " + message);
   }
   lua_pop(L_, 1);
   return std::make_shared<const collision::Mesh>(std::move(mesh));

@@ -238,6 +238,37 @@ TEST(MeshImport, UnreadableFormat) {
   EXPECT_NE(import_error(dir / "noise.obj").find("noise.obj"), std::string::npos);
 }
 
+TEST(MeshImport, TextThatIsNoMeshIsSaidSo) {
+  TempDir dir;
+  const std::string text =
+      "hello, this is a text file and not a mesh\nsaved under the wrong name by mistake, "
+      "long enough for a header\n";
+  write_file(dir / "text.stl", text);
+  write_file(dir / "text.obj", text);
+  const std::string stl = import_error(dir / "text.stl");
+  EXPECT_NE(stl.find("text.stl: is not an STL file: it is text but does not start with 'solid'"),
+            std::string::npos)
+      << stl;
+  const std::string obj = import_error(dir / "text.obj");
+  EXPECT_NE(obj.find("text.obj: cannot be read as a mesh: the importer found no mesh in it (is it "
+                     "a .obj file?)"),
+            std::string::npos)
+      << obj;
+}
+
+TEST(MeshImport, AFolderReachedThroughALinkIsItsTarget) {
+  // "link/../x" is x beside the link's target, as the file system resolves it.
+  TempDir dir;
+  fs::create_directories(dir / "real" / "scenarios");
+  fs::create_directories(dir / "real" / "parts");
+  fs::copy_file(kModels / "OBJ/box.obj", dir / "real" / "parts" / "box.obj");
+  fs::create_directories(dir / "elsewhere");
+  fs::create_directory_symlink(dir / "real" / "scenarios", dir / "elsewhere" / "scenarios");
+  collision::Mesh mesh;
+  EXPECT_NO_THROW(mesh = import_mesh(dir / "elsewhere" / "scenarios" / ".." / "parts" / "box.obj"));
+  EXPECT_EQ(mesh.triangle_count(), 12u);
+}
+
 TEST(MeshImport, TruncatedBinaryStl) {
   TempDir dir;
   const std::string whole = read_file(kModels / "STL/Spider_binary.stl");
