@@ -138,8 +138,19 @@ TEST(Capture, BadFilesNameTheFileAndLine) {
   const std::size_t t = good.rfind("\nend\n");
   const std::size_t last = good.rfind('\n', t - 1) + 1;  // last triangle of b
   bad_index.replace(last, t - last, "0 1 99");
+  // A pose whose first entry of R is changed is no rotation; a NaN in it is not finite.
+  const std::size_t x = good.find("X_AB ") + 5;
+  const std::size_t x_end = good.find(' ', x);
+  std::string not_rotation = good;
+  not_rotation.replace(x, x_end - x, "0.78");
+  std::string nan_pose = good;
+  nan_pose.replace(x, x_end - x, "nan");
   const std::vector<Case> cases = {
       {"magic.capture", "dovetail-capture 2\n", ":1: not a capture file"},
+      {"rotation.capture", not_rotation, ":5: X_AB's R is not a rotation"},
+      {"nan_pose.capture", nan_pose, ":5: X_AB is not finite"},
+      {"trailing.capture", good + "\nmore\n", "text after 'end'"},
+      {"empty.capture", "", ": empty"},
       {"kind.capture", "dovetail-capture 1\nkind overheated\n", ":2: unknown kind 'overheated'"},
       {"short.capture", good.substr(0, good.find("mesh b")), "ends early, expecting a mesh"},
       {"vertex.capture", bad_vertex, "expected a vertex: x y z, found '0x1p0 zebra 3'"},

@@ -81,6 +81,15 @@ class LineReader {
 
   [[noreturn]] void fail(const std::string& message) const { fail_at(line_number_, message); }
 
+  /// Nothing but blank lines may follow.
+  void expect_end() {
+    std::string line;
+    while (std::getline(in_, line)) {
+      ++line_number_;
+      if (line.find_first_not_of(" \t\r") != std::string::npos) fail("text after 'end'");
+    }
+  }
+
   /// The numbers of a line, all of it: `count` doubles (hex or decimal).
   std::vector<Real> reals(std::string_view line, std::size_t count, std::string_view what) const {
     std::vector<Real> values;
@@ -323,9 +332,19 @@ Capture read_capture(const fs::path& file) {
     for (int k = 0; k < 3; ++k) c.X_AB.R(r, k) = x[3 * r + k];
   }
   c.X_AB.t = Vec3(x[9], x[10], x[11]);
+  // Only a non-finite capture holds a pose that is not one.
+  if (c.kind != CaptureKind::kNonFinite) {
+    if (!finite(c.X_AB)) reader.fail("X_AB is not finite");
+    const Real off = (c.X_AB.R.transpose() * c.X_AB.R - Mat3::Identity()).cwiseAbs().maxCoeff();
+    if (!(off <= 1e-9) || !(c.X_AB.R.determinant() > 0)) {
+      reader.fail("X_AB's R is not a rotation (R^T R departs from the identity by " +
+                  std::to_string(off) + ", or it mirrors)");
+    }
+  }
   c.a = read_mesh(reader, 'a');
   c.b = read_mesh(reader, 'b');
   if (reader.next("'end'") != "end") reader.fail("expected 'end' after the meshes");
+  reader.expect_end();
   return c;
 }
 
