@@ -124,6 +124,7 @@ class Runner {
   std::optional<std::string> output_read() const;
   void refuse_outputs();
   void build();
+  void warn_about_glove(const GloveSpec& glove, const interaction::GloveSource& source);
   void start_frame(std::uint64_t frame, double t);
   void end_frame(const engine::FrameResult& result, double previous_time);
   std::vector<Occurrence> occurrences(const engine::FrameResult& result);
@@ -393,6 +394,7 @@ void Runner::build() {
     grasping_ = std::make_unique<interaction::Grasping>(*sim_, *hand_);
     for (const MateSpec& m : scenario_.mates) grasping_->add_mate(m.mate);
     if (!glove.holding.empty()) grasping_->hold(glove.holding, glove.grasp);
+    warn_about_glove(glove, *source);
   }
   if (options_.record && !hand_) {
     throw ScenarioError(file_.string() +
@@ -403,6 +405,50 @@ void Runner::build() {
     events.insert(events.end(), injected_.begin(), injected_.end());
     injected_.clear();
   });
+}
+
+/// Warnings about a glove that cannot be what was meant: a hand that goes
+/// far from every part (a plan written in millimetres reads as metres), and
+/// one that holds a part it starts far from (the part keeps that offset).
+void Runner::warn_about_glove(const GloveSpec& glove, const interaction::GloveSource& source) {
+  const engine::Scene& scene = sim_->scene();
+  const auto box_of = [&](PartId id) {
+    Eigen::AlignedBox<double, 3> box;
+    if (const auto& mesh = scene.collision_mesh(id)) {
+      const Transform X_WP = scene.world_pose(id);
+      for (const Vec3& v : mesh->vertices) box.extend(X_WP.apply(v));
+    }
+    return box;
+  };
+  Eigen::AlignedBox<double, 3> parts;
+  for (const PartId id : scene.parts()) {
+    if (!scene.has_tag(id, "hand"))
+      parts.extend(box_of(id));  // the hand's own segments are not parts
+  }
+  if (parts.isEmpty()) return;
+  const std::string who = options_.trace ? options_.trace->string() : glove.where.str() + ": glove";
+  // Farther than ten times the parts' size, and a metre, from all of them.
+  const double limit = std::max(1.0, 10 * parts.diagonal().norm());
+  double farthest = 0, when = 0;
+  constexpr int kSamples = 200;
+  for (int k = 0; k <= kSamples; ++k) {
+    const double t = source.end_time() * k / kSamples;
+    const double d = parts.exteriorDistance(source.sample(t).p_WH);
+    if (d > farthest) farthest = d, when = t;
+  }
+  if (farthest > limit) {
+    out_.warnings.push_back(who + ": the hand is " + format_length(farthest, out_) +
+                            " from every part at t=" + format_time(when) +
+                            " s; plans and traces are in metres: is it written in other units?");
+  }
+  if (!glove.holding.empty()) {
+    const PartId held = scene.find(glove.holding);
+    const double d = held.valid() ? box_of(held).exteriorDistance(source.sample(0).p_WH) : 0;
+    if (d > 0.5) {
+      out_.warnings.push_back(who + ": the hand starts " + format_length(d, out_) + " from '" +
+                              glove.holding + "', which it holds; the part keeps that offset");
+    }
+  }
 }
 
 void Runner::start_frame(std::uint64_t, double t) {

@@ -90,6 +90,13 @@ add_test(NAME cli.replay_final_frame_cannot_be_drawn
          COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/render_failure.sh $<TARGET_FILE:dovetail>
                  ${scenarios}/06_peg_replay.lua ${PROJECT_SOURCE_DIR}/assets/traces/peg_in_hole.csv
                  ${out}/render_failure)
+# A plan written in millimetres reads as metres: the run passes but says the hand is far away.
+file(WRITE ${out}/check_plan/mm.plan "start 0 150 0 1 0 0 0 power\nreach 1 0 100 0 1 0 0 0\n")
+file(WRITE ${out}/check_plan/mm_plan.lua
+     "return scenario { name = \"mm plan\", parts = { b = part { shape = box { size = { 40, 40, 40 } } } },\n"
+     "  hand = glove { plan = \"mm.plan\", holding = \"b\" } }\n")
+dovetail_cli_test(run_plan_in_millimetres EXIT 0 ARGS run ${out}/check_plan/mm_plan.lua --quiet
+                  STDERR "mm_plan.lua:2: glove: the hand is 1.5e\\+05 mm from every part at t=0.000 s; plans and traces are in metres&&mm_plan.lua:2: glove: the hand starts .* from 'b', which it holds")
 # --record needs a glove to record.
 dovetail_cli_test(run_record_without_a_glove EXIT 1
                   ARGS run ${out}/regress_clash/a.lua --record ${out}/check_plan/none.csv
