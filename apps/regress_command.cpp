@@ -80,8 +80,15 @@ std::string read_file(const std::filesystem::path& path) {
 }
 
 std::string xml_escape(const std::string& text) {
+  // UTF-8, and without U+FFFE and U+FFFF, which XML 1.0 does not allow either.
+  std::string valid = engine::valid_utf8(text);
+  for (const std::string_view bad : {"\xEF\xBF\xBE", "\xEF\xBF\xBF"}) {
+    for (std::size_t at = valid.find(bad); at != std::string::npos; at = valid.find(bad, at)) {
+      valid.replace(at, bad.size(), "\xEF\xBF\xBD");
+    }
+  }
   std::string out;
-  for (const char c : engine::valid_utf8(text)) {
+  for (const char c : valid) {
     switch (c) {
       case '<':
         out += "&lt;";
@@ -138,6 +145,14 @@ std::string first_reason(const Job& job) {
   return job.stopped.empty() ? job.status : job.stopped;
 }
 
+/// Removes what an earlier regress left of `job`'s outputs, so that none of
+/// it passes for this run's: the report and the final frame.
+void remove_old_outputs(const Job& job, const std::filesystem::path& out) {
+  std::error_code ec;
+  std::filesystem::remove(out / (job.stem + ".json"), ec);
+  std::filesystem::remove(out / job.stem / "final.png", ec);
+}
+
 /// Starts the run of `job` with its standard error in OUT/STEM.log; false,
 /// with the reason in job.stopped, when it cannot start.
 bool start(Job& job, const std::filesystem::path& out, int threads) {
@@ -157,10 +172,7 @@ bool start(Job& job, const std::filesystem::path& out, int threads) {
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  // What an earlier regress left must not pass for this run's.
-  std::error_code ec;
-  std::filesystem::remove(out / (job.stem + ".json"), ec);
-  std::filesystem::remove(folder / "final.png", ec);
+  remove_old_outputs(job, out);
   job.start = std::chrono::steady_clock::now();
   const std::string log = (out / (job.stem + ".log")).string();
   const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -400,10 +412,15 @@ void print_line(const Job& job) {
 
 /// Collects the child `pid` that ended with `wait_status` and prints its
 /// line; false when it is none of the jobs.
-bool collect(std::vector<Job>& jobs, pid_t pid, int wait_status, const std::filesystem::path& out) {
+bool collect(std::vector<Job>& jobs, pid_t pid, int wait_status, const std::filesystem::path& out,
+             const std::string& interrupted) {
   for (Job& job : jobs) {
     if (job.pid != pid) continue;
     job.pid = -1;
+    // Ctrl-C reaches the runs too: one it ended was stopped by the interrupt.
+    if (!interrupted.empty() && WIFSIGNALED(wait_status) && job.stopped.empty()) {
+      job.stopped = "stopped: " + interrupted;
+    }
     finish(job, wait_status, out);
     print_line(job);
     return true;
@@ -415,6 +432,10 @@ bool collect(std::vector<Job>& jobs, pid_t pid, int wait_status, const std::file
 volatile std::sig_atomic_t g_interrupted = 0;
 
 extern "C" void on_interrupt(int signal_number) { g_interrupted = signal_number; }
+
+std::string interrupted_by(int signal_number) {
+  return "regress was interrupted by signal " + std::to_string(signal_number);
+}
 
 /// While it lives, an interrupt stops the runs rather than regress itself,
 /// so that no run is left behind and the summaries are still written.
@@ -468,7 +489,7 @@ int run_jobs(std::vector<Job>& jobs, const std::filesystem::path& out, std::size
   std::size_t next = 0, running = 0, done = 0;
   try {
     while (done < jobs.size() && g_interrupted == 0) {
-      while (running < parallel && next < jobs.size()) {
+      while (running < parallel && next < jobs.size() && g_interrupted == 0) {
         Job& job = jobs[next++];
         if (start(job, out, threads)) {
           ++running;
@@ -481,7 +502,9 @@ int run_jobs(std::vector<Job>& jobs, const std::filesystem::path& out, std::size
       int wait_status = 0;
       const pid_t pid = waitpid(-1, &wait_status, WNOHANG);
       if (pid > 0) {
-        if (collect(jobs, pid, wait_status, out)) {
+        const int signal_number = g_interrupted;
+        if (collect(jobs, pid, wait_status, out,
+                    signal_number != 0 ? interrupted_by(signal_number) : std::string())) {
           --running;
           ++done;
         }
@@ -505,12 +528,15 @@ int run_jobs(std::vector<Job>& jobs, const std::filesystem::path& out, std::size
   }
   const int signal_number = g_interrupted;
   if (signal_number == 0) return 0;
-  const std::string why = "regress was interrupted by signal " + std::to_string(signal_number);
+  const std::string why = interrupted_by(signal_number);
   stop_running(jobs, out, "stopped: " + why);
   for (; next < jobs.size(); ++next) {
     Job& job = jobs[next];
     job.start = std::chrono::steady_clock::now();
     job.stopped = "not run: " + why;
+    // Nothing of an earlier regress may stand for it: a fresh log and report.
+    remove_old_outputs(job, out);
+    std::ofstream(out / (job.stem + ".log"), std::ios::binary | std::ios::trunc);
     finish(job, std::nullopt, out);
     print_line(job);
   }
@@ -598,7 +624,13 @@ int regress_command(std::span<const std::string> argv) {
               interrupted != 0 ? ", interrupted" : "");
   if (junit) write_junit(jobs, *junit, total);
   if (html) write_html(jobs, *html, out);
-  if (interrupted != 0) return 128 + interrupted;
+  if (interrupted != 0) {
+    // Ended by the signal, as a caller (a shell loop) expects of an interrupt.
+    std::fflush(nullptr);
+    std::signal(interrupted, SIG_DFL);
+    std::raise(interrupted);
+    return 128 + interrupted;
+  }
   return passed == jobs.size() ? kExitOk : kExitCheckFailed;
 }
 

@@ -56,20 +56,37 @@ return scenario {
   duration = 2,
 }
 )lua";
-  // The name goes into a Lua string: its quotes and backslashes escaped.
+  // The name goes into a Lua string: quotes, backslashes and control
+  // characters escaped. The file goes into comments: a line each.
   std::string quoted;
   for (const char c : name) {
-    if (c == '"' || c == '\\') quoted += '\\';
-    quoted += c;
-  }
-  const auto put = [&](std::string_view placeholder, const std::string& value) {
-    for (std::size_t at = text.find(placeholder); at != std::string::npos;
-         at = text.find(placeholder, at + value.size())) {
-      text.replace(at, placeholder.size(), value);
+    if (c == '"' || c == '\\') {
+      quoted += '\\';
+      quoted += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      quoted += '\\';
+      quoted += std::to_string(static_cast<int>(c));
+    } else {
+      quoted += c;
     }
-  };
-  put("FILE", file);
-  put("NAME", quoted);
+  }
+  std::string shown = file;
+  for (char& c : shown) {
+    if (static_cast<unsigned char>(c) < 0x20) c = '?';
+  }
+  // One pass, so that neither value is read again as a placeholder.
+  std::string out;
+  std::size_t from = 0;
+  while (true) {
+    const std::size_t at_name = text.find("NAME", from), at_file = text.find("FILE", from);
+    const std::size_t at = std::min(at_name, at_file);
+    if (at == std::string::npos) break;
+    out.append(text, from, at - from);
+    out += at == at_name ? quoted : shown;
+    from = at + 4;
+  }
+  out.append(text, from, std::string::npos);
+  text = std::move(out);
   return text;
 }
 

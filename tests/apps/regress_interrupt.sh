@@ -11,6 +11,9 @@ for name in a b c; do
   echo 'return scenario { name = "slow", duration = 3600, time_step = 0.0001,
     parts = { a = part { shape = box { size = { 10, 10, 10 } } } } }' > "$out/scenarios/$name.lua"
 done
+# What an earlier regress left of the scenario that will not run must not stand.
+mkdir -p "$out/reports/c" && echo '{"outcome": "passed"}' > "$out/reports/c.json" &&
+  echo 'an old log' > "$out/reports/c.log" && echo 'not a png' > "$out/reports/c/final.png" || exit 1
 "$program" regress "$out/scenarios" --out "$out/reports" -j 2 --junit "$out/junit.xml" \
   > "$out/stdout.txt" 2>&1 &
 regress=$!
@@ -40,4 +43,6 @@ grep -q 'tests="3" failures="0" errors="3"' "$out/junit.xml" || fail "no JUnit s
 for name in a b c; do
   grep -q '"outcome": "error"' "$out/reports/$name.json" || fail "no report for $name"
 done
+! grep -q 'an old log' "$out/reports/c.log" || fail "the old log of c stands"
+[ ! -f "$out/reports/c/final.png" ] || fail "the old final frame of c stands"
 echo "interrupted as expected"

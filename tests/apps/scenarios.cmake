@@ -66,6 +66,9 @@ add_test(NAME cli.new_with_the_extension
 dovetail_cli_test(new_quotes_in_the_name EXIT 0 ARGS new "a\"b" --out ${out}/new_named/quoted.lua
                   FILE ${out}/new_named/quoted.lua MATCHES "name = \"a\\\\\"b\"&&dovetail check .*quoted.lua"
                   REMOVE ${out}/new_named/quoted.lua)
+dovetail_cli_test(new_placeholder_in_the_path EXIT 0 ARGS new x --out ${out}/new_named/MYNAME.lua
+                  FILE ${out}/new_named/MYNAME.lua MATCHES "dovetail check .*/MYNAME.lua &&name = \"x\""
+                  REMOVE ${out}/new_named/MYNAME.lua)
 dovetail_cli_test(new_into_a_missing_folder EXIT 1 ARGS new x --out ${out}/no_such_folder/x.lua
                   STDERR "cannot be written: the folder .*no_such_folder does not exist")
 

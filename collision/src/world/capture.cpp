@@ -336,9 +336,12 @@ Capture read_capture(const fs::path& file) {
   if (c.kind != CaptureKind::kNonFinite) {
     if (!finite(c.X_AB)) reader.fail("X_AB is not finite");
     const Real off = (c.X_AB.R.transpose() * c.X_AB.R - Mat3::Identity()).cwiseAbs().maxCoeff();
-    if (!(off <= 1e-9) || !(c.X_AB.R.determinant() > 0)) {
+    // As loose as what a run accepts as a rotation (a script's set_matrix).
+    if (!(off < 1e-6) || !(c.X_AB.R.determinant() > 0)) {
+      char departs[32];
+      std::snprintf(departs, sizeof departs, "%g", off);
       reader.fail("X_AB's R is not a rotation (R^T R departs from the identity by " +
-                  std::to_string(off) + ", or it mirrors)");
+                  std::string(departs) + ", or it mirrors)");
     }
   }
   c.a = read_mesh(reader, 'a');
