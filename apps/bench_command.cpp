@@ -290,9 +290,11 @@ int tumble_protocol(const Args& args) {
     if (std::sscanf(d->c_str(), "%lf:%lf:%lf%c", &settings.first_distance, &settings.last_distance,
                     &settings.distance_step, &end) != 3 ||
         !(settings.distance_step > 0) || !(settings.last_distance >= settings.first_distance) ||
+        !std::isfinite(settings.distance_step) || !(std::abs(settings.first_distance) <= 1e30) ||
+        !(std::abs(settings.last_distance) <= 1e30) ||
         (settings.last_distance - settings.first_distance) / settings.distance_step > 1e5) {
       throw UsageError(
-          "--distances needs D0:D1:STEP with D0 <= D1, STEP > 0 and at most "
+          "--distances needs D0:D1:STEP with D0 <= D1 within 1e30, a finite STEP > 0 and at most "
           "100,000 distances, not '" +
           *d + "'");
     }

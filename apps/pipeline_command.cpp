@@ -20,6 +20,7 @@
 #include "dovetail/collision/broadphase.h"
 #include "dovetail/collision/collision_world.h"
 #include "dovetail/collision/model.h"
+#include "dovetail/collision/pose_sampling.h"
 #include "dovetail/engine/mesh_import.h"
 #include "line_reader.h"
 
@@ -68,11 +69,23 @@ collision::Transform read_pose(LineReader& reader, std::uint64_t frame, std::uin
   }
   double v[7];
   for (std::size_t k = 0; k < 7; ++k) v[k] = reader.number((*fields)[k]);
-  const Eigen::Quaternion<double> q(v[3], v[4], v[5], v[6]);
-  const double norm = q.norm();
-  if (!(norm > 1e-12) || !std::isfinite(norm)) reader.fail("the quaternion has no length");
+  // As pose lists have it (pose_list.h): coordinates within 1e30, any
+  // quaternion but zero, scaled before it is normalised.
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (!(std::abs(v[k]) <= 1e30)) reader.fail("a translation beyond the coordinate limit of 1e30");
+  }
+  double w = v[3], x = v[4], y = v[5], z = v[6];
+  const double largest = std::max({std::abs(w), std::abs(x), std::abs(y), std::abs(z)});
+  if (largest == 0) reader.fail("the quaternion is zero");
+  if (const double squared = w * w + x * x + y * y + z * z;
+      !std::isfinite(squared) || squared < 1e-150) {
+    w /= largest;  // so that normalising neither overflows nor underflows
+    x /= largest;
+    y /= largest;
+    z /= largest;
+  }
   collision::Transform X;
-  X.R = q.normalized().toRotationMatrix();
+  X.R = collision::rotation_from_quaternion(w, x, y, z);
   X.t = collision::Vec3(v[0], v[1], v[2]);
   return X;
 }

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 #include <algorithm>
+#include <array>
 #include <assimp/Importer.hpp>
 #include <cctype>
 #include <cerrno>
@@ -17,7 +18,9 @@
 #include <numbers>
 #include <optional>
 #include <set>
+#include <unordered_map>
 #include <utility>
+#include <vector>
 
 #include "declared_sizes.h"
 #include "folder_io_system.h"
@@ -248,12 +251,41 @@ FaceCounts count_faces(const aiMesh& mesh) {
   return counts;
 }
 
+/// The bits of a coordinate as read, with -0 as +0 (one position).
+std::uint64_t position_bits(ai_real x) {
+  const double d = static_cast<double>(x) + 0.0;
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &d, sizeof bits);
+  return bits;
+}
+
+struct PositionHash {
+  std::size_t operator()(const std::array<std::uint64_t, 3>& k) const {
+    std::uint64_t h = 1469598103934665603ULL;
+    for (const std::uint64_t x : k) h = (h ^ x) * 1099511628211ULL;
+    return static_cast<std::size_t>(h ^ (h >> 32));
+  }
+};
+
 /// Appends the triangles of `mesh` transformed by X_RN; all the mesh's
 /// vertices are appended when it has at least one triangle.
 void append(const fs::path& path, const aiMesh& mesh, const Affine& X_RN, Geometry& out) {
   const std::size_t offset = out.vertices.size();
-  for (unsigned v = 0; v < mesh.mNumVertices; ++v)
-    out.vertices.push_back(apply(X_RN, mesh.mVertices[v]));
+  // Vertices at exactly the same position are one (the first), so that faces
+  // that share a corner share its index: a weld by equality, never by
+  // distance, so no real vertex, however near another, is lost.
+  std::vector<std::uint32_t> index(mesh.mNumVertices);
+  std::unordered_map<std::array<std::uint64_t, 3>, std::uint32_t, PositionHash> first;
+  first.reserve(mesh.mNumVertices);
+  for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+    const aiVector3D& p = mesh.mVertices[v];
+    const std::array<std::uint64_t, 3> key = {position_bits(p.x), position_bits(p.y),
+                                              position_bits(p.z)};
+    const auto [it, fresh] =
+        first.emplace(key, static_cast<std::uint32_t>(out.vertices.size() - offset));
+    if (fresh) out.vertices.push_back(apply(X_RN, p));
+    index[v] = it->second;
+  }
   // A mirroring transform turns the winding; swap to keep normals outward.
   const bool mirrored = X_RN.leftCols<3>().determinant() < 0;
   for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
@@ -266,7 +298,7 @@ void append(const fs::path& path, const aiMesh& mesh, const Affine& X_RN, Geomet
                        " refers to vertex " + std::to_string(face.mIndices[k]) + " of " +
                        std::to_string(mesh.mNumVertices));
       }
-      t[k] = static_cast<std::uint32_t>(offset + face.mIndices[k]);
+      t[k] = static_cast<std::uint32_t>(offset + index[face.mIndices[k]]);
     }
     if (mirrored) std::swap(t[1], t[2]);
     out.triangles.push_back(t);
@@ -499,7 +531,7 @@ ImportReport import_file(const fs::path& path, const ImportOptions& options) {
   // an absolute threshold that would drop real triangles of small parts.
   importer.SetPropertyBool(AI_CONFIG_PP_FD_CHECKAREA, false);
   // Only positions matter for collisions (and cameras for pictures); dropping
-  // the rest lets JoinIdenticalVertices weld by position.
+  // the rest leaves positions alone, which `append` welds by equality.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
                               aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                   aiComponent_COLORS | aiComponent_TEXCOORDS |
@@ -517,8 +549,7 @@ ImportReport import_file(const fs::path& path, const ImportOptions& options) {
     if (scene == nullptr) fail_import(path, importer, *io);
     repeated = check_raw_scene(path, *scene, options.limits);
     raw_meshes = scene->mNumMeshes;
-    scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                         aiProcess_ValidateDataStructure |
+    scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_ValidateDataStructure |
                                          aiProcess_FindDegenerates | aiProcess_FindInvalidData |
                                          aiProcess_SortByPType | aiProcess_RemoveComponent);
     if (scene == nullptr) fail_import(path, importer, *io);

@@ -96,7 +96,8 @@ void write_rgba_png(std::span<const std::uint8_t> rgba, int width, int height,
     reason = std::strerror(errno);
   }
   if (!ok) {
-    std::filesystem::remove(path, ec);
+    // A partial picture is removed; a device or pipe written to is left alone.
+    if (std::filesystem::is_regular_file(path, ec)) std::filesystem::remove(path, ec);
     throw RenderError(name + ": write failed: " + reason);
   }
 }

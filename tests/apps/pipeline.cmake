@@ -27,7 +27,16 @@ dovetail_cli_test(pipeline_no_parts EXIT 1 ARGS pipeline --scene ${pl_data}/no_p
                   STDERR "no_parts.txt:1: no parts [^\n]*but F > 0 frames")
 dovetail_cli_test(pipeline_zero_quaternion EXIT 1
                   ARGS pipeline --scene ${pl_data}/zero_quaternion.txt
-                  STDERR "zero_quaternion.txt:5: the quaternion has no length")
+                  STDERR "zero_quaternion.txt:5: the quaternion is zero")
+# A tiny or huge quaternion is a rotation like any other; a far translation is refused.
+file(WRITE ${out}/pipeline_quaternions/scene.txt
+     "2 1\n${data}/cube.obj\n${data}/cube.obj\n0 0 0 1e-13 0 0 0\n1 0 0 1e300 0 0 1e300\n")
+dovetail_cli_test(pipeline_tiny_and_huge_quaternions EXIT 0
+                  ARGS pipeline --scene ${out}/pipeline_quaternions/scene.txt STDOUT "\"pairs_total\":1")
+file(WRITE ${out}/pipeline_quaternions/far.txt
+     "2 1\n${data}/cube.obj\n${data}/cube.obj\n0 0 0 1 0 0 0\n1e300 0 0 1 0 0 0\n")
+dovetail_cli_test(pipeline_translation_too_far EXIT 1 ARGS pipeline --scene ${out}/pipeline_quaternions/far.txt
+                  STDERR "far.txt:5: a translation beyond the coordinate limit of 1e30")
 dovetail_cli_test(pipeline_missing_mesh EXIT 1 ARGS pipeline --scene ${pl_data}/missing_mesh.txt
                   STDERR "missing_mesh.txt:3: mesh of part 1: [^\n]*missing.obj: file not found")
 dovetail_cli_test(pipeline_short_pose EXIT 1 ARGS pipeline --scene ${pl_data}/short_pose.txt

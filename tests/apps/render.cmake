@@ -73,3 +73,10 @@ file(COPY ${CMAKE_SOURCE_DIR}/assets/glove/reach_engine.plan DESTINATION ${out})
 dovetail_cli_test(render_out_is_plan EXIT 2
                   ARGS render ${cube} --plan ${out}/reach_engine.plan --out ${out}/reach_engine.plan
                   STDERR "would be overwritten")
+
+# A picture that cannot be written to a device fails, and the device stays
+# (a partial file is removed only when it is a regular file).
+add_test(NAME cli.render_to_a_full_device
+         COMMAND sh -c "[ -c /dev/full ] || exit 77; \"$0\" render \"$1\" --width 8 --height 8 --out /dev/full; code=$?; [ -c /dev/full ] || { echo '/dev/full was replaced'; exit 1; }; [ $code -eq 1 ]"
+                 $<TARGET_FILE:dovetail> ${data}/cube.obj)
+set_tests_properties(cli.render_to_a_full_device PROPERTIES SKIP_RETURN_CODE 77)

@@ -269,6 +269,23 @@ TEST(MeshImport, AFolderReachedThroughALinkIsItsTarget) {
   EXPECT_EQ(mesh.triangle_count(), 12u);
 }
 
+TEST(MeshImport, VerticesAreWeldedOnlyWhenEqual) {
+  // A vertex 1e-6 from another is a vertex of its own: the sliver keeps its
+  // area and both triangles (a weld by distance used to merge the two and
+  // drop the sliver as degenerate). Equal positions are one vertex.
+  TempDir dir;
+  write_file(dir / "sliver.obj",
+             "v 0 0 0\nv 1 0 0\nv 1 1e-6 0\nf 1 2 3\nv 0 1 0\nv 0 0 1\nf 1 4 5\n");
+  const collision::Mesh sliver = import_mesh(dir / "sliver.obj");
+  EXPECT_EQ(sliver.vertex_count(), 5u);
+  EXPECT_EQ(sliver.triangle_count(), 2u);
+  write_file(dir / "shared.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 4 5 3\n");
+  const collision::Mesh shared = import_mesh(dir / "shared.obj");
+  EXPECT_EQ(shared.vertex_count(), 4u);
+  EXPECT_EQ(shared.triangles[1][0], shared.triangles[0][1])
+      << "the corner at (1, 0, 0) is one vertex";
+}
+
 TEST(MeshImport, TruncatedBinaryStl) {
   TempDir dir;
   const std::string whole = read_file(kModels / "STL/Spider_binary.stl");

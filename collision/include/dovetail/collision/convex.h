@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -193,5 +194,23 @@ struct GjkResult {
 /// sub-distance; always returns finite values for finite input.
 GjkResult gjk(const ConvexHull& a, const ConvexHull& b, const Transform& X_AB,
               GjkCache* cache = nullptr);
+
+/// Penetration depth of two convex parts: the length of the shortest
+/// translation of B that leaves the interiors apart, and its direction.
+struct PenetrationDepth {
+  Real depth = 0;               ///< 0 when the hulls do not overlap
+  Vec3 normal = Vec3::UnitZ();  ///< unit, in A's frame: B moves along it to separate
+};
+
+/// The penetration depth of hulls A and B (B at X_AB in A's frame), when each
+/// is its part (surface_on_hull on a closed mesh): the smallest overlap of
+/// the two along a face normal of either or the cross product of an edge of
+/// each. The smallest over every direction is attained at a face normal of
+/// their Minkowski difference, which is one of these, so the result is
+/// exact up to rounding. Costs (faces + edge pairs) support queries; nothing
+/// (std::nullopt) when the edge pairs exceed `max_edge_pairs`.
+std::optional<PenetrationDepth> convex_penetration_depth(const ConvexHull& a, const ConvexHull& b,
+                                                         const Transform& X_AB,
+                                                         std::size_t max_edge_pairs = 65536);
 
 }  // namespace dovetail::collision
