@@ -329,11 +329,11 @@ std::vector<Word> make_vocabulary() {
   w.push_back({"max_penetration",
                WordKind::kExpectation,
                {{"depth", kLength, kRequired, "the deepest allowed, in the scenario's units"}},
-               "No vertex of a part ever lies deeper inside another part than this "
-               "(measured every frame: the deepest vertex's distance to the other's surface; "
-               "parts that cross with no vertex inside the other, two bars laid crosswise, "
-               "measure 0, so check those with no_contact; the hand's segments are not "
-               "counted).",
+               "No two parts ever overlap deeper than this, measured every frame: for two "
+               "convex parts the exact penetration depth (the shortest move that parts them), "
+               "otherwise the deepest vertex of one inside the other, which misses parts that "
+               "cross with no vertex inside (check those with no_contact). The hand's segments "
+               "are not counted.",
                "max_penetration(0.01)"});
   w.push_back({"no_contact",
                WordKind::kExpectation,

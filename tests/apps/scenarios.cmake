@@ -100,6 +100,15 @@ file(WRITE ${out}/check_plan/mm_plan.lua
      "  hand = glove { plan = \"mm.plan\", holding = \"b\" } }\n")
 dovetail_cli_test(run_plan_in_millimetres EXIT 0 ARGS run ${out}/check_plan/mm_plan.lua --quiet
                   STDERR "mm_plan.lua:2: glove: the hand is 1.5e\\+05 mm from every part at t=0.000 s; plans and traces are in metres&&mm_plan.lua:2: glove: the hand starts .* from 'b', which it holds")
+# Two convex bars laid crosswise 8 mm into each other: no vertex is inside the
+# other, and the exact penetration depth says 8 mm.
+file(WRITE ${out}/crossed_bars/crossed_bars.lua
+     "return scenario { name = \"crossed bars\", duration = 0.1,\n"
+     "  parts = { a = part { shape = box { size = { 100, 10, 10 } }, fixed = true },\n"
+     "            b = part { shape = box { size = { 10, 10, 100 } }, at = { 0, 2, 0 } } },\n"
+     "  expect = { max_penetration(0.01) } }\n")
+dovetail_cli_test(run_crossed_bars_penetrate EXIT 3 ARGS run ${out}/crossed_bars/crossed_bars.lua --quiet
+                  STDERR "expectation max_penetration\\(0.01\\) failed: 'a' and 'b' overlapped 8 mm at t=0.000 s")
 # --record needs a glove to record.
 dovetail_cli_test(run_record_without_a_glove EXIT 1
                   ARGS run ${out}/regress_clash/a.lua --record ${out}/check_plan/none.csv

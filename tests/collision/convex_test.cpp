@@ -1095,3 +1095,79 @@ TEST(Gjk, NonFiniteAndExtremeInputStayFinite) {
 
 }  // namespace
 }  // namespace dovetail::collision
+
+namespace dovetail::collision {
+namespace {
+
+ConvexHull hull_of_points(const std::vector<Vec3>& points) {
+  return compute_convex_hull(points, "test");
+}
+
+std::vector<Vec3> box_points(const Vec3& half) {
+  std::vector<Vec3> p;
+  for (int c = 0; c < 8; ++c) {
+    p.emplace_back(c & 1 ? half.x() : -half.x(), c & 2 ? half.y() : -half.y(),
+                   c & 4 ? half.z() : -half.z());
+  }
+  return p;
+}
+
+TEST(PenetrationDepth, CrossedBarsAndBoxes) {
+  // Two bars laid crosswise, 8 deep along y: no vertex of either is inside the other.
+  const ConvexHull a = hull_of_points(box_points(Vec3(50, 5, 5)));
+  const ConvexHull b = hull_of_points(box_points(Vec3(5, 5, 50)));
+  Transform X_AB;
+  X_AB.t = Vec3(0, 2, 0);
+  const auto pd = convex_penetration_depth(a, b, X_AB);
+  ASSERT_TRUE(pd.has_value());
+  EXPECT_NEAR(pd->depth, 8, 1e-12);
+  EXPECT_NEAR(std::abs(pd->normal.y()), 1, 1e-12);
+  // Apart and touching: 0.
+  X_AB.t = Vec3(0, 10, 0);
+  EXPECT_EQ(convex_penetration_depth(a, b, X_AB)->depth, 0);
+  X_AB.t = Vec3(0, 11, 0);
+  EXPECT_EQ(convex_penetration_depth(a, b, X_AB)->depth, 0);
+  // Too many edge pairs for the limit: nothing.
+  EXPECT_FALSE(convex_penetration_depth(a, b, X_AB, 10).has_value());
+}
+
+TEST(PenetrationDepth, NoDirectionSeparatesWithLessAndItsOwnDoes) {
+  // Random polytopes at random overlapping poses: moving B along the normal by
+  // the depth (and a hair) separates them, and no sampled direction needs less.
+  Random random(20261127);
+  for (int trial = 0; trial < 60; ++trial) {
+    std::vector<Vec3> pa, pb;
+    for (int k = 0; k < 12; ++k) {
+      pa.push_back(Vec3(random.normal(), random.normal(), random.normal()).normalized());
+      pb.push_back(Vec3(random.normal(), random.normal(), random.normal()).normalized() * 0.7);
+    }
+    const ConvexHull a = hull_of_points(pa), b = hull_of_points(pb);
+    Transform X_AB;
+    const Vec3 axis = Vec3(random.normal(), random.normal(), random.normal()).normalized();
+    X_AB.R = Eigen::AngleAxisd(random.uniform(0, 2 * kPi), axis).toRotationMatrix();
+    X_AB.t = Vec3(random.uniform(-0.8, 0.8), random.uniform(-0.8, 0.8), random.uniform(-0.8, 0.8));
+    const auto pd = convex_penetration_depth(a, b, X_AB);
+    ASSERT_TRUE(pd.has_value());
+    if (!gjk(a, b, X_AB).intersecting) {
+      EXPECT_EQ(pd->depth, 0);
+      continue;
+    }
+    ASSERT_GT(pd->depth, 0);
+    Transform moved = X_AB;
+    moved.t += pd->normal * (pd->depth + 1e-6);
+    EXPECT_FALSE(gjk(a, b, moved).intersecting) << trial;
+    moved.t = X_AB.t + pd->normal * (pd->depth - 1e-6);
+    EXPECT_TRUE(gjk(a, b, moved).intersecting) << trial;
+    // The overlap along any direction is at least the depth.
+    for (int k = 0; k < 200; ++k) {
+      const Vec3 n = Vec3(random.normal(), random.normal(), random.normal()).normalized();
+      Real max_a = -1e300, min_b = 1e300;
+      for (const Vec3& v : a.vertices) max_a = std::max(max_a, n.dot(v));
+      for (const Vec3& v : b.vertices) min_b = std::min(min_b, n.dot(X_AB.apply(v)));
+      EXPECT_GE(max_a - min_b, pd->depth - 1e-12) << trial;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace dovetail::collision
