@@ -11,11 +11,22 @@
 
 namespace dovetail::cli {
 
+/// The field in quotes, a control byte (a NUL, say) written as \xNN so that
+/// the message shows it and is not cut short by it.
 std::string quote(std::string_view field) {
   std::string s;
   s.reserve(field.size() + 2);
   s += '\'';
-  s += field;
+  for (const char c : field) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02X", byte);
+      s += escaped;
+    } else {
+      s += c;
+    }
+  }
   s += '\'';
   return s;
 }
@@ -38,6 +49,7 @@ std::optional<std::vector<std::string_view>> LineReader::next() {
   while (std::getline(in_, text_)) {
     ++line_;
     if (!text_.empty() && text_.back() == '\r') text_.pop_back();
+    if (line_ == 1 && text_.starts_with("\xEF\xBB\xBF")) text_.erase(0, 3);  // a byte-order mark
     fields_.clear();
     std::size_t i = 0;
     while (i < text_.size()) {

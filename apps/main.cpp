@@ -104,8 +104,21 @@ int dispatch(const std::vector<std::string>& args) {
   throw dovetail::cli::UsageError("unknown command '" + name + "' (see 'dovetail --help')");
 }
 
-int report(const char* message, int code) {
-  std::fprintf(stderr, "dovetail: %s\n", message);
+/// Prints `message` whole: a NUL or another control byte a file brought in
+/// is written as \xNN, not cutting the line short (tabs and line ends stay).
+int report(const std::string& message, int code) {
+  std::string shown;
+  for (const char c : message) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 && c != '\n' && c != '\t') {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
+      shown += escaped;
+    } else {
+      shown += c;
+    }
+  }
+  std::fprintf(stderr, "dovetail: %s\n", shown.c_str());
   return code;
 }
 

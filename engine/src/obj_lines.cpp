@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <string_view>
@@ -23,6 +24,16 @@ std::string_view next_word(std::string_view line, std::size_t& at) {
   const std::size_t start = at;
   while (at < line.size() && !space(line[at])) ++at;
   return line.substr(start, at - start);
+}
+
+/// The whole word as a finite number (with an optional leading '+').
+bool is_finite_number(std::string_view word) {
+  const char* first = word.data();
+  const char* last = word.data() + word.size();
+  if (first != last && *first == '+') ++first;
+  double value = 0;
+  const auto [ptr, ec] = std::from_chars(first, last, value);
+  return first != last && ptr == last && ec == std::errc() && std::isfinite(value);
 }
 
 /// The whole word as a number, with an optional leading '+'.
@@ -83,6 +94,11 @@ std::optional<std::string> check_obj_lines(const std::filesystem::path& path,
   std::vector<std::pair<std::uint64_t, std::uint64_t>> ahead;
   while (std::getline(in, text)) {
     ++line_number;
+    if (line_number == 1 && text.starts_with("\xEF\xBB\xBF")) {
+      return at_line(1,
+                     "starts with a byte-order mark, which the OBJ reader does not skip; "
+                     "save the file without it (as plain UTF-8 or ASCII)");
+    }
     const std::string_view line = text;
     std::size_t at = 0;
     const std::string_view keyword = next_word(line, at);
@@ -107,6 +123,11 @@ std::optional<std::string> check_obj_lines(const std::filesystem::path& path,
         if (!is_number(word)) {
           return at_line(line_number,
                          quoted(word) + " is not a number, in the vertex " + quoted(line));
+        }
+        if (!is_finite_number(word)) {
+          // Checked here: the OBJ reader drops a vertex no face uses unseen.
+          return at_line(line_number, quoted(word) + " is not finite, in the vertex " +
+                                          quoted(line) + "; a vertex must be, used or not");
         }
         if (word.front() == '.') {
           // assimp 5.2 drops such a line without a word, and every later

@@ -140,6 +140,7 @@ std::optional<PoseEntry> PoseListReader::next() {
   std::string text;
   while (std::getline(in_, text)) {
     ++line_;
+    if (line_ == 1 && text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);  // a byte-order mark
     const std::string where = path_.string() + ":" + std::to_string(line_);
     if (std::optional<Transform> X_AB = parse_pose_line(text, where)) {
       return PoseEntry{*X_AB, line_};

@@ -35,6 +35,11 @@ dovetail_cli_test(pipeline_tiny_and_huge_quaternions EXIT 0
                   ARGS pipeline --scene ${out}/pipeline_quaternions/scene.txt STDOUT "\"pairs_total\":1")
 file(WRITE ${out}/pipeline_quaternions/far.txt
      "2 1\n${data}/cube.obj\n${data}/cube.obj\n0 0 0 1 0 0 0\n1e300 0 0 1 0 0 0\n")
+# A byte-order mark before the first line is skipped.
+file(WRITE ${out}/pipeline_quaternions/bom.txt
+     "﻿2 1\n${data}/cube.obj\n${data}/cube.obj\n0 0 0 1 0 0 0\n0.5 0 0 1 0 0 0\n")
+dovetail_cli_test(pipeline_byte_order_mark EXIT 0 ARGS pipeline --scene ${out}/pipeline_quaternions/bom.txt
+                  STDOUT "\"pairs_total\":1")
 dovetail_cli_test(pipeline_translation_too_far EXIT 1 ARGS pipeline --scene ${out}/pipeline_quaternions/far.txt
                   STDERR "far.txt:5: a translation beyond the coordinate limit of 1e30")
 dovetail_cli_test(pipeline_missing_mesh EXIT 1 ARGS pipeline --scene ${pl_data}/missing_mesh.txt

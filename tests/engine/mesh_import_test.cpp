@@ -286,6 +286,16 @@ TEST(MeshImport, VerticesAreWeldedOnlyWhenEqual) {
       << "the corner at (1, 0, 0) is one vertex";
 }
 
+TEST(MeshImport, AnUnusedNonFiniteVertexAndAByteOrderMarkAreNamed) {
+  TempDir dir;
+  write_file(dir / "unused_nan.obj", "v 0 0 0\nv 0 1 0\nv 0 0 1\nv nan 0 0\nf 1 2 3\n");
+  const std::string nan = import_error(dir / "unused_nan.obj");
+  EXPECT_NE(nan.find("line 4: 'nan' is not finite"), std::string::npos) << nan;
+  write_file(dir / "bom.obj", "\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string bom = import_error(dir / "bom.obj");
+  EXPECT_NE(bom.find("line 1: starts with a byte-order mark"), std::string::npos) << bom;
+}
+
 TEST(MeshImport, TruncatedBinaryStl) {
   TempDir dir;
   const std::string whole = read_file(kModels / "STL/Spider_binary.stl");
