@@ -351,13 +351,15 @@ int query_command(std::span<const std::string> argv) {
   const PoseBatch batch = read_poses(*reader);
   const QueryOutcome r = o.distance_mode ? run_distance_mode(o, a, b, batch.poses)
                                          : run_collision_mode(o, a, b, batch.poses);
-  if (o.out_path) {
+  // A pose list whose first line is already wrong leaves an existing file as it was.
+  const bool no_answers = batch.poses.empty() && batch.error.has_value();
+  if (o.out_path && !no_answers) {
     std::ofstream out(*o.out_path, std::ios::binary | std::ios::trunc);
     if (!out) throw InputError(*o.out_path + ": cannot be written: " + std::strerror(errno));
     out.write(r.lines.data(), static_cast<std::streamsize>(r.lines.size()));
     out.close();
     if (!out) throw InputError(*o.out_path + ": write failed: " + std::strerror(errno));
-  } else {
+  } else if (!o.out_path) {
     std::fwrite(r.lines.data(), 1, r.lines.size(), stdout);
   }
   JsonLine json = query_summary(o, a, b, batch.poses.size(), r);
