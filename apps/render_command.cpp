@@ -193,7 +193,11 @@ int render_command(std::span<const std::string> argv) {
   refuse_overwriting_input("render", out, files);  // nor a file the input refers to
 
   check_camera(scene, settings.camera, input);
-  const double render_ms = render_to_png(scene, settings, input, out);
+  // A drawing that fails with a hand may be the hand's doing (a trace that
+  // puts it far away): both inputs are named.
+  const double render_ms = render_to_png(
+      scene, settings, with_hand ? input + " with the hand of " + (trace ? *trace : *plan) : input,
+      out);
 
   JsonLine json;
   json.add("input", input)
