@@ -5,10 +5,13 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <optional>
 #include <string_view>
 #include <system_error>
 #include <utility>
 #include <vector>
+
+#include "dovetail/engine/pose_list.h"
 
 namespace dovetail::engine::detail {
 
@@ -24,28 +27,6 @@ std::string_view next_word(std::string_view line, std::size_t& at) {
   const std::size_t start = at;
   while (at < line.size() && !space(line[at])) ++at;
   return line.substr(start, at - start);
-}
-
-/// The whole word as a finite number (with an optional leading '+').
-bool is_finite_number(std::string_view word) {
-  const char* first = word.data();
-  const char* last = word.data() + word.size();
-  if (first != last && *first == '+') ++first;
-  double value = 0;
-  const auto [ptr, ec] = std::from_chars(first, last, value);
-  return first != last && ptr == last && ec == std::errc() && std::isfinite(value);
-}
-
-/// The whole word as a number, with an optional leading '+'.
-bool is_number(std::string_view word) {
-  const char* first = word.data();
-  const char* last = word.data() + word.size();
-  if (first != last && *first == '+') ++first;
-  double value = 0;
-  const auto [ptr, ec] = std::from_chars(first, last, value);
-  // Out of range (1e999) is a number: the mesh check calls it not finite.
-  return first != last && ptr == last &&
-         (ec == std::errc() || ec == std::errc::result_out_of_range);
 }
 
 /// The whole word as a vertex number (an integer, maybe negative), or
@@ -120,11 +101,12 @@ std::optional<std::string> check_obj_lines(const std::filesystem::path& path,
           return at_line(line_number, "a vertex needs three numbers (x y z), this one has " +
                                           std::to_string(k) + ": " + quoted(line));
         }
-        if (!is_number(word)) {
+        const std::optional<double> x = parse_real(word);
+        if (!x) {
           return at_line(line_number,
                          quoted(word) + " is not a number, in the vertex " + quoted(line));
         }
-        if (!is_finite_number(word)) {
+        if (!std::isfinite(*x)) {
           // Checked here: the OBJ reader drops a vertex no face uses unseen.
           return at_line(line_number, quoted(word) + " is not finite, in the vertex " +
                                           quoted(line) + "; a vertex must be, used or not");

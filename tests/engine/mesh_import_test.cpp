@@ -294,6 +294,9 @@ TEST(MeshImport, AnUnusedNonFiniteVertexAndAByteOrderMarkAreNamed) {
   write_file(dir / "bom.obj", "\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   const std::string bom = import_error(dir / "bom.obj");
   EXPECT_NE(bom.find("line 1: starts with a byte-order mark"), std::string::npos) << bom;
+  // A coordinate too small for a double is finite: it reads as zero, as before.
+  write_file(dir / "tiny.obj", "v 1e-400 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n");
+  EXPECT_EQ(import_mesh(dir / "tiny.obj").triangle_count(), 1u);
 }
 
 TEST(MeshImport, TruncatedBinaryStl) {
