@@ -3,32 +3,21 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 
 #include "cli.h"
+#include "dovetail/engine/pose_list.h"
 
 namespace dovetail::cli {
 
 /// The field in quotes, a control byte (a NUL, say) written as \xNN so that
 /// the message shows it and is not cut short by it.
 std::string quote(std::string_view field) {
-  std::string s;
-  s.reserve(field.size() + 2);
-  s += '\'';
-  for (const char c : field) {
-    const auto byte = static_cast<unsigned char>(c);
-    if (byte < 0x20 || byte == 0x7f) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\x%02X", byte);
-      s += escaped;
-    } else {
-      s += c;
-    }
-  }
-  s += '\'';
-  return s;
+  std::string quoted = "'";
+  quoted += engine::escape_control_bytes(field);
+  quoted += '\'';
+  return quoted;
 }
 
 std::string fields_text(std::size_t n) {

@@ -104,21 +104,11 @@ int dispatch(const std::vector<std::string>& args) {
   throw dovetail::cli::UsageError("unknown command '" + name + "' (see 'dovetail --help')");
 }
 
-/// Prints `message` whole: a NUL or another control byte a file brought in
-/// is written as \xNN, not cutting the line short (tabs and line ends stay).
+/// Prints `message` whole: a control byte a file brought in is written as
+/// \xNN (tabs and line ends stay).
 int report(const std::string& message, int code) {
-  std::string shown;
-  for (const char c : message) {
-    const auto byte = static_cast<unsigned char>(c);
-    if (byte < 0x20 && c != '\n' && c != '\t') {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
-      shown += escaped;
-    } else {
-      shown += c;
-    }
-  }
-  std::fprintf(stderr, "dovetail: %s\n", shown.c_str());
+  std::fprintf(stderr, "dovetail: %s\n",
+               dovetail::engine::escape_control_bytes(message, "\n\t").c_str());
   return code;
 }
 

@@ -57,21 +57,24 @@ std::optional<Real> parse_real(std::string_view token) {
   return value;
 }
 
-std::string shown_token(std::string_view token) {
-  constexpr std::size_t kMax = 40;
-  std::string text;
-  for (const char c : token.substr(0, kMax)) {
+std::string escape_control_bytes(std::string_view text, std::string_view keep) {
+  std::string shown;
+  for (const char c : text) {
     const auto byte = static_cast<unsigned char>(c);
-    if (byte < 0x20 || byte == 0x7f) {
+    if ((byte < 0x20 || byte == 0x7f) && keep.find(c) == std::string_view::npos) {
       char escaped[5];
       std::snprintf(escaped, sizeof escaped, "\\x%02X", byte);
-      text += escaped;
+      shown += escaped;
     } else {
-      text += c;
+      shown += c;
     }
   }
-  if (token.size() > kMax) text += "...";
-  return text;
+  return shown;
+}
+
+std::string shown_token(std::string_view token) {
+  constexpr std::size_t kMax = 40;
+  return escape_control_bytes(token.substr(0, kMax)) + (token.size() > kMax ? "..." : "");
 }
 
 std::optional<Transform> parse_pose_line(std::string_view text, std::string_view where) {

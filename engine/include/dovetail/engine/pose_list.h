@@ -58,6 +58,11 @@ std::optional<collision::Real> parse_real(std::string_view token);
 /// the terminal.
 std::string shown_token(std::string_view token);
 
+/// `text` with its control bytes (below 0x20, and 0x7f) written as \xNN,
+/// but those in `keep`: what a message shows of a file's text, so that it
+/// neither drives the terminal nor is cut short at a NUL.
+std::string escape_control_bytes(std::string_view text, std::string_view keep = {});
+
 /// Parses one line of a pose list. Returns nullopt for a blank or comment
 /// line; throws PoseListError with message `where: what` for a bad line.
 std::optional<collision::Transform> parse_pose_line(std::string_view text, std::string_view where);
