@@ -7,7 +7,6 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 #include <algorithm>
-#include <array>
 #include <assimp/Importer.hpp>
 #include <cctype>
 #include <cerrno>
@@ -18,7 +17,6 @@
 #include <numbers>
 #include <optional>
 #include <set>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -251,22 +249,6 @@ FaceCounts count_faces(const aiMesh& mesh) {
   return counts;
 }
 
-/// The bits of a coordinate as read, with -0 as +0 (one position).
-std::uint64_t position_bits(ai_real x) {
-  const double d = static_cast<double>(x) + 0.0;
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &d, sizeof bits);
-  return bits;
-}
-
-struct PositionHash {
-  std::size_t operator()(const std::array<std::uint64_t, 3>& k) const {
-    std::uint64_t h = 1469598103934665603ULL;
-    for (const std::uint64_t x : k) h = (h ^ x) * 1099511628211ULL;
-    return static_cast<std::size_t>(h ^ (h >> 32));
-  }
-};
-
 /// Appends the triangles of `mesh` transformed by X_RN; all the mesh's
 /// vertices are appended when it has at least one triangle.
 void append(const fs::path& path, const aiMesh& mesh, const Affine& X_RN, Geometry& out) {
@@ -274,17 +256,19 @@ void append(const fs::path& path, const aiMesh& mesh, const Affine& X_RN, Geomet
   // Vertices at exactly the same position are one (the first), so that faces
   // that share a corner share its index: a weld by equality, never by
   // distance, so no real vertex, however near another, is lost.
-  std::vector<std::uint32_t> index(mesh.mNumVertices);
-  std::unordered_map<std::array<std::uint64_t, 3>, std::uint32_t, PositionHash> first;
-  first.reserve(mesh.mNumVertices);
+  std::vector<Vec3> local(mesh.mNumVertices);
   for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
-    const aiVector3D& p = mesh.mVertices[v];
-    const std::array<std::uint64_t, 3> key = {position_bits(p.x), position_bits(p.y),
-                                              position_bits(p.z)};
-    const auto [it, fresh] =
-        first.emplace(key, static_cast<std::uint32_t>(out.vertices.size() - offset));
-    if (fresh) out.vertices.push_back(apply(X_RN, p));
-    index[v] = it->second;
+    local[v] = Vec3(mesh.mVertices[v].x, mesh.mVertices[v].y, mesh.mVertices[v].z);
+  }
+  const std::vector<std::uint32_t> welded = collision::welded_ids(local);
+  std::vector<std::uint32_t> index(mesh.mNumVertices);
+  for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+    if (welded[v] == v) {
+      index[v] = static_cast<std::uint32_t>(out.vertices.size() - offset);
+      out.vertices.push_back(apply(X_RN, mesh.mVertices[v]));
+    } else {
+      index[v] = index[welded[v]];  // an earlier vertex, already placed
+    }
   }
   // A mirroring transform turns the winding; swap to keep normals outward.
   const bool mirrored = X_RN.leftCols<3>().determinant() < 0;

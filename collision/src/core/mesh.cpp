@@ -1,8 +1,11 @@
 #include "dovetail/collision/mesh.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "dovetail/collision/predicates.h"
@@ -88,6 +91,22 @@ Mesh make_mesh(std::vector<Vec3> vertices, std::vector<TriangleIndices> triangle
 
   if (validation != nullptr) *validation = found;
   return Mesh{std::move(vertices), std::move(triangles), std::move(source)};
+}
+
+std::vector<std::uint32_t> welded_ids(std::span<const Vec3> vertices) {
+  std::vector<std::uint32_t> order(vertices.size());
+  std::iota(order.begin(), order.end(), std::uint32_t{0});
+  const auto key = [&](std::uint32_t i) {
+    return std::make_tuple(vertices[i].x(), vertices[i].y(), vertices[i].z());
+  };
+  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {
+    return std::make_pair(key(i), i) < std::make_pair(key(j), j);
+  });
+  std::vector<std::uint32_t> id(vertices.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    id[order[k]] = (k > 0 && key(order[k]) == key(order[k - 1])) ? id[order[k - 1]] : order[k];
+  }
+  return id;
 }
 
 Bounds mesh_bounds(const Mesh& mesh) {

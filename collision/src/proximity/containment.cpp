@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <memory>
 #include <numbers>
-#include <numeric>
 #include <tuple>
 #include <vector>
 
@@ -16,23 +15,6 @@
 namespace dovetail::collision {
 
 namespace {
-
-/// Vertex ids with equal positions merged: the smallest index of each position.
-std::vector<std::uint32_t> welded_ids(const std::vector<Vec3>& vertices) {
-  std::vector<std::uint32_t> order(vertices.size());
-  std::iota(order.begin(), order.end(), std::uint32_t{0});
-  const auto key = [&](std::uint32_t i) {
-    return std::make_tuple(vertices[i].x(), vertices[i].y(), vertices[i].z());
-  };
-  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {
-    return std::make_pair(key(i), i) < std::make_pair(key(j), j);
-  });
-  std::vector<std::uint32_t> id(vertices.size());
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    id[order[k]] = (k > 0 && key(order[k]) == key(order[k - 1])) ? id[order[k - 1]] : order[k];
-  }
-  return id;
-}
 
 /// A directed edge of a triangle, between welded vertices.
 struct Edge {

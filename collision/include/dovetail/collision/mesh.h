@@ -8,6 +8,7 @@
 /// degenerate (zero-area) triangles, which are removed and counted.
 
 #include <cstddef>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -63,6 +64,11 @@ Mesh make_mesh(std::vector<Vec3> vertices, std::vector<TriangleIndices> triangle
 /// make_mesh; no coordinate or size limit is applied (the importer chooses
 /// those), and degenerate triangles are allowed.
 void check_mesh(const Mesh& mesh);
+
+/// For each vertex, the smallest index of a vertex at exactly the same
+/// position (equal coordinates, so -0 is 0): vertices welded by equality,
+/// never by distance.
+std::vector<std::uint32_t> welded_ids(std::span<const Vec3> vertices);
 
 /// Axis-aligned bounds of all vertices.
 struct Bounds {
