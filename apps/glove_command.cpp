@@ -121,44 +121,31 @@ int convert(std::span<const std::string> argv) {
 /// The most samples `glove plan` writes: 31 hours at 90 Hz, about 4 GB while sampled.
 constexpr double kMaxPlanSamples = 1e7;
 
-int plan(std::span<const std::string> argv) {
-  const Args args("glove plan", argv, {"out", "rate", "seed"}, {"noise"});
-  if (args.help()) {
-    std::fputs(kHelp, stdout);
-    return kExitOk;
+/// --rate in Hz (default 90); any bad value gets the range's message.
+double plan_rate(const Args& args) {
+  const std::optional<std::string> text = args.value("rate");
+  if (!text) return 90;
+  double rate = -1;
+  try {
+    rate = *args.number("rate", 0);
+  } catch (const UsageError&) {
+    // not a number: the range's message below
   }
-  args.expect_positional(1, "one plan file PLAN");
-  const std::string& path = args.positional()[0];
-  const std::string out = args.required("out");
-  double rate = 90;
-  if (const std::optional<std::string> text = args.value("rate")) {
-    try {
-      rate = *args.number("rate", 0);
-    } catch (const UsageError&) {
-      rate = -1;  // not a number: the range's message below
-    }
-    if (!(rate > 0) || rate > 1e5) {
-      throw UsageError("glove plan: --rate must be a number of Hz in (0, 100000], not '" + *text +
-                       "'");
-    }
+  if (!(rate > 0) || rate > 1e5) {
+    throw UsageError("glove plan: --rate must be a number of Hz in (0, 100000], not '" + *text +
+                     "'");
   }
-  const std::string inputs[] = {path};
-  refuse_overwriting_input("glove plan", out, inputs);
+  return rate;
+}
 
-  std::shared_ptr<const interaction::GloveSource> source =
-      std::make_shared<interaction::SimulatedGlove>(
-          input_step([&] { return interaction::read_plan(std::filesystem::path(path)); }));
-  if (args.flag("noise")) {
-    interaction::GloveNoise noise;
-    noise.seed = args.unsigned_integer("seed").value_or(1);
-    source = std::make_shared<interaction::NoisyGlove>(source, noise);
-  } else if (args.value("seed")) {
-    throw UsageError("glove plan: --seed needs --noise");
-  }
-  const double end = source->end_time();
+/// The plan's samples at each multiple of 1/rate up to its end, and at the
+/// end itself when it falls between two of them; `path` names the plan in
+/// the error for a plan too long to hold.
+std::vector<GloveSample> sample_plan(const interaction::GloveSource& source, double rate,
+                                     const std::string& path) {
+  const double end = source.end_time();
   // Counted as a double first: a plan of 1e300 s would not fit any integer.
-  // Every sample is held until the trace is written (about 400 bytes each):
-  // one at each multiple of 1/rate up to the end, and the end itself.
+  // Every sample is held until the trace is written (about 400 bytes each).
   const double on_grid = std::floor(end * rate + 1e-9);  // the last multiple of 1/rate
   const bool end_between = on_grid / rate < end;
   const double wanted = on_grid + (end_between ? 2 : 1);
@@ -174,10 +161,36 @@ int plan(std::span<const std::string> argv) {
   std::vector<GloveSample> samples;
   samples.reserve(count);
   for (std::uint64_t k = 0; k < count; ++k) {
-    samples.push_back(source->sample(static_cast<double>(k) / rate));
+    samples.push_back(source.sample(static_cast<double>(k) / rate));
   }
-  // The plan's end is a sample too when it falls between two of the rate's.
-  if (end_between) samples.push_back(source->sample(end));
+  if (end_between) samples.push_back(source.sample(end));
+  return samples;
+}
+
+int plan(std::span<const std::string> argv) {
+  const Args args("glove plan", argv, {"out", "rate", "seed"}, {"noise"});
+  if (args.help()) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  args.expect_positional(1, "one plan file PLAN");
+  const std::string& path = args.positional()[0];
+  const std::string out = args.required("out");
+  const double rate = plan_rate(args);
+  const std::string inputs[] = {path};
+  refuse_overwriting_input("glove plan", out, inputs);
+
+  std::shared_ptr<const interaction::GloveSource> source =
+      std::make_shared<interaction::SimulatedGlove>(
+          input_step([&] { return interaction::read_plan(std::filesystem::path(path)); }));
+  if (args.flag("noise")) {
+    interaction::GloveNoise noise;
+    noise.seed = args.unsigned_integer("seed").value_or(1);
+    source = std::make_shared<interaction::NoisyGlove>(source, noise);
+  } else if (args.value("seed")) {
+    throw UsageError("glove plan: --seed needs --noise");
+  }
+  const std::vector<GloveSample> samples = sample_plan(*source, rate, path);
   input_step([&] {
     interaction::write_trace(out, samples);
     return 0;

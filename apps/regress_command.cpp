@@ -560,6 +560,41 @@ void check_output_names(const std::vector<std::filesystem::path>& files) {
   }
 }
 
+/// A path made absolute and canonical as far as it exists; "results/" is "results".
+std::filesystem::path full_path(const std::filesystem::path& p) {
+  std::filesystem::path f = std::filesystem::weakly_canonical(std::filesystem::absolute(p));
+  return f.has_filename() ? f : f.parent_path();
+}
+
+/// Whether `file` is inside folder `out` (at any depth).
+bool inside(const std::filesystem::path& out, const std::string& file) {
+  const std::filesystem::path out_folder = full_path(out);
+  const std::filesystem::path parent = full_path(std::filesystem::absolute(file).parent_path());
+  const auto [end, at] =
+      std::mismatch(out_folder.begin(), out_folder.end(), parent.begin(), parent.end());
+  return end == out_folder.end();
+}
+
+/// Checks the --junit and --html files before any scenario runs and before
+/// the output folder is made: neither a scenario nor each other, and
+/// writable. One inside the output folder is checked for writing once the
+/// folder is made (regress_command).
+void check_summaries(const std::optional<std::string>& junit,
+                     const std::optional<std::string>& html,
+                     const std::vector<std::filesystem::path>& files,
+                     const std::filesystem::path& out) {
+  std::vector<std::string> scenarios;
+  for (const std::filesystem::path& f : files) scenarios.push_back(f.string());
+  for (const std::optional<std::string>& summary : {junit, html}) {
+    if (!summary) continue;
+    refuse_overwriting_input("regress", *summary, scenarios);
+    if (!inside(out, *summary)) check_writable(*summary);
+  }
+  if (junit && html && engine::same_file(*junit, *html)) {
+    throw UsageError("regress: --junit and --html name the same file '" + *junit + "'");
+  }
+}
+
 }  // namespace
 
 int regress_command(std::span<const std::string> argv) {
@@ -577,33 +612,9 @@ int regress_command(std::span<const std::string> argv) {
   const int threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
   const double timeout = args.number("timeout", 1).value_or(900);
   const auto [shard_k, shard_n] = parse_shard(args);
-  // The summaries are checked before any scenario runs, and before the
-  // output folder is made: neither a scenario nor each other, and writable.
-  std::vector<std::string> scenarios;
-  for (const std::filesystem::path& f : scenario_files(folder)) scenarios.push_back(f.string());
   const std::optional<std::string> junit = args.value("junit");
   const std::optional<std::string> html = args.value("html");
-  // A summary inside the output folder is checked for writing once the
-  // folder is made.
-  const auto full = [](const std::filesystem::path& p) {
-    std::filesystem::path f = std::filesystem::weakly_canonical(std::filesystem::absolute(p));
-    return f.has_filename() ? f : f.parent_path();  // "results/" is "results"
-  };
-  const std::filesystem::path out_folder = full(out);
-  const auto inside_out = [&](const std::string& summary) {
-    const std::filesystem::path parent = full(std::filesystem::absolute(summary).parent_path());
-    const auto [end, at] =
-        std::mismatch(out_folder.begin(), out_folder.end(), parent.begin(), parent.end());
-    return end == out_folder.end();
-  };
-  for (const std::optional<std::string>& summary : {junit, html}) {
-    if (!summary) continue;
-    refuse_overwriting_input("regress", *summary, scenarios);
-    if (!inside_out(*summary)) check_writable(*summary);
-  }
-  if (junit && html && engine::same_file(*junit, *html)) {
-    throw UsageError("regress: --junit and --html name the same file '" + *junit + "'");
-  }
+  check_summaries(junit, html, scenario_files(folder), out);
   check_output_names(scenario_files(folder));
   std::vector<Job> jobs = shard_jobs(folder, shard_k, shard_n);
   make_folder(out);
@@ -611,7 +622,7 @@ int regress_command(std::span<const std::string> argv) {
     throw InputError(out.string() + ": cannot be written: " + std::strerror(errno));
   }
   for (const std::optional<std::string>& summary : {junit, html}) {
-    if (summary && inside_out(*summary)) check_writable(*summary);
+    if (summary && inside(out, *summary)) check_writable(*summary);
   }
 
   const auto begin = std::chrono::steady_clock::now();

@@ -149,6 +149,17 @@ double render_to_png(const engine::RenderScene& scene, const engine::RenderSetti
   return render_ms;
 }
 
+/// --width, --height and --camera.
+engine::RenderSettings render_settings(const Args& args) {
+  engine::RenderSettings settings;
+  settings.width = static_cast<int>(args.integer("width", 1, engine::kMaxImageSize).value_or(1024));
+  settings.height =
+      static_cast<int>(args.integer("height", 1, engine::kMaxImageSize).value_or(768));
+  settings.camera = args.value("camera").value_or("auto");
+  if (settings.camera.empty()) throw UsageError("render: --camera must name a camera or be 'auto'");
+  return settings;
+}
+
 }  // namespace
 
 int render_command(std::span<const std::string> argv) {
@@ -163,12 +174,7 @@ int render_command(std::span<const std::string> argv) {
   args.expect_positional(1, "one mesh or assembly file INPUT");
   const std::string& input = args.positional()[0];
   const std::string out = args.required("out");
-  engine::RenderSettings settings;
-  settings.width = static_cast<int>(args.integer("width", 1, engine::kMaxImageSize).value_or(1024));
-  settings.height =
-      static_cast<int>(args.integer("height", 1, engine::kMaxImageSize).value_or(768));
-  settings.camera = args.value("camera").value_or("auto");
-  if (settings.camera.empty()) throw UsageError("render: --camera must name a camera or be 'auto'");
+  const engine::RenderSettings settings = render_settings(args);
   const std::optional<std::string> trace = args.value("trace");
   const std::optional<std::string> plan = args.value("plan");
   if (trace && plan) throw UsageError("render: give --trace or --plan, not both");
