@@ -386,6 +386,44 @@ TEST(Contacts, DepthEqualsTheDeepestVertexInsideOnTurnedBoxes) {
   EXPECT_NEAR(other[0].depth, 0.01, 1e-12);
 }
 
+TEST(Contacts, DepthIntoBodiesThatTouchIsMeasuredToTheirSurface) {
+  // A cabinet's side wall and top panel exported as one mesh, touching
+  // along the wall's top face (welded at the shared edge), and a drawer 1
+  // deeper than the opening pushed in by 30: the depth is the 1 of the
+  // side, as with the wall alone, not the 30 of the push.
+  const Mesh wall = make_box(Vec3(9, 51, 160));
+  const Mesh panel = make_box(Vec3(219, 9, 160));
+  std::vector<Vec3> v;
+  std::vector<TriangleIndices> t;
+  const auto add = [&](const Mesh& m, const Vec3& at) {
+    const auto base = static_cast<std::uint32_t>(v.size());
+    for (const Vec3& p : m.vertices) v.push_back(p + at);
+    for (const TriangleIndices& f : m.triangles)
+      t.push_back({f[0] + base, f[1] + base, f[2] + base});
+  };
+  add(wall, Vec3(210, 0, -160));
+  add(panel, Vec3(0, 60, -160));
+  const Mesh cabinet = make_mesh(std::move(v), std::move(t), "wall and top");
+  ASSERT_TRUE(is_closed(cabinet));
+  const auto cabinet_model = model(cabinet);
+  const auto wall_model = model([&] {
+    Mesh m = make_box(Vec3(9, 51, 160));
+    for (Vec3& p : m.vertices) p += Vec3(210, 0, -160);
+    return m;
+  }());
+  const auto drawer = model(make_box(Vec3(202, 50, 150)));
+  for (const Real push : {10.0, 30.0, 60.0}) {
+    for (const auto* a : {cabinet_model.get(), wall_model.get()}) {
+      const std::vector<ContactPatch> patches =
+          compute_contacts(*a, *drawer, translation(0, 0, 150 - push));
+      ASSERT_FALSE(patches.empty()) << push;
+      Real depth = 0;
+      for (const ContactPatch& p : patches) depth = std::max(depth, p.depth);
+      EXPECT_NEAR(depth, 1.0, 1e-9) << "push " << push;
+    }
+  }
+}
+
 TEST(Contacts, VertexOnFaceIsAPointPatch) {
   // An octahedron standing on one vertex on A's top face.
   std::vector<Vec3> v = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};

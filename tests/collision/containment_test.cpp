@@ -59,6 +59,44 @@ TEST(Containment, IsClosed) {
   EXPECT_TRUE(is_closed(make_mesh(std::move(v), std::move(t), "split box")));
 }
 
+/// Two boxes in one mesh, as a CAD export writes an assembly of bodies: the
+/// second box's vertices moved by `offset`; no welding but by position.
+Mesh two_boxes(const Vec3& half_a, const Vec3& half_b, const Vec3& offset) {
+  const Mesh a = make_box(half_a);
+  const Mesh b = make_box(half_b);
+  std::vector<Vec3> v = a.vertices;
+  std::vector<TriangleIndices> t = a.triangles;
+  const auto base = static_cast<std::uint32_t>(v.size());
+  for (const Vec3& p : b.vertices) v.push_back(p + offset);
+  for (const TriangleIndices& f : b.triangles) t.push_back({f[0] + base, f[1] + base, f[2] + base});
+  return make_mesh(std::move(v), std::move(t), "two boxes");
+}
+
+TEST(Containment, BodiesThatTouchAreClosedTogether) {
+  // Sharing an edge (welded vertices: four triangles at the edge), sharing
+  // a whole face (two opposed faces), and a box standing on another's face
+  // (a face inside the other's face) are closed, and a point is inside
+  // exactly where it is inside one of the boxes.
+  const Vec3 half(1, 1, 1);
+  for (const Vec3& offset : {Vec3(2, 2, 0), Vec3(2, 0, 0), Vec3(0, 0, 1.5)}) {
+    const Mesh bodies = offset.z() > 0 ? two_boxes(half, Vec3(0.5, 0.5, 0.5), offset)
+                                       : two_boxes(half, half, offset);
+    EXPECT_TRUE(is_closed(bodies)) << offset.transpose();
+    EXPECT_EQ(locate_point(bodies, Vec3(0.5, 0.5, 0.5)), PointLocation::kInside);
+    EXPECT_EQ(locate_point(bodies, offset + Vec3(0.2, -0.3, 0.1)), PointLocation::kInside);
+    EXPECT_EQ(locate_point(bodies, Vec3(0, 0, 5)), PointLocation::kOutside);
+  }
+  EXPECT_EQ(locate_point(two_boxes(half, half, Vec3(2, 2, 0)), Vec3(1.5, 0.5, 0)),
+            PointLocation::kOutside);
+  // Still open with a triangle missing, still inconsistent with one flipped.
+  Mesh open = two_boxes(half, half, Vec3(2, 2, 0));
+  open.triangles.pop_back();
+  EXPECT_FALSE(is_closed(open));
+  Mesh flipped = two_boxes(half, half, Vec3(2, 0, 0));
+  std::swap(flipped.triangles[15][1], flipped.triangles[15][2]);
+  EXPECT_FALSE(is_closed(flipped));
+}
+
 TEST(Containment, PointInsideBoxSphereAndTorus) {
   const Mesh box = make_box(Vec3(1, 1, 1));
   EXPECT_EQ(locate_point(box, Vec3(0, 0, 0)), PointLocation::kInside);

@@ -207,15 +207,25 @@ std::pair<Inside, Inside> shells_inside(const Mesh& solid, const std::vector<Vec
 }  // namespace
 
 bool is_closed(const Mesh& mesh) {
-  const std::vector<Edge> edges = directed_edges(mesh);
-  const auto same = [](const Edge& x, const Edge& y) { return x.from == y.from && x.to == y.to; };
-  for (std::size_t k = 0; k < edges.size(); ++k) {
-    const Edge& e = edges[k];
-    // Each directed edge once, and its reverse exactly once.
-    if (k + 1 < edges.size() && same(e, edges[k + 1])) return false;
-    const Edge reverse{e.to, e.from, 0};
-    const auto it = std::lower_bound(edges.begin(), edges.end(), reverse);
-    if (it == edges.end() || !same(*it, reverse)) return false;
+  if (mesh.triangles.empty()) return false;
+  // Each edge as (lower id, higher id) with the direction it is used in:
+  // +1 from lower to higher, -1 back. Closed: every edge's directions cancel.
+  std::vector<Edge> edges = directed_edges(mesh);
+  for (Edge& e : edges) {
+    e.triangle = e.from < e.to ? 1 : 0;  // reused as the direction
+    if (e.from > e.to) std::swap(e.from, e.to);
+  }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t k = 0; k < edges.size();) {
+    std::size_t end = k;
+    std::int64_t balance = 0;
+    for (; end < edges.size() && edges[end].from == edges[k].from && edges[end].to == edges[k].to;
+         ++end) {
+      balance += edges[end].triangle == 1 ? 1 : -1;
+    }
+    // An edge of a triangle with two welded corners has no direction to cancel.
+    if (balance != 0 && edges[k].from != edges[k].to) return false;
+    k = end;
   }
   return true;
 }

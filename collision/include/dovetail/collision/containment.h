@@ -19,10 +19,11 @@
 
 namespace dovetail::collision {
 
-/// True when every edge of `mesh` is shared by exactly two triangles that
-/// use it in opposite directions (a closed, consistently oriented surface,
-/// possibly of several shells). Vertices at equal positions count as one, so
-/// meshes with split vertices are judged by their geometry.
+/// True when every edge of `mesh` is used as often in one direction as in
+/// the other by its triangles: a closed, consistently oriented surface, or
+/// several, which may share edges and vertices (bodies that touch, exported
+/// as one mesh). Vertices at equal positions count as one, so meshes with
+/// split vertices are judged by their geometry.
 bool is_closed(const Mesh& mesh);
 
 /// Where a point lies against a closed mesh.
