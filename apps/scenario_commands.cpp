@@ -13,6 +13,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "dovetail/engine/paths.h"
+#include "dovetail/engine/pose_list.h"
 #include "dovetail/scripting/scenario_run.h"
 
 namespace dovetail::cli {
@@ -120,6 +121,10 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
   return options;
 }
 
+/// A scenario's text (its name, a step's, a warning) as the terminal shows
+/// it: control bytes as \xNN, so that a script never drives the terminal.
+std::string shown(const std::string& text) { return engine::escape_control_bytes(text); }
+
 void write_report(const std::string& path, const scripting::RunOutcome& outcome) {
   std::ofstream out(path, std::ios::binary);
   out << outcome.to_json();
@@ -129,7 +134,9 @@ void write_report(const std::string& path, const scripting::RunOutcome& outcome)
 
 /// Warnings, failures and suspect queries, on standard error.
 void print_problems(const scripting::RunOptions& options, const scripting::RunOutcome& outcome) {
-  for (const std::string& w : outcome.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (const std::string& w : outcome.warnings) {
+    std::fprintf(stderr, "warning: %s\n", shown(w).c_str());
+  }
   if (options.capture_dir && outcome.suspect_queries > 0) {
     std::fprintf(stderr, "warning: %zu suspect collision queries, %zu capture files in %s\n",
                  outcome.suspect_queries, outcome.captures.size(),
@@ -143,16 +150,17 @@ void print_problems(const scripting::RunOptions& options, const scripting::RunOu
 void print_summary(const scripting::RunOutcome& outcome) {
   std::size_t passed = 0;
   for (const auto& e : outcome.expectations) passed += e.passed ? 1 : 0;
-  std::printf("%s: %s (%zu/%zu expectations, %llu frames, %.2f s wall)\n", outcome.name.c_str(),
+  std::printf("%s: %s (%zu/%zu expectations, %llu frames, %.2f s wall)\n",
+              shown(outcome.name).c_str(),
               std::string(scripting::status_name(outcome.status)).c_str(), passed,
               outcome.expectations.size(), static_cast<unsigned long long>(outcome.report.frames),
               outcome.wall_seconds);
   for (const auto& s : outcome.steps) {
     if (s.done_at) {
-      std::printf("  step %-20s done at t=%.3f s%s\n", s.name.c_str(), *s.done_at,
+      std::printf("  step %-20s done at t=%.3f s%s\n", shown(s.name).c_str(), *s.done_at,
                   s.out_of_order ? " (out of order)" : "");
     } else {
-      std::printf("  step %-20s not done\n", s.name.c_str());
+      std::printf("  step %-20s not done\n", shown(s.name).c_str());
     }
   }
   std::printf("  state_hash 0x%016llx\n",
@@ -253,10 +261,10 @@ int check_command(std::span<const std::string> argv) {
   const std::filesystem::path file = args.positional()[0];
   if (!std::filesystem::exists(file)) throw InputError(file.string() + ": no such file");
   const scripting::Scenario s = scripting::check_scenario(file);
-  for (const std::string& w : s.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (const std::string& w : s.warnings) std::fprintf(stderr, "warning: %s\n", shown(w).c_str());
   std::printf("%s: ok: '%s', %zu parts, %zu mates, %zu steps, %zu rules, %zu expectations%s\n",
-              file.string().c_str(), s.name.c_str(), s.parts.size(), s.mates.size(), s.steps.size(),
-              s.rules.size(), s.expectations.size(), s.glove ? ", a hand" : "");
+              file.string().c_str(), shown(s.name).c_str(), s.parts.size(), s.mates.size(),
+              s.steps.size(), s.rules.size(), s.expectations.size(), s.glove ? ", a hand" : "");
   return kExitOk;
 }
 

@@ -223,9 +223,15 @@ class Loader {
     lua_pushstring(L_, key);
     return lua_rawget(L_, table);  // leaves the value on the stack
   }
+  /// The string at `index` whole, NUL bytes included (a number is converted).
+  std::string string_at(int index) {
+    std::size_t length = 0;
+    const char* text = lua_tolstring(L_, index, &length);
+    return text != nullptr ? std::string(text, length) : std::string();
+  }
   std::string string_field(int table, const char* key) {
     std::string out;
-    if (type_of_field(table, key) == LUA_TSTRING) out = lua_tostring(L_, -1);
+    if (type_of_field(table, key) == LUA_TSTRING) out = string_at(-1);
     lua_pop(L_, 1);
     return out;
   }
@@ -248,7 +254,7 @@ class Loader {
   std::string describe(int index) {
     switch (lua_type(L_, index)) {
       case LUA_TSTRING:
-        return "\"" + std::string(lua_tostring(L_, index)) + "\"";
+        return "\"" + string_at(index) + "\"";
       case LUA_TNUMBER:
         return format_number(lua_tonumber(L_, index));
       case LUA_TBOOLEAN:
@@ -287,7 +293,7 @@ class Loader {
     while (lua_next(L_, index) != 0) {
       lua_pop(L_, 1);
       if (lua_type(L_, -1) == LUA_TSTRING) {
-        strings.emplace_back(lua_tostring(L_, -1));
+        strings.push_back(string_at(-1));
       } else if (lua_isinteger(L_, -1)) {
         integers.push_back(lua_tointeger(L_, -1));
       } else {
@@ -328,7 +334,7 @@ class Loader {
   }
   Vec3 direction_at(int index, const SourceLocation& where, const std::string& what) {
     if (lua_type(L_, index) == LUA_TSTRING) {
-      const std::string s = lua_tostring(L_, index);
+      const std::string s = string_at(index);
       static const std::map<std::string, Vec3> axes = {
           {"x", Vec3::UnitX()},   {"y", Vec3::UnitY()},   {"z", Vec3::UnitZ()},
           {"+x", Vec3::UnitX()},  {"+y", Vec3::UnitY()},  {"+z", Vec3::UnitZ()},
@@ -344,7 +350,7 @@ class Loader {
   }
   std::array<float, 3> color_at(int index, const SourceLocation& where, const std::string& what) {
     if (lua_type(L_, index) == LUA_TSTRING) {
-      const std::string s = lua_tostring(L_, index);
+      const std::string s = string_at(index);
       const auto it = color_names().find(s);
       if (it == color_names().end()) {
         std::vector<std::string> names;
@@ -359,7 +365,7 @@ class Loader {
   }
   std::vector<std::string> names_at(int index, const SourceLocation& where,
                                     const std::string& what) {
-    if (lua_type(L_, index) == LUA_TSTRING) return {lua_tostring(L_, index)};
+    if (lua_type(L_, index) == LUA_TSTRING) return {string_at(index)};
     if (lua_type(L_, index) != LUA_TTABLE || !word_of(index).empty()) {
       fail(where, what + " must be a list of names { \"a\", \"b\" }, not " + describe(index));
     }
@@ -371,7 +377,7 @@ class Loader {
         lua_pop(L_, 1);
         fail(where, what + " must be a list of names");
       }
-      names.emplace_back(lua_tostring(L_, -1));
+      names.push_back(string_at(-1));
       lua_pop(L_, 1);
     }
     return names;
@@ -397,7 +403,7 @@ class Loader {
                                                         : "a name in quotes") +
                           ", not " + describe(index));
         }
-        arg.text = lua_tostring(L_, index);
+        arg.text = string_at(index);
         if (param.type == ArgType::kGraspType && arg.text != "precision" && arg.text != "tripod" &&
             arg.text != "power") {
           fail(where,
@@ -760,14 +766,13 @@ void Loader::read_scenario_fields(int table, const SourceLocation& where) {
                       format_number(tolerance));
     }
     scenario_.tolerance_m = tolerance * scenario_.metres_per_unit;
-  } else if (lua_type(L_, -1) != LUA_TNIL && !(lua_type(L_, -1) == LUA_TSTRING &&
-                                               std::string_view(lua_tostring(L_, -1)) == "exact")) {
+  } else if (lua_type(L_, -1) != LUA_TNIL &&
+             !(lua_type(L_, -1) == LUA_TSTRING && string_at(-1) == "exact")) {
     fail(where,
          std::string("scenario: accuracy must be \"exact\" or a length > 0 (a tolerance), "
                      "not a ") +
              luaL_typename(L_, -1) +
-             (lua_type(L_, -1) == LUA_TSTRING ? " \"" + std::string(lua_tostring(L_, -1)) + "\""
-                                              : std::string()));
+             (lua_type(L_, -1) == LUA_TSTRING ? " \"" + string_at(-1) + "\"" : std::string()));
   }
   lua_pop(L_, 1);
   auto with_field = [&](const char* name, auto read) {
@@ -1071,7 +1076,7 @@ void Loader::read_steps(int list, const SourceLocation& where) {
       if (lua_type(L_, v) != LUA_TNIL) {
         if (lua_type(L_, v) != LUA_TSTRING)
           fail(step.where, what + ": its " + key + " must be text");
-        out = lua_tostring(L_, v);
+        out = string_at(v);
       }
       lua_pop(L_, 2);
       return out;

@@ -16,6 +16,7 @@
 #include "dovetail/collision/model.h"
 #include "dovetail/engine/json.h"
 #include "dovetail/engine/paths.h"
+#include "dovetail/engine/pose_list.h"
 #include "dovetail/engine/render.h"
 #include "dovetail/engine/scene_render.h"
 #include "dovetail/interaction/glove_plan.h"
@@ -117,7 +118,9 @@ class Runner {
   bool part_pose(const char* name, Transform& X, char* error, std::size_t size);
   bool set_part_pose(const char* name, const Transform& X, char* error, std::size_t size);
   double time() const { return sim_ ? sim_->time() : 0; }
-  void log(const char* text) { out_.messages.push_back({time(), "log", text, current_where_}); }
+  void log(std::string text) {
+    out_.messages.push_back({time(), "log", std::move(text), current_where_});
+  }
   double metres_per_unit() const { return scenario_.metres_per_unit; }
 
  private:
@@ -297,8 +300,9 @@ int api_time(lua_State* L) {
 }
 
 int api_log(lua_State* L) {
-  const char* text = luaL_checkstring(L, 1);
-  runner_of(L)->log(text);  // copies into a std::string; no error raised after
+  std::size_t length = 0;
+  const char* text = luaL_checklstring(L, 1, &length);
+  runner_of(L)->log(std::string(text, length));  // no error raised after the copy
   return 0;
 }
 
@@ -1099,7 +1103,8 @@ std::string RunOutcome::failure_summary() const {
     if (m.level == "violation")
       out += m.where.str() + ": at t=" + format_time(m.time) + " s: " + m.text + "\n";
   }
-  return out;
+  // A script's text never drives the terminal.
+  return engine::escape_control_bytes(out, "\n");
 }
 
 RunOutcome run_scenario(const std::filesystem::path& file, const RunOptions& options) {

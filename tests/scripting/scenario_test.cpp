@@ -286,6 +286,31 @@ TEST(ScenarioRun, CustomActionsUseTheLowLevelApi) {
   EXPECT_EQ(logged, (std::vector<std::string>{"0 100 0", "0 250 0"})) << o.to_json();
 }
 
+TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
+  // A NUL inside a logged text (a log action's and dt.log's) is kept, and
+  // the report writes it as \u0000; the failure summary for the terminal
+  // shows control bytes as \xNN.
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(
+      dir, "nul.lua",
+      moved_peg(
+          "    rule { when = after(0.1), act = { log \"a\\0b\" }, once = true },\n"
+          "    rule { when = after(0.2), act = { custom(function(dt) dt.log(\"c\\0d\") end) },\n"
+          "           once = true },\n"
+          "    rule { when = after(0.3), act = { fail \"e\\27[31m\" }, once = true },",
+          ""));
+  const RunOutcome o = run_scenario(file);
+  std::vector<std::string> logged;
+  for (const Message& m : o.messages) {
+    if (m.level == "log") logged.push_back(m.text);
+  }
+  EXPECT_EQ(logged, (std::vector<std::string>{std::string("a\0b", 3), std::string("c\0d", 3)}));
+  const std::string json = o.to_json();
+  EXPECT_NE(json.find(R"("text": "a\u0000b")"), std::string::npos) << json;
+  EXPECT_NE(o.failure_summary().find("failed at t=0.300 s: e\\x1B[31m\n"), std::string::npos)
+      << o.failure_summary();
+}
+
 TEST(ScenarioRun, RegionsTimersAttachAndCompletedEventsAsDescribed) {
   const test::TempDir dir("dovetail_scenario");
   const auto file = write(dir, "words.lua", R"(return scenario {
