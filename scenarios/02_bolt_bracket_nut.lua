@@ -7,10 +7,11 @@
 --
 -- Scripted, not done by the hand: the nut. It waits on the base under the
 -- hole, and once the bolt is in, a rule moves it straight up the bolt's axis
--- onto the shank (`move`, which checks no collision on the way), and when it
--- touches the flange's underside a rule snaps it into place (`snap`). Nothing
--- turns it: threads are not modelled, and its 10.5 mm bore clears the 10 mm
--- shank (no_contact checks that the nut never touches the bolt).
+-- onto the shank (`move` does not look for collisions: the nut goes where it
+-- is sent), and when it touches the flange's underside a rule snaps it into
+-- place (`snap`). Nothing turns it: threads are not modelled, and its
+-- 10.5 mm bore clears the 10 mm shank (no_contact checks that the nut never
+-- touches the bolt).
 --
 -- The bolt, nut and bracket are meshes written by assets/parts/make_parts.py.
 return scenario {

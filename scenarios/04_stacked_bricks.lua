@@ -10,9 +10,10 @@
 -- brick comes down past it (no_contact checks that they never touch).
 --
 -- Scripted, not done by the hand: the lower and the top brick. Each is moved
--- straight down onto the stack by a rule (`move`, which checks no collision
--- on the way: they come down exactly on the studs' axis) and snapped into
--- place as soon as it touches the brick or plate below (`snap`).
+-- straight down onto the stack by a rule (`move` does not look for
+-- collisions: they come down exactly on the studs' axis, which no_contact and
+-- max_penetration check) and snapped into place as soon as it touches the
+-- brick or plate below (`snap`).
 --
 -- The bricks and the plate are meshes written by assets/parts/make_parts.py.
 return scenario {

@@ -43,7 +43,8 @@ enum class Happening {
   kSlide,
   kEnter,
   kLeave,
-  kCompleted
+  kCompleted,
+  kArrive
 };
 
 struct Occurrence {
@@ -177,6 +178,7 @@ class Runner {
     double t0, t1;
   };
   std::vector<Motion> motions_;
+  std::vector<std::string> arrived_;  ///< parts whose move ended this frame, in order
   std::map<const collision::Mesh*, std::shared_ptr<const collision::CollisionModel>> models_;
   /// Each mesh's hull when the part is convex (its hull is the part), else null.
   std::map<const collision::Mesh*, std::shared_ptr<const collision::ConvexHull>> convex_;
@@ -475,7 +477,12 @@ void Runner::start_frame(std::uint64_t, double t) {
       X.t = it->from + (it->to - it->from) * s;
       scene.set_world_pose(p, X);
     }
-    it = s >= 1 ? motions_.erase(it) : it + 1;
+    if (s >= 1) {
+      if (p.valid()) arrived_.push_back(it->part);
+      it = motions_.erase(it);
+    } else {
+      ++it;
+    }
   }
 }
 
@@ -551,6 +558,9 @@ bool Runner::holds(const Clause& state) const {
 
 std::vector<Occurrence> Runner::occurrences(const engine::FrameResult& result) {
   std::vector<Occurrence> out;
+  // Moves ended at the start of this frame: the parts are where they were sent.
+  for (std::string& part : arrived_) out.push_back({Happening::kArrive, std::move(part), ""});
+  arrived_.clear();
   for (const Event& e : result.events) {
     switch (e.kind) {
       case EventKind::kContactBegin:
@@ -632,6 +642,8 @@ bool Runner::matches(const Clause& when, const Occurrence& o) const {
       return w == "leaves" && args[0].text == o.a && args[1].text == o.b;
     case Happening::kCompleted:
       return w == "completed" && args[0].text == o.a;
+    case Happening::kArrive:
+      return w == "arrives" && args[0].text == o.a;
   }
   return false;
 }

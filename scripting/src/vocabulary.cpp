@@ -211,6 +211,12 @@ std::vector<Word> make_vocabulary() {
        "A rule fires at most once per its cooldown (default 0.1 s): for a shorter period give "
        "the rule cooldown = 0.",
        "every(1)"});
+  w.push_back({"arrives",
+               WordKind::kEvent,
+               {{"part", kPart, kRequired, "the part"}},
+               "A move action has brought the part where it was sent (in the frame it gets "
+               "there; at once for a move without `over`).",
+               "arrives \"cap\""});
   w.push_back({"completed",
                WordKind::kEvent,
                {{"step", kStep, kRequired, "the step"}},
@@ -271,7 +277,9 @@ std::vector<Word> make_vocabulary() {
                {{"part", kPart, kRequired, "the part"},
                 {"to", kVector, kRequired, "the new position of its origin"},
                 {"over", kSeconds, kOptional, "seconds to get there (default 0: at once)"}},
-               "Moves the part in a straight line, keeping its orientation.",
+               "Moves the part in a straight line, keeping its orientation. It goes where it is "
+               "sent: nothing stops it on the way (max_penetration and no_contact see what it "
+               "passes through). Act when it gets there with arrives.",
                "move(\"cover\", { 0, 200, 0 }, 0.5)"});
   w.push_back({"attach",
                WordKind::kAction,

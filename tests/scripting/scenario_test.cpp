@@ -311,6 +311,35 @@ TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
       << o.failure_summary();
 }
 
+TEST(ScenarioRun, AMovedPartArrivesOnceInTheFrameItGetsThere) {
+  // A move over 0.2 s from the start of the frame after t = 0.1, and one at
+  // once: each arrives once, where it was sent; a move replaced before its
+  // end does not arrive.
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(
+      dir, "arrive.lua",
+      moved_peg("    rule { when = after(0.1), act = { move(\"peg\", { 0, 150, 0 }, 0.2) } },\n"
+                "    rule { when = after(0.4), act = { move(\"peg\", { 0, 200, 0 }, 0.3) } },\n"
+                "    rule { when = after(0.5), act = { move(\"peg\", { 0, 180, 0 }) } },\n"
+                "    rule { when = arrives \"peg\", act = { custom(function(dt)\n"
+                "      local x, y, z = dt.part(\"peg\"):translation()\n"
+                "      dt.log(string.format(\"%.6g\", y))\n"
+                "    end) } },",
+                ""));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_NE(o.status, RunOutcome::Status::kError) << o.error;
+  std::vector<std::pair<double, std::string>> logged;
+  for (const Message& m : o.messages) {
+    if (m.level == "log") logged.emplace_back(m.time, m.text);
+  }
+  ASSERT_EQ(logged.size(), 2u) << o.to_json();
+  EXPECT_EQ(logged[0].second, "150");
+  EXPECT_GE(logged[0].first, 0.3);
+  EXPECT_LE(logged[0].first, 0.3 + 3.0 / 90);  // sent a frame after the rule fired
+  EXPECT_EQ(logged[1].second, "180");
+  EXPECT_LE(logged[1].first, 0.5 + 3.0 / 90);
+}
+
 TEST(ScenarioRun, RegionsTimersAttachAndCompletedEventsAsDescribed) {
   const test::TempDir dir("dovetail_scenario");
   const auto file = write(dir, "words.lua", R"(return scenario {
