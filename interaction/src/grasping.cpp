@@ -500,11 +500,40 @@ void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
     if (!p.valid() || !o.valid()) continue;
     const Transform X_WP = scene.world_pose(p), X_WO = scene.world_pose(o);
     if (!within_tolerance(mate, X_WP, X_WO)) continue;
-    scene.set_world_pose(p, mate_pose(mate, X_WP, X_WO));
+    const Transform X_seated = mate_pose(mate, X_WP, X_WO);
+    if (const auto [blocker, depth] = deepest_overlap(scene, p, X_seated); depth > kSnapOverlap) {
+      refused_snaps_.push_back({mate.name, part, blocker, depth, simulation.time()});
+      continue;
+    }
+    scene.set_world_pose(p, X_seated);
     pending_.push_back(
         {EventKind::kMate, simulation.frame(), simulation.time(), mate.part, mate.other});
     return;
   }
+}
+
+std::pair<std::string, Real> Grasping::deepest_overlap(const engine::Scene& scene, PartId part,
+                                                       const Transform& X_WP) {
+  const auto& mesh = scene.collision_mesh(part);
+  const auto attached = [&](PartId other) {
+    for (PartId p = scene.parent(other); p.valid(); p = scene.parent(p)) {
+      if (p == part) return true;
+    }
+    return false;
+  };
+  const collision::Bounds box = collision::transformed_bounds(models_->mesh_bounds(mesh), X_WP);
+  std::pair<std::string, Real> deepest{"", 0};
+  for (const PartId other : scene.parts()) {
+    const auto& other_mesh = scene.collision_mesh(other);
+    if (other == part || !other_mesh || scene.has_tag(other, "hand") || attached(other)) continue;
+    const Transform X_WB = scene.world_pose(other);
+    if (!overlap(collision::transformed_bounds(models_->mesh_bounds(other_mesh), X_WB), box, 0)) {
+      continue;
+    }
+    const Real depth = overlap_.depth(mesh, X_WP, other_mesh, X_WB);
+    if (depth > deepest.second) deepest = {scene.name(other), depth};
+  }
+  return deepest;
 }
 
 MateOffset mate_offset(const Mate& mate, const Transform& X_WP, const Transform& X_WO) {

@@ -23,6 +23,7 @@
 #include "dovetail/interaction/glove_trace.h"
 #include "dovetail/interaction/grasping.h"
 #include "dovetail/interaction/hand.h"
+#include "dovetail/interaction/overlap.h"
 
 namespace dovetail::scripting {
 
@@ -140,10 +141,12 @@ class Runner {
   bool near(const interaction::Mate& mate) const;
   void complete_step(std::size_t index, double now, std::vector<Occurrence>& occurrences);
   void apply(const Clause& action, double now);
-  /// The hull of a convex part's mesh, null for a part that is not convex.
-  std::shared_ptr<const collision::ConvexHull> convex_hull_of(
-      const std::shared_ptr<const collision::Mesh>& mesh);
   void measure_penetration(double now);
+  /// Each mate's closest approach so far, and the snaps refused this frame as warnings.
+  void watch_mates(double now);
+  /// Why a mate never snapped, for its expectation: a refused snap, or how
+  /// close its part came to its place against the tolerances.
+  std::string why_not_snapped(const MateSpec& mate) const;
   void evaluate_expectations();
   void render(const std::filesystem::path& path);
   const MateSpec* mate(const std::string& name) const;
@@ -179,9 +182,15 @@ class Runner {
   };
   std::vector<Motion> motions_;
   std::vector<std::string> arrived_;  ///< parts whose move ended this frame, in order
-  std::map<const collision::Mesh*, std::shared_ptr<const collision::CollisionModel>> models_;
-  /// Each mesh's hull when the part is convex (its hull is the part), else null.
-  std::map<const collision::Mesh*, std::shared_ptr<const collision::ConvexHull>> convex_;
+  /// Per mate (by index): the frame its part came closest to its place.
+  struct Closest {
+    interaction::MateOffset offset;
+    double time = 0;
+    bool seen = false;
+  };
+  std::vector<Closest> closest_;
+  std::size_t refusals_seen_ = 0;      ///< of grasping_->refused_snaps(), written as warnings
+  interaction::OverlapGauge overlap_;  ///< max_penetration's measure
   std::optional<engine::Camera> camera_;
   /// Poses at which each touching pair's depth was last measured.
   std::map<std::pair<std::string, std::string>, std::optional<std::pair<Transform, Transform>>>
@@ -678,24 +687,6 @@ void Runner::complete_step(std::size_t i, double now, std::vector<Occurrence>& o
   occurrences.push_back({Happening::kCompleted, scenario_.steps[i].name, ""});
 }
 
-std::shared_ptr<const collision::ConvexHull> Runner::convex_hull_of(
-    const std::shared_ptr<const collision::Mesh>& mesh) {
-  const auto [it, fresh] = convex_.try_emplace(mesh.get());
-  if (fresh) {
-    try {
-      auto hull = std::make_shared<const collision::ConvexHull>(
-          collision::compute_convex_hull(mesh->vertices, mesh->source));
-      if (collision::is_closed(*mesh) &&
-          collision::surface_on_hull(*hull, mesh->vertices, mesh->triangles)) {
-        it->second = std::move(hull);
-      }
-    } catch (const std::invalid_argument&) {
-      // A flat part has no hull: its vertex depth is all there is.
-    }
-  }
-  return it->second;
-}
-
 void Runner::measure_penetration(double now) {
   const engine::Scene& scene = sim_->scene();
   for (const auto& [a, b] : touching_) {
@@ -704,12 +695,6 @@ void Runner::measure_penetration(double now) {
     const auto& ma = scene.collision_mesh(pa);
     const auto& mb = scene.collision_mesh(pb);
     if (!ma || !mb) continue;
-    auto model = [&](const std::shared_ptr<const collision::Mesh>& mesh) {
-      auto& slot = models_[mesh.get()];
-      if (!slot) slot = collision::build_model(collision::Method::kObb, mesh);
-      return slot;
-    };
-    const auto model_a = model(ma), model_b = model(mb);
     const Transform X_WA = scene.world_pose(pa), X_WB = scene.world_pose(pb);
     // Parts that have not moved since they were last measured overlap as deep as then.
     auto& last = measured_[{a, b}];
@@ -718,19 +703,7 @@ void Runner::measure_penetration(double now) {
       continue;
     }
     last = std::pair(X_WA, X_WB);
-    const Transform X_AB{X_WA.R.transpose() * X_WB.R, X_WA.R.transpose() * (X_WB.t - X_WA.t)};
-    double depth = 0;
-    for (const collision::ContactPatch& patch :
-         collision::compute_contacts(*model_a, *model_b, X_AB)) {
-      depth = std::max(depth, patch.depth);
-    }
-    // Two convex parts: the exact penetration depth, which no vertex depth exceeds.
-    const auto hull_a = convex_hull_of(ma), hull_b = convex_hull_of(mb);
-    if (hull_a && hull_b) {
-      if (const auto pd = collision::convex_penetration_depth(*hull_a, *hull_b, X_AB)) {
-        depth = std::max(depth, pd->depth);
-      }
-    }
+    const double depth = overlap_.depth(ma, X_WA, mb, X_WB);
     if (depth > out_.max_penetration) {
       out_.max_penetration = depth;
       out_.max_penetration_time = now;
@@ -740,10 +713,60 @@ void Runner::measure_penetration(double now) {
   }
 }
 
+std::string Runner::why_not_snapped(const MateSpec& m) const {
+  if (grasping_) {
+    const auto& refused = grasping_->refused_snaps();
+    for (auto it = refused.rbegin(); it != refused.rend(); ++it) {
+      if (it->mate != m.mate.name) continue;
+      return ": released within its tolerances at t=" + format_time(it->time) +
+             " s, but in place it would overlap '" + it->blocker + "' by " +
+             format_length(it->depth_m, out_);
+    }
+  }
+  const auto i = static_cast<std::size_t>(&m - scenario_.mates.data());
+  if (i >= closest_.size() || !closest_[i].seen) return "";
+  const Closest& c = closest_[i];
+  char angle[64];
+  // Rounded to a millionth of a degree: turns given in degrees leave ~1e-15.
+  std::snprintf(angle, sizeof angle, "%.3g degrees", std::round(c.offset.angle_deg * 1e6) / 1e6);
+  char tolerance[64];
+  std::snprintf(tolerance, sizeof tolerance, "%.3g degrees", m.mate.angle_tolerance_deg);
+  return ": the closest it came was " + format_length(c.offset.distance_m, out_) +
+         " from its place, its axis " + angle + " off, at t=" + format_time(c.time) +
+         " s (a snap needs " + format_length(m.mate.position_tolerance, out_) + " and " +
+         tolerance + ", and the part released there)";
+}
+
+void Runner::watch_mates(double now) {
+  const engine::Scene& scene = sim_->scene();
+  closest_.resize(scenario_.mates.size());
+  for (std::size_t i = 0; i < scenario_.mates.size(); ++i) {
+    const interaction::Mate& m = scenario_.mates[i].mate;
+    const PartId p = scene.find(m.part), o = scene.find(m.other);
+    if (!p.valid() || !o.valid()) continue;
+    const interaction::MateOffset offset =
+        interaction::mate_offset(m, scene.world_pose(p), scene.world_pose(o));
+    Closest& c = closest_[i];
+    if (!c.seen || offset.distance_m < c.offset.distance_m) c = {offset, now, true};
+  }
+  if (!grasping_) return;
+  const auto& refused = grasping_->refused_snaps();
+  for (; refusals_seen_ < refused.size(); ++refusals_seen_) {
+    const interaction::RefusedSnap& r = refused[refusals_seen_];
+    const MateSpec* m = mate(r.mate);
+    out_.messages.push_back({r.time, "warn",
+                             "'" + r.part + "' was released within the tolerances of mate '" +
+                                 r.mate + "' but not snapped: in place it would overlap '" +
+                                 r.blocker + "' by " + format_length(r.depth_m, out_),
+                             m ? m->where : SourceLocation{}});
+  }
+}
+
 void Runner::end_frame(const engine::FrameResult& result, double previous_time) {
   const double now = result.time;
   std::vector<Occurrence> happened = occurrences(result);
   measure_penetration(now);
+  watch_mates(now);
   // Steps first: their completions are events the rules of this frame see.
   for (const std::size_t i : forced_steps_) complete_step(i, now, happened);
   forced_steps_.clear();
@@ -887,7 +910,8 @@ void Runner::evaluate_expectations() {
       }
       if (!mated) {
         e.passed = false;
-        e.detail = "'" + m->mate.part + "' never snapped into '" + m->mate.other + "'";
+        e.detail = "'" + m->mate.part + "' never snapped into '" + m->mate.other + "'" +
+                   why_not_snapped(*m);
       } else if (!near(m->mate)) {
         e.passed = false;
         e.detail = "'" + m->mate.part + "' snapped at t=" + format_time(at) +

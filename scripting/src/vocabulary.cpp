@@ -71,7 +71,8 @@ std::vector<Word> make_vocabulary() {
         {"angle", kNumber, kOptional,
          "angle tolerance in degrees, above 0 and at most 180 (default 5)"}},
        "A fit: released within the tolerances, the part snaps so its point and axis meet "
-       "the other's, and `mated` fires. While carried near it, the part is drawn onto the axis.",
+       "the other's, and `mated` fires, unless in place it would overlap another part (then a "
+       "warning names it). While carried near it, the part is drawn onto the axis.",
        "peg_in_hole = mate { part = \"peg\", point = { 0, 0, 60 }, axis = \"z\", into = "
        "\"block\", at = { 0, -10, 0 }, along = \"-y\" }"});
   w.push_back({"glove",

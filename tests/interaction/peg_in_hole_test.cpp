@@ -29,8 +29,18 @@ constexpr Real kBlockTop = 0.03;
 
 /// The block (fixed, hole axis along y, opening at y = kBlockTop) and the peg
 /// (a cylinder along its z axis from 0 to kPegLength, turned so z points down).
-engine::Scene peg_and_block(const Transform& X_WPeg, int sides = 64) {
+/// With a pebble of height `pebble` (a fixed 8 mm box) on the hole's bottom.
+engine::Scene peg_and_block(const Transform& X_WPeg, int sides = 64, Real pebble = 0) {
   engine::Scene scene;
+  if (pebble > 0) {
+    Transform X;
+    X.t = Vec3(0, kBlockTop - kHoleDepth + pebble / 2, 0);
+    scene.add_part({.name = "pebble",
+                    .X_QP = X,
+                    .movable = false,
+                    .render_mesh = std::make_shared<const collision::Mesh>(
+                        collision::make_box(Vec3(0.004, pebble / 2, 0.004)))});
+  }
   scene.add_part(
       {.name = "block",
        .movable = false,
@@ -60,15 +70,17 @@ struct PegRun {
   Real max_stretch = 0;
   std::vector<GloveSample> recorded;  ///< the glove samples the run used
   std::string report;                 ///< the report's JSON
+  std::vector<RefusedSnap> refused;
 };
 
 /// The hand holds the peg from the start, carries it 90 mm down along the
 /// hole's axis (20 mm past the bottom) in 2 s, waits, and opens.
 PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool measure_depth = true,
-               int sides = 64, std::shared_ptr<const GloveSource> replay = nullptr) {
+               int sides = 64, std::shared_ptr<const GloveSource> replay = nullptr,
+               Real pebble = 0) {
   const Transform X_WPeg0 = peg_start(offset, tilt_deg);
   engine::Simulation sim(
-      peg_and_block(X_WPeg0, sides),
+      peg_and_block(X_WPeg0, sides, pebble),
       {.collision_threads = threads, .contacts = collision::ContactDetail::kPairs});
   // The hand is above the peg, tilted with it, its power posture around nothing.
   GlovePlan plan;
@@ -128,6 +140,7 @@ PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool mea
   run.max_stretch = grasping.stats().max_stretch_m;
   run.recorded = hand.recorded();
   run.report = sim.report().to_json();
+  run.refused = grasping.refused_snaps();
   return run;
 }
 
@@ -182,6 +195,24 @@ TEST(PegInHole, APegFarOffTheHoleIsLeftBehindNotPushedThrough) {
   const Vec3 bottom = run.X_WPeg.apply(Vec3(0, 0, kPegLength));
   EXPECT_GE(bottom.y(), kBlockTop);
   EXPECT_LT(bottom.y(), kBlockTop + 1e-4);
+}
+
+TEST(PegInHole, APegStoppedShortByAPebbleIsNotSnappedThroughIt) {
+  // A 1.5 mm pebble on the hole's bottom: the peg stops on it, within the
+  // mate's 2 mm tolerance, and is released there. Seated, it would overlap
+  // the pebble by 1.5 mm, so it stays where it is and the refusal says why.
+  const PegRun run = run_peg(0.0015, -2, false, 1, true, 64, nullptr, 0.0015);
+  EXPECT_TRUE(has(run.events, EventKind::kRelease, "peg", "opened"));
+  EXPECT_FALSE(has(run.events, EventKind::kMate, "peg", "block"));
+  ASSERT_EQ(run.refused.size(), 1u);
+  EXPECT_EQ(run.refused[0].mate, "peg_in_hole");
+  EXPECT_EQ(run.refused[0].part, "peg");
+  EXPECT_EQ(run.refused[0].blocker, "pebble");
+  EXPECT_NEAR(run.refused[0].depth_m, 0.0015, 1e-5);
+  const Vec3 bottom = run.X_WPeg.apply(Vec3(0, 0, kPegLength));
+  EXPECT_GE(bottom.y(), kBlockTop - kHoleDepth + 0.0015);
+  EXPECT_LT(bottom.y(), kBlockTop - kHoleDepth + 0.0015 + 1e-4);
+  EXPECT_LT(run.max_depth, 1e-5);
 }
 
 TEST(PegInHole, ACoarselyTessellatedHoleStillTakesThePeg) {

@@ -340,6 +340,23 @@ TEST(ScenarioRun, AMovedPartArrivesOnceInTheFrameItGetsThere) {
   EXPECT_LE(logged[1].first, 0.5 + 3.0 / 90);
 }
 
+TEST(ScenarioRun, AMateNeverMadeSaysHowCloseItsPartCame) {
+  // The peg moved to 12 mm above its place in the hole and left there.
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(dir, "short.lua",
+                          moved_peg("    rule { when = after(0.1), act = { move(\"peg\", { 0, 62, "
+                                    "0 }, 0.2) } },",
+                                    "    mate_made \"peg_in_hole\","));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed) << o.error;
+  const std::string summary = o.failure_summary();
+  EXPECT_NE(summary.find("'peg' never snapped into 'block': the closest it came was 12 mm from its "
+                         "place, its axis 0 degrees off, at t=0.311 s (a snap needs 2 mm and 5 "
+                         "degrees, and the part released there)"),
+            std::string::npos)
+      << summary;
+}
+
 TEST(ScenarioRun, RegionsTimersAttachAndCompletedEventsAsDescribed) {
   const test::TempDir dir("dovetail_scenario");
   const auto file = write(dir, "words.lua", R"(return scenario {

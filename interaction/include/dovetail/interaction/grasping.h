@@ -25,6 +25,7 @@
 
 #include "dovetail/engine/simulation.h"
 #include "dovetail/interaction/hand.h"
+#include "dovetail/interaction/overlap.h"
 #include "dovetail/interaction/sliding.h"
 
 namespace dovetail::interaction {
@@ -104,6 +105,21 @@ bool within_tolerance(const Mate& mate, const Transform& X_WP, const Transform& 
 /// are opposite), then moved so the two feature points meet.
 Transform mate_pose(const Mate& mate, const Transform& X_WP, const Transform& X_WO);
 
+/// A released part that was within a mate's tolerances but was not snapped:
+/// in place it would overlap another part (a screw head in the way, a bore
+/// too small), which no real part can do.
+struct RefusedSnap {
+  std::string mate{};
+  std::string part{};     ///< the released part
+  std::string blocker{};  ///< the part it would overlap most deeply
+  Real depth_m = 0;       ///< how deep (OverlapGauge, as max_penetration measures)
+  Real time = 0;          ///< when it was released
+};
+
+/// A part in place may touch others; it is refused a snap only when it
+/// would overlap one deeper than this (metres).
+inline constexpr Real kSnapOverlap = 1e-6;
+
 /// What the interaction of one hand does, and its settings.
 struct InteractionSettings {
   GraspSettings grasp{};
@@ -149,6 +165,8 @@ class Grasping {
   /// The last sliding step of the part held.
   const SlideResult& last_slide() const { return last_slide_; }
   const InteractionStats& stats() const { return stats_; }
+  /// Every snap refused so far, in order.
+  const std::vector<RefusedSnap>& refused_snaps() const { return refused_snaps_; }
 
  private:
   struct Models;
@@ -163,6 +181,10 @@ class Grasping {
                    const Transform& X_WP_target);
   void release(engine::Simulation& simulation, const std::string& reason);
   void snap(engine::Simulation& simulation, const std::string& part);
+  /// The part other than `part` (and the parts attached to it) that `part`
+  /// at X_WP overlaps most deeply, and how deep; depth 0 when none.
+  std::pair<std::string, Real> deepest_overlap(const engine::Scene& scene, engine::PartId part,
+                                               const Transform& X_WP);
 
   engine::Simulation* simulation_;
   Hand* hand_;
@@ -189,6 +211,8 @@ class Grasping {
   SlideFronts fronts_;                         ///< of the held part, against each obstacle
   std::vector<engine::PartId> contact_parts_;  ///< the parts of last_slide_'s obstacle ids
   InteractionStats stats_{};
+  std::vector<RefusedSnap> refused_snaps_;
+  OverlapGauge overlap_;  ///< what a snap may not do
 };
 
 }  // namespace dovetail::interaction

@@ -1,0 +1,44 @@
+#pragma once
+/// \file overlap.h
+/// How deep two placed parts overlap: the measure of a scenario's
+/// `max_penetration` and of a mate's snap (a part is not snapped into a pose
+/// where it would overlap another).
+///
+/// Why one gauge: the two must agree on what "overlap" is. For two convex
+/// parts (closed, every triangle on the hull) it is exact: the penetration
+/// depth, the shortest move that parts them. For any other pair it is the
+/// collision layer's contact depth estimate (docs/proximity.md, "Depth
+/// estimate"): the deepest vertex of one part inside the other, measured to
+/// the other's surface, which misses parts that cross with no vertex inside.
+
+#include <map>
+#include <memory>
+
+#include "dovetail/collision/convex.h"
+#include "dovetail/collision/mesh.h"
+#include "dovetail/collision/model.h"
+#include "dovetail/collision/types.h"
+
+namespace dovetail::interaction {
+
+using collision::Real;
+using collision::Transform;
+
+/// Keeps each mesh's OBB tree and, for a convex part, its hull, built on
+/// first use. The meshes must outlive the gauge's use of them.
+class OverlapGauge {
+ public:
+  /// 0 when the parts are apart or only touch.
+  Real depth(const std::shared_ptr<const collision::Mesh>& a, const Transform& X_WA,
+             const std::shared_ptr<const collision::Mesh>& b, const Transform& X_WB);
+
+ private:
+  const collision::CollisionModel& model(const std::shared_ptr<const collision::Mesh>& mesh);
+  /// The hull of a convex part's mesh; null for a part that is not convex.
+  const collision::ConvexHull* convex_hull(const std::shared_ptr<const collision::Mesh>& mesh);
+
+  std::map<const collision::Mesh*, std::shared_ptr<const collision::CollisionModel>> models_;
+  std::map<const collision::Mesh*, std::shared_ptr<const collision::ConvexHull>> hulls_;
+};
+
+}  // namespace dovetail::interaction
