@@ -6,12 +6,13 @@
 #include <charconv>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string_view>
 #include <vector>
 
+#include "gltf_nodes.h"
 #include "obj_lines.h"
-
 namespace dovetail::engine::detail {
 
 namespace {
@@ -251,6 +252,19 @@ std::optional<std::string> check_binary_stl(std::string_view head, std::uintmax_
   return std::nullopt;
 }
 
+/// A node hierarchy deeper than kMaxNodeDepth (the importer's recursion
+/// would overflow the stack on some thousands of levels).
+std::optional<std::string> check_gltf_nodes(const std::filesystem::path& path, bool binary) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::optional<std::string_view> json = gltf_json(bytes, binary);
+  if (!json) return std::nullopt;
+  const std::optional<std::size_t> depth = gltf_node_depth(*json);
+  if (!depth || *depth <= kMaxNodeDepth) return std::nullopt;
+  return "its node hierarchy is " + std::to_string(*depth) + " levels deep; at most " +
+         std::to_string(kMaxNodeDepth) + " are read";
+}
+
 }  // namespace
 
 std::optional<std::string> check_declared_sizes(const std::filesystem::path& path,
@@ -270,6 +284,8 @@ std::optional<std::string> check_declared_sizes(const std::filesystem::path& pat
   }
   if (extension == ".stl") return check_binary_stl(head, file_size, limits);
   if (extension == ".obj") return check_obj_lines(path, limits);
+  if (extension == ".gltf" || extension == ".glb")
+    return check_gltf_nodes(path, extension == ".glb");
   return std::nullopt;
 }
 

@@ -926,11 +926,15 @@ std::shared_ptr<const collision::Mesh> Loader::read_shape(int index, const Sourc
     } else {
       mesh = collision::make_sphere(positive(get("diameter"), "diameter") / 2, 3);
     }
-  } catch (const std::invalid_argument& e) {
-    // The mesh maker's message, without its own function name.
+  } catch (const ScenarioError&) {
+    throw;
+  } catch (const std::exception& e) {
+    // The mesh maker's message (or the mesh check's), without its own name.
     std::string message = e.what();
-    if (message.rfind("make_", 0) == 0 && message.find(": ") != std::string::npos) {
-      message.erase(0, message.find(": ") + 2);
+    for (const char* own : {"make_", "generated "}) {
+      if (message.rfind(own, 0) == 0 && message.find(": ") != std::string::npos) {
+        message.erase(0, message.find(": ") + 2);
+      }
     }
     fail(where, word_name + ": " + message);
   }

@@ -121,6 +121,44 @@ TEST(MeshImport, OnlyTheFormatsDovetailNeedsAreRead) {
   EXPECT_EQ(import_mesh(dir / "TETRA.OBJ").triangle_count(), 4u);
 }
 
+/// glTF JSON of a chain of `levels` nodes, each the child of the one before.
+std::string node_chain(int levels) {
+  std::string json = R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [)";
+  for (int i = 0; i < levels; ++i) {
+    if (i > 0) json += ", ";
+    json += i + 1 < levels ? "{\"children\": [" + std::to_string(i + 1) + "]}" : "{}";
+  }
+  return json + "]}";
+}
+
+TEST(MeshImport, AGltfNodeHierarchyDeeperThanAThousandLevelsIsRefused) {
+  // 20,000 levels overflowed the importer's stack (a crash); glb and gltf alike.
+  const TempDir dir;
+  for (const int levels : {1001, 20000}) {
+    const std::string json = node_chain(levels);
+    write_file(dir / "deep.gltf", json);
+    EXPECT_NE(import_error(dir / "deep.gltf")
+                  .find("deep.gltf: its node hierarchy is " + std::to_string(levels) +
+                        " levels deep; at most 1000 are read"),
+              std::string::npos);
+    std::string glb = "glTF";
+    const auto u32 = [&](std::uint32_t v) {
+      for (int k = 0; k < 4; ++k) glb += static_cast<char>((v >> (8 * k)) & 0xff);
+    };
+    const std::string padded = json + std::string((4 - json.size() % 4) % 4, ' ');
+    u32(2);
+    u32(static_cast<std::uint32_t>(12 + 8 + padded.size()));
+    u32(static_cast<std::uint32_t>(padded.size()));
+    glb += "JSON" + padded;
+    write_file(dir / "deep.glb", glb);
+    EXPECT_NE(import_error(dir / "deep.glb").find("levels deep; at most 1000 are read"),
+              std::string::npos);
+  }
+  // 1000 levels pass this check (the importer then finds no mesh in them).
+  write_file(dir / "deep.gltf", node_chain(1000));
+  EXPECT_EQ(import_error(dir / "deep.gltf").find("levels deep"), std::string::npos);
+}
+
 TEST(MeshImport, GlbMergedEqualsItsParts) {
   const fs::path file = kModels / "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
   const ImportReport merged = import_file(file);

@@ -183,6 +183,21 @@ TEST(ScenarioLoad, ARuleThatCanNeverFireIsAWarning) {
       << s.warnings[0];
 }
 
+TEST(ScenarioLoad, AShapeTooLargeOrTooSmallIsNamedAtItsLine) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto shape = [&](const std::string& name, const std::string& text) {
+    return write(dir, name,
+                 "return scenario {\n  name = \"s\",\n  parts = {\n    a = part { shape = " + text +
+                     " },\n  },\n}\n");
+  };
+  EXPECT_EQ(load_error(shape("huge.lua", "box { size = { 1e308, 1, 1 } }")),
+            (dir / "huge.lua").string() +
+                ":4: box: vertex 0 has a coordinate beyond \xC2\xB1"
+                "1e+30");
+  EXPECT_EQ(load_error(shape("tiny.lua", "cylinder { diameter = 1e-300, length = 1e-300 }")),
+            (dir / "tiny.lua").string() + ":4: cylinder: all 256 triangles are degenerate");
+}
+
 TEST(ScenarioLoad, TheFileMustReturnAScenario) {
   const test::TempDir dir("dovetail_scenario");
   LuaHost host({}, 1);

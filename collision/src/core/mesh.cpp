@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -25,8 +26,9 @@ void check_vertices(const std::vector<Vec3>& vertices, const std::string& source
       const Real c = vertices[i][k];
       if (!std::isfinite(c)) fail(source, "vertex " + std::to_string(i) + " is not finite");
       if (std::abs(c) > limits.max_abs_coordinate) {
-        fail(source, "vertex " + std::to_string(i) + " has a coordinate beyond " +
-                         std::to_string(limits.max_abs_coordinate));
+        char bound[32];
+        std::snprintf(bound, sizeof bound, "%g", limits.max_abs_coordinate);
+        fail(source, "vertex " + std::to_string(i) + " has a coordinate beyond ±" + bound);
       }
     }
   }

@@ -1,0 +1,218 @@
+#include "gltf_nodes.h"
+
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+namespace dovetail::engine::detail {
+
+namespace {
+
+/// JSON nested deeper than this is not read (glTF's own nesting is a few levels).
+constexpr int kMaxJsonNesting = 256;
+
+/// Reads just enough of glTF JSON to find every node's children. Any
+/// malformed input makes ok() false; nothing is thrown.
+class NodeReader {
+ public:
+  explicit NodeReader(std::string_view text) : s_(text) {}
+
+  bool ok() const { return ok_; }
+  const std::vector<std::vector<std::uint64_t>>& children() const { return children_; }
+
+  /// The top-level object, its "nodes" array read, everything else skipped.
+  void read() {
+    object([&](std::string_view key) {
+      if (key == "nodes") {
+        nodes();
+      } else {
+        skip(1);
+      }
+    });
+    space();
+    if (i_ != s_.size()) ok_ = false;
+  }
+
+ private:
+  void space() {
+    while (i_ < s_.size() && (s_[i_] == ' ' || s_[i_] == '\t' || s_[i_] == '\n' || s_[i_] == '\r'))
+      ++i_;
+  }
+  bool take(char c) {
+    space();
+    if (i_ < s_.size() && s_[i_] == c) {
+      ++i_;
+      return true;
+    }
+    return false;
+  }
+  bool at(char c) {
+    space();
+    return i_ < s_.size() && s_[i_] == c;
+  }
+
+  /// A string's raw text between its quotes (escapes left as written).
+  std::string_view string() {
+    if (!take('"')) {
+      ok_ = false;
+      return {};
+    }
+    const std::size_t begin = i_;
+    while (i_ < s_.size() && s_[i_] != '"') i_ += s_[i_] == '\\' ? 2 : 1;
+    if (i_ >= s_.size()) {
+      ok_ = false;
+      return {};
+    }
+    return s_.substr(begin, i_++ - begin);
+  }
+
+  /// An object, calling member(key) with the position at its value.
+  template <typename Member>
+  void object(Member&& member) {
+    if (!take('{')) {
+      ok_ = false;
+      return;
+    }
+    if (take('}')) return;
+    while (ok_) {
+      const std::string_view key = string();
+      if (!ok_ || !take(':')) {
+        ok_ = false;
+        return;
+      }
+      member(key);
+      if (take(',')) continue;
+      if (!take('}')) ok_ = false;
+      return;
+    }
+  }
+
+  /// An array, calling element() with the position at each element.
+  template <typename Element>
+  void array(Element&& element) {
+    if (!take('[')) {
+      ok_ = false;
+      return;
+    }
+    if (take(']')) return;
+    while (ok_) {
+      element();
+      if (take(',')) continue;
+      if (!take(']')) ok_ = false;
+      return;
+    }
+  }
+
+  void nodes() {
+    array([&] {
+      std::vector<std::uint64_t>& kids = children_.emplace_back();
+      if (!at('{')) {
+        skip(2);
+        return;
+      }
+      object([&](std::string_view key) {
+        if (key != "children") {
+          skip(3);
+          return;
+        }
+        array([&] { kids.push_back(index()); });
+      });
+    });
+  }
+
+  std::uint64_t index() {
+    space();
+    std::uint64_t value = 0;
+    const std::size_t begin = i_;
+    while (i_ < s_.size() && s_[i_] >= '0' && s_[i_] <= '9' && value < (std::uint64_t{1} << 40)) {
+      value = value * 10 + static_cast<std::uint64_t>(s_[i_++] - '0');
+    }
+    if (i_ == begin) ok_ = false;
+    return value;
+  }
+
+  /// Any value, nested at most kMaxJsonNesting deep.
+  void skip(int depth) {
+    if (depth > kMaxJsonNesting) {
+      ok_ = false;
+      return;
+    }
+    space();
+    if (i_ >= s_.size()) {
+      ok_ = false;
+    } else if (s_[i_] == '{') {
+      object([&](std::string_view) { skip(depth + 1); });
+    } else if (s_[i_] == '[') {
+      array([&] { skip(depth + 1); });
+    } else if (s_[i_] == '"') {
+      string();
+    } else {
+      // A number or a literal: up to the next delimiter.
+      const std::size_t begin = i_;
+      while (i_ < s_.size() && std::strchr(",]} \t\r\n", s_[i_]) == nullptr) ++i_;
+      if (i_ == begin) ok_ = false;
+    }
+  }
+
+  std::string_view s_;
+  std::size_t i_ = 0;
+  bool ok_ = true;
+  std::vector<std::vector<std::uint64_t>> children_;
+};
+
+std::uint32_t little_u32(std::string_view bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(bytes[at + k]);
+  return v;
+}
+
+}  // namespace
+
+std::optional<std::string_view> gltf_json(std::string_view bytes, bool binary) {
+  if (!binary) return bytes;
+  // GLB: "glTF", version, length; then the first chunk: length, "JSON", data.
+  if (bytes.size() < 20 || bytes.substr(0, 4) != "glTF" || bytes.substr(16, 4) != "JSON") {
+    return std::nullopt;
+  }
+  const std::uint32_t length = little_u32(bytes, 12);
+  if (length > bytes.size() - 20) return std::nullopt;
+  return bytes.substr(20, length);
+}
+
+std::optional<std::size_t> gltf_node_depth(std::string_view json) {
+  NodeReader reader(json);
+  reader.read();
+  if (!reader.ok()) return std::nullopt;
+  const auto& children = reader.children();
+  const std::size_t n = children.size();
+  // depth[v] once known; a stack of (node, next child) walks each node once.
+  constexpr std::size_t kUnknown = 0, kOnPath = SIZE_MAX;
+  std::vector<std::size_t> depth(n, kUnknown);
+  std::size_t deepest = 0;
+  for (std::size_t root = 0; root < n; ++root) {
+    if (depth[root] != kUnknown) continue;
+    std::vector<std::pair<std::size_t, std::size_t>> path{{root, 0}};
+    depth[root] = kOnPath;
+    while (!path.empty()) {
+      auto& [node, next] = path.back();
+      if (next < children[node].size()) {
+        const std::uint64_t child = children[node][next++];
+        if (child >= n) return std::nullopt;
+        if (depth[child] == kOnPath) return std::nullopt;  // a cycle
+        if (depth[child] == kUnknown) {
+          depth[child] = kOnPath;
+          path.emplace_back(child, 0);
+        }
+        continue;
+      }
+      std::size_t d = 1;
+      for (const std::uint64_t child : children[node]) d = std::max(d, depth[child] + 1);
+      depth[node] = d;
+      deepest = std::max(deepest, d);
+      path.pop_back();
+    }
+  }
+  return deepest;
+}
+
+}  // namespace dovetail::engine::detail

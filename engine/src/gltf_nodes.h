@@ -1,0 +1,30 @@
+#pragma once
+/// \file gltf_nodes.h
+/// The depth of a glTF file's node hierarchy, read before the importer.
+///
+/// Why: the importer walks the hierarchy recursively, one stack frame per
+/// level, and a file of a few hundred kilobytes chaining 20,000 nodes
+/// overflows the stack (a crash, not an error). Real assemblies are a few
+/// dozen levels deep; a file deeper than the limit is refused with a message.
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace dovetail::engine::detail {
+
+/// The deepest node hierarchy Dovetail reads.
+inline constexpr std::size_t kMaxNodeDepth = 1000;
+
+/// The JSON of a .gltf file, or of a .glb file's first (JSON) chunk;
+/// nullopt when `bytes` is neither (the importer decides then).
+std::optional<std::string_view> gltf_json(std::string_view bytes, bool binary);
+
+/// The levels of the deepest chain of nodes ("nodes" and their "children")
+/// in glTF JSON, counting a node without children as one; nullopt when the
+/// JSON cannot be read this way or the children form a cycle (the importer
+/// names those).
+std::optional<std::size_t> gltf_node_depth(std::string_view json);
+
+}  // namespace dovetail::engine::detail
