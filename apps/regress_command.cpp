@@ -593,6 +593,18 @@ void check_summaries(const std::optional<std::string>& junit,
   if (junit && html && engine::same_file(*junit, *html)) {
     throw UsageError("regress: --junit and --html name the same file '" + *junit + "'");
   }
+  // Nor a scenario's own output: its report, its log or a frame in its folder.
+  for (const auto& [option, summary] : {std::pair{"junit", junit}, std::pair{"html", html}}) {
+    if (!summary) continue;
+    for (const std::filesystem::path& f : files) {
+      const std::string stem = f.stem().string();
+      if (engine::same_file(*summary, out / (stem + ".json")) ||
+          engine::same_file(*summary, out / (stem + ".log")) || inside(out / stem, *summary)) {
+        throw UsageError(std::string("regress: --") + option + " '" + *summary +
+                         "' is an output of " + f.string() + " in " + out.string());
+      }
+    }
+  }
 }
 
 }  // namespace

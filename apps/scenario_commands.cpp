@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -181,23 +182,49 @@ int exit_code(scripting::RunOutcome::Status status) {
   return kExitInputError;
 }
 
-/// The report and the recording, before the run: neither an input nor each
-/// other (usage errors), both writable (input error). Files the scenario
-/// itself reads are refused by the run (RunOptions::outputs).
+/// Whether `file` is one the run writes into `folder`: with `--render`,
+/// final.png and frame_NNNNNN.png; with `--capture`, NAME-HASH.capture.
+bool written_into(const std::filesystem::path& folder, const std::filesystem::path& file,
+                  bool render) {
+  const std::filesystem::path parent = file.has_parent_path() ? file.parent_path() : ".";
+  if (!engine::same_file(parent, folder)) return false;
+  const std::string name = file.filename().string();
+  if (!render) return name.ends_with(".capture");
+  static const std::regex frame("frame_[0-9]{6,}\\.png");
+  return name == "final.png" || std::regex_match(name, frame);
+}
+
+/// The report and the recording, before the run and before its folders
+/// are made: neither an input nor each other, nor the --render or
+/// --capture folder or a file the run writes there (usage errors). Files
+/// the scenario itself reads are refused by the run (RunOptions::outputs).
 void check_outputs(const Args& args, const std::filesystem::path& scenario,
-                   const scripting::RunOptions& options) {
+                   const std::optional<std::filesystem::path>& trace) {
   std::vector<std::string> inputs = {scenario.string()};
-  if (options.trace) inputs.push_back(options.trace->string());
+  if (trace) inputs.push_back(trace->string());
   const std::optional<std::string> report = args.value("report");
   const std::optional<std::string> record = args.value("record");
-  for (const std::optional<std::string>& out : {report, record}) {
+  const std::optional<std::string> render = args.value("render");
+  const std::optional<std::string> capture = args.value("capture");
+  const std::string& command = args.command();
+  for (const auto& [option, out] : {std::pair{"report", report}, std::pair{"record", record}}) {
     if (!out) continue;
-    refuse_overwriting_input(args.command(), *out, inputs);
-    check_writable(*out);
+    for (const auto& [folder_option, folder] :
+         {std::pair{"render", render}, std::pair{"capture", capture}}) {
+      if (!folder) continue;
+      if (engine::same_file(*out, *folder)) {
+        throw UsageError(command + ": --" + option + " and --" + folder_option +
+                         " name the same path '" + *out + "'");
+      }
+      if (written_into(*folder, *out, std::string_view(folder_option) == "render")) {
+        throw UsageError(command + ": --" + option + " '" + *out + "' is a file that --" +
+                         folder_option + " " + *folder + " writes");
+      }
+    }
+    refuse_overwriting_input(command, *out, inputs);
   }
   if (report && record && engine::same_file(*report, *record)) {
-    throw UsageError(args.command() + ": --report and --record name the same file '" + *report +
-                     "'");
+    throw UsageError(command + ": --report and --record name the same file '" + *report + "'");
   }
 }
 
@@ -205,8 +232,12 @@ int run_scenario_command(const Args& args, const std::filesystem::path& scenario
                          std::optional<std::filesystem::path> trace) {
   // A missing scenario or trace is the run's error, like any other: the
   // report is written with it.
+  check_outputs(args, scenario, trace);
   scripting::RunOptions options = run_options(args, std::move(trace));
-  check_outputs(args, scenario, options);
+  // Writable once the folders are made: a report may go into --render's.
+  for (const char* option : {"report", "record"}) {
+    if (const std::optional<std::string> out = args.value(option)) check_writable(*out);
+  }
   if (auto path = args.value("report")) options.outputs.emplace_back(*path);
   const scripting::RunOutcome outcome = scripting::run_scenario(scenario, options);
   if (auto path = args.value("report"); path && !outcome.outputs_refused) {

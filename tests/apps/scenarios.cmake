@@ -154,6 +154,21 @@ dovetail_cli_test(run_record_is_plan EXIT 1
                        --record ${out}/alias/plan_alias/hand.plan --report ${out}/alias/kept.json
                   STDERR "hand.plan', which the run reads; it would be overwritten"
                   KEEP ${out}/alias/kept.json)
+# Nor a folder or a file the run writes: --render's final.png and frames,
+# the --render folder itself; refused before the folder is made.
+dovetail_cli_test(run_report_is_final_frame EXIT 2
+                  ARGS run ${out}/alias/well_behaved.lua --render ${out}/alias/frames
+                       --report ${out}/alias/frames/final.png
+                  STDERR "--report '.*frames/final.png' is a file that --render .*frames writes")
+dovetail_cli_test(run_record_is_a_frame EXIT 2
+                  ARGS run ${out}/alias/well_behaved.lua --render ${out}/alias/frames --every 10
+                       --record ${out}/alias/frames/frame_000010.png
+                  STDERR "--record '.*frame_000010.png' is a file that --render")
+dovetail_cli_test(run_report_is_render_folder EXIT 2
+                  ARGS run ${out}/alias/well_behaved.lua --render ${out}/alias/same.json
+                       --report ${out}/alias/same.json
+                  STDERR "--report and --render name the same path"
+                  REMOVE ${out}/alias/same.json)
 # The report is not written over a mesh the scenario names, even when the
 # scenario fails to load, and even when the mesh cannot be read.
 file(COPY ${scenario_data}/invalid/mesh_then_error.lua ${data}/cube.obj DESTINATION ${out}/mesh_alias)
@@ -194,6 +209,15 @@ file(COPY ${out}/regress_clash/a.lua DESTINATION ${out}/regress_clash/more)
 file(RENAME ${out}/regress_clash/more/a.lua ${out}/regress_clash/a.log.lua)
 dovetail_cli_test(regress_output_names_clash EXIT 1 ARGS regress ${out}/regress_clash --out ${out}/regress_clash_out
                   STDERR "a.log.lua and .*a.lua would both write OUT/a.log; rename one of them")
+# A summary is not written over a scenario's report, log or frames.
+dovetail_cli_test(regress_junit_is_a_report EXIT 2
+                  ARGS regress ${out}/regress_clash --out ${out}/regress_summary_out
+                       --junit ${out}/regress_summary_out/a.json
+                  STDERR "--junit '.*regress_summary_out/a.json' is an output of .*a.lua in")
+dovetail_cli_test(regress_html_is_a_log EXIT 2
+                  ARGS regress ${out}/regress_clash --out ${out}/regress_summary_out
+                       --html ${out}/regress_summary_out/a.log
+                  STDERR "--html '.*a.log' is an output of")
 # A folder whose name starts with '-', a link to a missing scenario (named, not
 # skipped), and a report that is UTF-8 whatever bytes the scenario's error holds.
 file(WRITE ${out}/regress_odd/-dash/ok.lua "return scenario { name = \"ok\", duration = 0.1, parts = { b = part { shape = box { size = { 1, 1, 1 } } } } }\n")
