@@ -655,6 +655,9 @@ class Loader {
     std::vector<lua_Integer> positions;
     keys_of(map, names, positions, where, field);
     if (!positions.empty()) fail(where, field + ": every " + noun + " needs a name: " + example);
+    for (const std::string& name : names) {
+      if (name.empty()) fail(where, field + ": a " + noun + "'s name may not be empty: " + example);
+    }
     return names;
   }
 
@@ -808,6 +811,10 @@ void Loader::read_scenario_fields(int table, const SourceLocation& where) {
     lua_pop(L_, 1);
     if (!((camera.eye - camera.target).norm() > 0))
       fail(where, "scenario: camera 'from' and 'to' are the same point");
+    // Straight down (or up) the y axis, up on the picture is -z, as for
+    // `render --camera top`: y, the usual up, is along the view.
+    const Vec3 view = (camera.target - camera.eye).normalized();
+    if (view.cross(camera.up).norm() <= 1e-9) camera.up = -Vec3::UnitZ();
     scenario_.camera = camera;
   });
 }

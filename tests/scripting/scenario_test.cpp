@@ -198,6 +198,25 @@ TEST(ScenarioLoad, AShapeTooLargeOrTooSmallIsNamedAtItsLine) {
             (dir / "tiny.lua").string() + ":4: cylinder: all 256 triangles are degenerate");
 }
 
+TEST(ScenarioLoad, AnEmptyPartNameIsNamedAndACameraStraightDownHasAnUp) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto empty = write(dir, "empty.lua",
+                           "return scenario {\n  name = \"s\",\n  parts = {\n    [\"\"] = part { "
+                           "shape = box { size = { 1, 1, 1 } } },\n  },\n}\n");
+  EXPECT_NE(load_error(empty).find("empty.lua:1: parts: a part's name may not be empty"),
+            std::string::npos);
+  // Looking down the y axis, the default up (y) is along the view: -z is up
+  // on the picture, as for `render --camera top`.
+  const auto down = write(dir, "down.lua",
+                          "return scenario {\n  name = \"s\",\n  parts = {\n    a = part { shape = "
+                          "box { size = { 1, 1, 1 } } },\n  },\n  camera = { from = { 0, 100, 0 }, "
+                          "to = { 0, 0, 0 } },\n}\n");
+  LuaHost host({}, 1);
+  const Scenario s = load_scenario(host, down);
+  ASSERT_TRUE(s.camera.has_value());
+  EXPECT_EQ(s.camera->up, -collision::Vec3::UnitZ());
+}
+
 TEST(ScenarioLoad, TheFileMustReturnAScenario) {
   const test::TempDir dir("dovetail_scenario");
   LuaHost host({}, 1);
