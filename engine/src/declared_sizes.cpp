@@ -113,14 +113,64 @@ std::string beyond_file(std::string_view format, long double needed, std::uintma
 /// PLY headers are checked strictly: importers are fragile on malformed ones
 /// (missing end_header, unknown types, malformed element or property lines),
 /// so these are refused here with the offending line.
-std::optional<std::string> check_ply(std::string_view head, std::uintmax_t file_size,
-                                     const collision::MeshLimits& limits) {
-  struct Element {
-    std::string name;
-    Count count;
-    std::size_t binary_bytes = 0;  // fixed bytes per element in binary formats
-    std::size_t properties = 0;
+/// One element of a PLY header.
+struct PlyElement {
+  std::string name;
+  Count count;
+  std::size_t binary_bytes = 0;  // fixed bytes per element in binary formats
+  std::size_t properties = 0;
+  bool lists = false;  // has a list property
+};
+
+/// An ASCII PLY body line by line: each element's entries one a line, in
+/// header order, with as many values as its properties (a list: its count,
+/// then that many values), and nothing after them. The importer reads a
+/// body that ends early or lists too few values without a word, taking the
+/// next line's values for the missing ones.
+std::optional<std::string> check_ascii_ply_body(const std::filesystem::path& path,
+                                                std::size_t header_lines,
+                                                const std::vector<PlyElement>& elements) {
+  std::ifstream in(path, std::ios::binary);
+  std::string text;
+  std::size_t line = 0;
+  for (; line < header_lines && std::getline(in, text); ++line) {
+  }
+  const auto next = [&]() -> std::optional<std::vector<std::string_view>> {
+    while (std::getline(in, text)) {
+      ++line;
+      std::vector<std::string_view> w = split_words(text);
+      if (!w.empty()) return w;
+    }
+    return std::nullopt;
   };
+  for (const PlyElement& e : elements) {
+    for (std::uint64_t k = 0; k < e.count.value; ++k) {
+      const auto w = next();
+      if (!w) {
+        return "PLY ends after " + std::to_string(k) + " of the " + std::to_string(e.count.value) +
+               " " + e.name + " lines its header declares; truncated";
+      }
+      if (e.lists && e.properties == 1) {  // a face: its corner count, then the corners
+        const Count n = parse_count((*w)[0]);
+        if (!n.valid || n.value + 1 != w->size()) {
+          return "PLY line " + std::to_string(line) + ": a " + e.name + " line gives " +
+                 std::string((*w)[0]) + " as its count of values and lists " +
+                 std::to_string(w->size() - 1);
+        }
+      } else if (!e.lists && w->size() != e.properties) {
+        return "PLY line " + std::to_string(line) + ": a " + e.name + " has " +
+               std::to_string(e.properties) + " values, this line " + std::to_string(w->size());
+      }
+    }
+  }
+  if (next()) return "PLY line " + std::to_string(line) + ": more lines than the header declares";
+  return std::nullopt;
+}
+
+std::optional<std::string> check_ply(const std::filesystem::path& path, std::string_view head,
+                                     std::uintmax_t file_size,
+                                     const collision::MeshLimits& limits) {
+  using Element = PlyElement;
   std::vector<Element> elements;
   bool binary = false;
   bool has_format = false;
@@ -174,6 +224,7 @@ std::optional<std::string> check_ply(std::string_view head, std::uintmax_t file_
         }
         if (ply_type_size(w[3]) == 0) return bad("unknown type '" + std::string(w[3]) + "'");
         e.binary_bytes += count_size;
+        e.lists = true;
       } else {
         if (w.size() != 3) return bad("a property needs a type and a name");
         const std::size_t size = ply_type_size(w[1]);
@@ -212,6 +263,7 @@ std::optional<std::string> check_ply(std::string_view head, std::uintmax_t file_
   }
   if (!binary && needed > 0) needed -= 1;  // the last value may end the file without separator
   if (needed > static_cast<long double>(available)) return beyond_file("PLY", needed, available);
+  if (!binary) return check_ascii_ply_body(path, line, elements);
   return std::nullopt;
 }
 
@@ -280,7 +332,7 @@ std::optional<std::string> check_declared_sizes(const std::filesystem::path& pat
     if (head.size() < 4 || (head[3] != '\n' && head[3] != '\r')) {
       return std::string("PLY header line 1: expected 'ply' alone on the line");
     }
-    return check_ply(head, file_size, limits);
+    return check_ply(path, head, file_size, limits);
   }
   if (extension == ".stl") return check_binary_stl(head, file_size, limits);
   if (extension == ".obj") return check_obj_lines(path, limits);

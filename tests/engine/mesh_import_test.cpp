@@ -159,6 +159,35 @@ TEST(MeshImport, AGltfNodeHierarchyDeeperThanAThousandLevelsIsRefused) {
   EXPECT_EQ(import_error(dir / "deep.gltf").find("levels deep"), std::string::npos);
 }
 
+TEST(MeshImport, AnAsciiPlyBodyMustMatchItsHeader) {
+  // The reader took a missing face as none, a face line as a vertex, and a
+  // face count of 255 with three corners; each is named now.
+  const TempDir dir;
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string vertices = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
+  const auto error_of = [&](const std::string& body) {
+    write_file(dir / "m.ply", header + body);
+    return import_error(dir / "m.ply");
+  };
+  EXPECT_NE(error_of(vertices + "3 0 1 2\n")
+                .find("m.ply: PLY ends after 1 of the 2 face lines its header declares; truncated"),
+            std::string::npos);
+  EXPECT_NE(error_of("0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 3\n")
+                .find("PLY line 13: a vertex has 3 values, this line 4"),
+            std::string::npos);
+  EXPECT_NE(error_of(vertices + "255 0 1 2\n3 0 2 3\n")
+                .find("PLY line 14: a face line gives 255 as its count of values and lists 3"),
+            std::string::npos);
+  EXPECT_NE(error_of(vertices + "3 0 1 2\n3 0 2 3\n3 1 2 3\n")
+                .find("PLY line 16: more lines than the header declares"),
+            std::string::npos);
+  // Blank lines and CRLF line ends are read.
+  write_file(dir / "ok.ply", header + vertices + "\n3 0 1 2\r\n3 0 2 3\r\n");
+  EXPECT_EQ(total_triangles(import_file(dir / "ok.ply")), 2u);
+}
+
 TEST(MeshImport, GlbMergedEqualsItsParts) {
   const fs::path file = kModels / "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
   const ImportReport merged = import_file(file);
