@@ -115,19 +115,45 @@ void count_hook(lua_State* L, lua_Debug* ar) {
   if (host.exhausted) raise_exhausted(L);
 }
 
+/// Whether an error message starts with a position, "chunk:line: ".
+bool has_position(std::string_view text) {
+  const std::size_t end = text.find(": ");
+  if (end == std::string_view::npos || end == 0) return false;
+  const std::size_t colon = text.rfind(':', end - 1);
+  if (colon == std::string_view::npos || colon + 1 == end) return false;
+  for (std::size_t i = colon + 1; i < end; ++i) {
+    if (text[i] < '0' || text[i] > '9') return false;
+  }
+  return text.find('\n') > end;
+}
+
 // The message handler of every host call: the error message (or the
 // exhausted limit's) followed by a traceback.
 int message_handler(lua_State* L) {
   HostState& host = host_of(L);
   if (limit_exhausted(host, L)) {
     lua_pushstring(L, host.exhausted_message);
-  } else if (lua_type(L, 1) == LUA_TSTRING || lua_type(L, 1) == LUA_TNUMBER) {
-    lua_pushvalue(L, 1);
-  } else if (luaL_callmeta(L, 1, "__tostring") == 0 || lua_type(L, -1) != LUA_TSTRING) {
-    // error(nil) or error({}): Lua adds no position, so say where it was raised.
-    char where[sizeof(host.where)];
-    write_where(L, 1, where, sizeof(where));
-    lua_pushfstring(L, "%s(error object is a %s value)", where, luaL_typename(L, 1));
+  } else {
+    const bool text = lua_type(L, 1) == LUA_TSTRING || lua_type(L, 1) == LUA_TNUMBER;
+    if (text) {
+      lua_pushvalue(L, 1);
+    } else if (luaL_callmeta(L, 1, "__tostring") == 0 || lua_type(L, -1) != LUA_TSTRING) {
+      // error(nil) or error({}): say what was raised.
+      lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
+    }
+    // Lua adds no position to error(text, 0), to error(text, 2) in a
+    // function the host called, to an error raised by a library function
+    // (coroutine.yield outside a coroutine) or to an object: say where it
+    // was raised.
+    std::size_t length = 0;
+    const char* message = lua_tolstring(L, -1, &length);
+    if (!has_position(std::string_view(message, length))) {
+      char where[sizeof(host.where)];
+      write_where(L, 1, where, sizeof(where));
+      lua_pushstring(L, where);
+      lua_insert(L, -2);
+      lua_concat(L, 2);
+    }
   }
   luaL_traceback(L, L, lua_tostring(L, -1), 1);
   return 1;

@@ -1140,7 +1140,7 @@ std::string RunOutcome::failure_summary() const {
       out += m.where.str() + ": at t=" + format_time(m.time) + " s: " + m.text + "\n";
   }
   // A script's text never drives the terminal.
-  return engine::escape_control_bytes(out, "\n");
+  return engine::escape_control_bytes(out, "\n\t");
 }
 
 RunOutcome run_scenario(const std::filesystem::path& file, const RunOptions& options) {

@@ -527,9 +527,16 @@ TEST(LuaHostErrors, ErrorObjectsThatAreNotStrings) {
                       "error(setmetatable({}, {__tostring = function() return 'custom' "
                       "end}))")
                 .message(),
-            "custom");
-  EXPECT_EQ(run_error(host, "error('plain', 0)").message(), "plain");
-  EXPECT_EQ(run_error(host, "error(42)").message(), "42");
+            "script.lua:1: custom");
+  // Nor to a text raised without one: at level 0, at a level above the
+  // script, or by a library function.
+  EXPECT_EQ(run_error(host, "\nerror('plain', 0)").message(), "script.lua:2: plain");
+  EXPECT_EQ(run_error(host, "local function f() error('up', 2) end\nf()").message(),
+            "script.lua:2: up");
+  EXPECT_EQ(run_error(host, "error('outside', 2)").message(), "script.lua:1: outside");
+  EXPECT_EQ(run_error(host, "error(42)").message(), "script.lua:1: 42");
+  EXPECT_EQ(run_error(host, "coroutine.yield()").message(),
+            "script.lua:1: attempt to yield from outside a coroutine");
 }
 
 TEST(LuaHostErrors, ErrorInsideWrappedCoroutineKeepsBothPositions) {
