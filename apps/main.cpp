@@ -3,6 +3,7 @@
 /// into a message on stderr and an exit code, never an uncaught exception.
 
 #include <cstdio>
+#include <filesystem>
 #include <new>
 #include <span>
 #include <string>
@@ -130,6 +131,10 @@ int main(int argc, char** argv) {
     code = report(e.what(), kExitInputError);
   } catch (const dovetail::collision::MeshError& e) {
     code = report(e.what(), kExitInputError);
+  } catch (const std::filesystem::filesystem_error& e) {
+    // "PATH: File name too long", not the library's "filesystem error: status: ...".
+    const std::string path = e.path1().empty() ? std::string() : e.path1().string() + ": ";
+    code = report(path + e.code().message(), kExitInputError);
   } catch (const std::bad_alloc&) {
     code = report("out of memory", kExitInputError);
   } catch (const std::exception& e) {

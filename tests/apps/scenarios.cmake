@@ -50,6 +50,10 @@ dovetail_cli_test(check_missing EXIT 1 ARGS check ${out}/no_such.lua STDERR "no_
 dovetail_cli_test(new_scenario EXIT 0 ARGS new my_first --out ${out}/my_first.lua
                   STDOUT "wrote .*my_first.lua" REMOVE ${out}/my_first.lua)
 set_tests_properties(cli.new_scenario PROPERTIES FIXTURES_SETUP new_scenario)
+dovetail_cli_test(new_folder_name EXIT 2 ARGS new ${out}/a_folder/ STDERR "new: the name .*a_folder/. names no file")
+string(REPEAT "x" 300 long_name)
+dovetail_cli_test(new_name_too_long EXIT 1 ARGS new ${out}/${long_name}
+                  STDERR "^dovetail: .*xxx.lua: File name too long\n$")
 dovetail_cli_test(new_scenario_checks EXIT 0 ARGS check ${out}/my_first.lua STDOUT "ok: 'my_first'")
 dovetail_cli_test(new_scenario_runs EXIT 0 ARGS run ${out}/my_first.lua STDOUT "my_first: passed")
 dovetail_cli_test(new_refuses_to_overwrite EXIT 1 ARGS new x --out ${scenarios}/01_peg_in_hole.lua
