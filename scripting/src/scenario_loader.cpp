@@ -136,10 +136,24 @@ const std::map<std::string, std::array<float, 3>, std::less<>>& color_names() {
 }
 
 /// A call of an unknown global that is nearly a word of the vocabulary
-/// (`touchs(...)`) gets the word suggested after Lua's own message.
+/// (`touchs(...)`) gets the word suggested after Lua's own message, and a
+/// table whose fields lack a comma the question whether one is missing.
 ScriptError with_word_suggested(const ScriptError& e) {
   constexpr std::string_view kCall = "attempt to call a nil value (global '";
   const std::string& first = e.message();
+  const auto with_hint = [&](const std::string& hint) {
+    const std::string what = e.what();
+    const std::size_t end = what.find('\n');
+    return ScriptError(e.kind(), end == std::string::npos
+                                     ? what + hint
+                                     : what.substr(0, end) + hint + what.substr(end));
+  };
+  // A table's fields run on without a comma: Lua stops at the next field,
+  // on the line after the one that lacks it.
+  if (e.kind() == ScriptError::Kind::kSyntax && first.find("'}' expected") != std::string::npos &&
+      first.find(" near ") != std::string::npos) {
+    return with_hint(" (is a comma missing at the end of the field before?)");
+  }
   const std::size_t at = first.find(kCall);
   if (at == std::string::npos) return e;
   const std::size_t from = at + kCall.size();
@@ -149,11 +163,7 @@ ScriptError with_word_suggested(const ScriptError& e) {
   for (const Word& w : vocabulary()) words.emplace_back(w.name);
   const std::string hint = did_you_mean(first.substr(from, to - from), words);
   if (hint.empty()) return e;
-  const std::string what = e.what();
-  const std::size_t end = what.find('\n');
-  return ScriptError(e.kind(), end == std::string::npos
-                                   ? what + hint
-                                   : what.substr(0, end) + hint + what.substr(end));
+  return with_hint(hint);
 }
 
 class Loader {
@@ -355,7 +365,13 @@ class Loader {
       if (it == color_names().end()) {
         std::vector<std::string> names;
         for (const auto& [name, rgb] : color_names()) names.push_back(name);
-        fail(where, what + ": unknown colour '" + s + "'" + did_you_mean(s, names));
+        std::string hint = did_you_mean(s, names);
+        if (hint.empty()) {
+          hint = " (a colour is one of";
+          for (const std::string& n : names) hint += (n == names.front() ? " " : ", ") + n;
+          hint += ", or {r, g, b} in [0, 1])";
+        }
+        fail(where, what + ": unknown colour '" + s + "'" + hint);
       }
       return it->second;
     }

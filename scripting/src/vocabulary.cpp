@@ -54,7 +54,9 @@ std::vector<Word> make_vocabulary() {
         {"at", kVector, kOptional, "position of the part's origin (default {0, 0, 0})"},
         {"turn", kTurn, kOptional, "orientation: degrees about x, then y, then z"},
         {"fixed", kFlag, kOptional, "true: the part never moves (default false)"},
-        {"color", kColor, kOptional, "display colour: a name or {r, g, b} in [0, 1]"},
+        {"color", kColor, kOptional,
+         "display colour: black, blue, brass, green, grey (or gray), orange, purple, red, "
+         "steel, white, yellow, or {r, g, b} in [0, 1]"},
         {"tags", kNames, kOptional, "free labels"}},
        "A part of the assembly: a generated shape or a mesh file, placed in the world.",
        "peg = part { shape = cylinder { diameter = 20, length = 60 }, at = { 0, 100, 0 } }"});

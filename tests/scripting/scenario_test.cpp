@@ -217,6 +217,26 @@ TEST(ScenarioLoad, AnEmptyPartNameIsNamedAndACameraStraightDownHasAnUp) {
   EXPECT_EQ(s.camera->up, -collision::Vec3::UnitZ());
 }
 
+TEST(ScenarioLoad, AMissingCommaAndAnUnknownColourGetAHint) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto comma = write(dir, "comma.lua",
+                           "return scenario {\n  name = \"s\",\n  parts = {\n"
+                           "    a = part { shape = box { size = { 1, 1, 1 } } }\n"
+                           "    b = part { shape = box { size = { 1, 1, 1 } } },\n  },\n}\n");
+  EXPECT_NE(load_error(comma).find("comma.lua:5: '}' expected (to close '{' at line 3) near 'b' "
+                                   "(is a comma missing at the end of the field before?)"),
+            std::string::npos);
+  const auto colour =
+      write(dir, "colour.lua",
+            "return scenario {\n  name = \"s\",\n  parts = {\n"
+            "    a = part { shape = box { size = { 1, 1, 1 } }, color = \"oak\" },\n"
+            "  },\n}\n");
+  EXPECT_NE(load_error(colour).find("unknown colour 'oak' (a colour is one of black, blue, brass, "
+                                    "gray, green, grey, orange, purple, red, steel, white, yellow, "
+                                    "or {r, g, b} in [0, 1])"),
+            std::string::npos);
+}
+
 TEST(ScenarioLoad, TheFileMustReturnAScenario) {
   const test::TempDir dir("dovetail_scenario");
   LuaHost host({}, 1);
