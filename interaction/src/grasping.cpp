@@ -445,7 +445,7 @@ Transform Grasping::guided(const engine::Scene& scene, const std::string& part,
                            const Transform& X_WP_target) {
   for (std::size_t m = 0; m < mates_.size(); ++m) {
     const Mate& mate = mates_[m];
-    if (mate.part != part) continue;
+    if (mate.part != part || !mate.guide) continue;
     const PartId o = scene.find(mate.other);
     if (!o.valid()) continue;
     const Transform X_WO = scene.world_pose(o);

@@ -992,6 +992,7 @@ void Loader::read_mates(int map, const SourceLocation& where) {
                              format_number(a.number));
       m.angle_tolerance_deg = a.number;
     }
+    if (const Arg a = field(t, word, "guide", spec.where, what); a.given) m.guide = a.number != 0;
     if (m.part == m.other) fail(spec.where, what + ": a part cannot mate with itself");
     lua_pop(L_, 2);
     scenario_.mates.push_back(std::move(spec));

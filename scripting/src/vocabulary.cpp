@@ -71,10 +71,14 @@ std::vector<Word> make_vocabulary() {
         {"along", kDirection, kRequired, "that part's feature axis, in its frame"},
         {"tolerance", kLength, kOptional, "position tolerance (default 2 mm)"},
         {"angle", kNumber, kOptional,
-         "angle tolerance in degrees, above 0 and at most 180 (default 5)"}},
+         "angle tolerance in degrees, above 0 and at most 180 (default 5)"},
+        {"guide", kFlag, kOptional,
+         "false: the carried part is not drawn onto the axis, so a misalignment stays as "
+         "it would without a chamfer (default true)"}},
        "A fit: released within the tolerances, the part snaps so its point and axis meet "
        "the other's, and `mated` fires, unless in place it would overlap another part (then a "
-       "warning names it). While carried near it, the part is drawn onto the axis.",
+       "warning names it). While carried near it, the part is drawn onto the axis (unless "
+       "guide = false).",
        "peg_in_hole = mate { part = \"peg\", point = { 0, 0, 60 }, axis = \"z\", into = "
        "\"block\", at = { 0, -10, 0 }, along = \"-y\" }"});
   w.push_back({"glove",

@@ -76,8 +76,8 @@ struct PegRun {
 /// The hand holds the peg from the start, carries it 90 mm down along the
 /// hole's axis (20 mm past the bottom) in 2 s, waits, and opens.
 PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool measure_depth = true,
-               int sides = 64, std::shared_ptr<const GloveSource> replay = nullptr,
-               Real pebble = 0) {
+               int sides = 64, std::shared_ptr<const GloveSource> replay = nullptr, Real pebble = 0,
+               bool guide = true) {
   const Transform X_WPeg0 = peg_start(offset, tilt_deg);
   engine::Simulation sim(
       peg_and_block(X_WPeg0, sides, pebble),
@@ -114,7 +114,8 @@ PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool mea
                      .axis_P = Vec3::UnitZ(),
                      .other = "block",
                      .p_OF = Vec3(0, kBlockTop - kHoleDepth, 0),
-                     .axis_O = -Vec3::UnitY()});
+                     .axis_O = -Vec3::UnitY(),
+                     .guide = guide});
   grasping.hold("peg", GraspType::kPower);
 
   const auto block = collision::build_model(collision::Method::kObb,
@@ -213,6 +214,16 @@ TEST(PegInHole, APegStoppedShortByAPebbleIsNotSnappedThroughIt) {
   EXPECT_GE(bottom.y(), kBlockTop - kHoleDepth + 0.0015);
   EXPECT_LT(bottom.y(), kBlockTop - kHoleDepth + 0.0015 + 1e-4);
   EXPECT_LT(run.max_depth, 1e-5);
+}
+
+TEST(PegInHole, WithoutGuidanceAPegOffTheAxisStaysOnTheRim) {
+  // The mate's guidance is what draws the peg 1.5 mm off the axis into the
+  // hole with 0.25 mm clearance; without it (a hole without a chamfer) the
+  // peg lands on the rim and is left behind, never pushed through.
+  const PegRun run = run_peg(0.0015, -2, false, 1, true, 64, nullptr, 0, /*guide=*/false);
+  EXPECT_FALSE(has(run.events, EventKind::kMate, "peg", "block"));
+  EXPECT_LT(run.max_depth, 1e-5);
+  EXPECT_GE(run.X_WPeg.apply(Vec3(0, 0, kPegLength)).y(), kBlockTop - 1e-3);
 }
 
 TEST(PegInHole, ACoarselyTessellatedHoleStillTakesThePeg) {

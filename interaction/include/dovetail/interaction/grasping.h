@@ -88,6 +88,9 @@ struct Mate {
   Vec3 axis_O = Vec3::UnitY();
   Real position_tolerance = 0.002;  ///< metres
   Real angle_tolerance_deg = 5;
+  /// Whether the carried part is drawn onto the axis (guidance); false keeps
+  /// its misalignment, as a fit without a chamfer would, and it only snaps.
+  bool guide = true;
 };
 
 /// How far a mate's part is from its place: the distance between the two
