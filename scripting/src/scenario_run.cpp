@@ -1036,6 +1036,12 @@ void Runner::run() {
     out_.error = e.what();
   }
   out_.report = sim_->report();
+  const engine::Scene& scene = sim_->scene();
+  for (const PartId p : scene.parts()) {
+    if (scene.has_tag(p, "hand")) continue;
+    const Transform X = scene.world_pose(p);
+    out_.final_poses.push_back({scene.name(p), X.t, engine::quaternion_from_rotation(X.R)});
+  }
   // An output that cannot be made is the run's error; the report still
   // holds everything simulated.
   const auto output = [&](const auto& make) {
@@ -1121,6 +1127,17 @@ std::string RunOutcome::to_json() const {
          ", \"time\": " + json_number(max_penetration_time) +
          ", \"a\": " + json_string(max_penetration_a) +
          ", \"b\": " + json_string(max_penetration_b) + "},\n";
+  out += "  \"final_poses\": [";
+  for (std::size_t i = 0; i < final_poses.size(); ++i) {
+    const PartPose& p = final_poses[i];
+    const collision::Vec3 at = p.position / metres_per_unit;
+    const engine::Quaternion& q = p.rotation;
+    out += (i ? ",\n    " : "\n    ") + std::string("{\"part\": ") + json_string(p.part) +
+           ", \"position\": [" + json_number(at.x()) + ", " + json_number(at.y()) + ", " +
+           json_number(at.z()) + "], \"rotation\": [" + json_number(q.w) + ", " + json_number(q.x) +
+           ", " + json_number(q.y) + ", " + json_number(q.z) + "]}";
+  }
+  out += final_poses.empty() ? "],\n" : "\n  ],\n";
   std::string simulation = report.to_json();
   while (!simulation.empty() && simulation.back() == '\n') simulation.pop_back();
   out += "  \"simulation\": " + simulation + "\n}\n";

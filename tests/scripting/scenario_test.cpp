@@ -398,6 +398,13 @@ TEST(ScenarioRun, AMovedPartArrivesOnceInTheFrameItGetsThere) {
   EXPECT_GE(logged[0].first, 0.3);
   EXPECT_LE(logged[0].first, 0.3 + 3.0 / 90);  // sent a frame after the rule fired
   EXPECT_EQ(logged[1].second, "180");
+  // The report gives where every part ended, in the scenario's units.
+  ASSERT_EQ(o.final_poses.size(), 3u);
+  EXPECT_EQ(o.final_poses[2].part, "peg");  // the parts' names in order
+  EXPECT_NEAR(o.final_poses[2].position.y(), 0.180, 1e-12);
+  EXPECT_NE(o.to_json().find("{\"part\": \"peg\", \"position\": [0, 180, 0], \"rotation\": ["),
+            std::string::npos)
+      << o.to_json();
   EXPECT_LE(logged[1].first, 0.5 + 3.0 / 90);
 }
 

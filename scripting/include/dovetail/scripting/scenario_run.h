@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "dovetail/collision/model.h"
+#include "dovetail/engine/pose_list.h"
 #include "dovetail/engine/report.h"
 #include "dovetail/scripting/lua_host.h"
 #include "dovetail/scripting/scenario.h"
@@ -94,6 +95,14 @@ struct RunOutcome {
   double max_penetration_time = 0;
   std::string max_penetration_a{}, max_penetration_b{};
   std::uint64_t rules_fired = 0;
+  /// Where every part ended (the hand's segments left out), in scene order:
+  /// its origin in metres and its rotation as a unit quaternion (w >= 0).
+  struct PartPose {
+    std::string part{};
+    collision::Vec3 position{collision::Vec3::Zero()};
+    engine::Quaternion rotation{};
+  };
+  std::vector<PartPose> final_poses{};
   double metres_per_unit = 0.001;
   std::string units = "mm";
   engine::Report report{};  ///< the simulation's report (timeline, contacts, state hash)
