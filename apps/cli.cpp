@@ -50,6 +50,8 @@ Args::Args(std::string command, std::span<const std::string> argv,
       throw UsageError(command_ + ": unknown option '" + arg + "'" + see_help(command_));
     }
     std::string name = arg.substr(short_option ? 1 : 2);
+    // The option as a message names it: -j for one letter, --name otherwise.
+    const auto spelled = [](const std::string& n) { return (n.size() == 1 ? "-" : "--") + n; };
     std::optional<std::string> inline_value;
     if (const std::size_t eq = name.find('='); eq != std::string::npos) {
       inline_value = name.substr(eq + 1);
@@ -57,19 +59,19 @@ Args::Args(std::string command, std::span<const std::string> argv,
     }
     if (flags.count(name) != 0) {
       if (inline_value) {
-        throw UsageError(command_ + ": option '--" + name + "' takes no value");
+        throw UsageError(command_ + ": option '" + spelled(name) + "' takes no value");
       }
       flags_set_.insert(name);
     } else if (value_options.count(name) != 0) {
       if (!inline_value) {
         if (i + 1 >= argv.size()) {
-          throw UsageError(command_ + ": option '--" + name + "' needs a value" +
+          throw UsageError(command_ + ": option '" + spelled(name) + "' needs a value" +
                            see_help(command_));
         }
         inline_value = argv[++i];
       }
       if (values_.count(name) != 0) {
-        throw UsageError(command_ + ": option '--" + name + "' given twice");
+        throw UsageError(command_ + ": option '" + spelled(name) + "' given twice");
       }
       values_[name] = *inline_value;
     } else {
@@ -299,6 +301,7 @@ std::vector<std::filesystem::path> scenario_files(const std::filesystem::path& f
 }
 
 void make_folder(const std::filesystem::path& folder) {
+  if (folder.empty()) throw UsageError("an output folder must be named: the path is empty");
   std::error_code ec;
   std::filesystem::create_directories(folder, ec);
   if (!std::filesystem::is_directory(folder, ec)) {

@@ -118,6 +118,7 @@ SourceLocation parse_where(const std::string& text, const std::string& fallback_
 }
 
 std::string format_number(double x) {
+  if (std::isnan(x)) return "nan (not a number, as 0/0 gives)";
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.10g", x);
   return buffer;

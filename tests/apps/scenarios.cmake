@@ -54,6 +54,8 @@ dovetail_cli_test(new_folder_name EXIT 2 ARGS new ${out}/a_folder/ STDERR "new: 
 string(REPEAT "x" 300 long_name)
 dovetail_cli_test(new_name_too_long EXIT 1 ARGS new ${out}/${long_name}
                   STDERR "^dovetail: .*xxx.lua: File name too long\n$")
+dovetail_cli_test(regress_short_option_twice EXIT 2 ARGS regress ${out} -j 2 -j 3
+                  STDERR "regress: option '-j' given twice")
 dovetail_cli_test(new_scenario_checks EXIT 0 ARGS check ${out}/my_first.lua STDOUT "ok: 'my_first'")
 dovetail_cli_test(new_scenario_runs EXIT 0 ARGS run ${out}/my_first.lua STDOUT "my_first: passed")
 dovetail_cli_test(new_refuses_to_overwrite EXIT 1 ARGS new x --out ${scenarios}/01_peg_in_hole.lua
