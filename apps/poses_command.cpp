@@ -96,6 +96,16 @@ int poses_command(std::span<const std::string> argv) {
   const std::vector<collision::SampledPose> poses =
       collision::contact_distance_poses(*model_a.model, *model_b.model, settings);
   const double generate_ms = ms_since(start);
+  // A gap large for meshes this size can place B beyond the bound that
+  // query reads (pose lists, docs/cli.md): refused, not written unreadable.
+  const collision::Real bound = collision::MeshLimits{}.max_abs_coordinate;
+  for (const collision::SampledPose& pose : poses) {
+    if (!(pose.X_AB.t.cwiseAbs().maxCoeff() <= bound)) {
+      throw InputError("poses: a gap of " + shortest(pose.gap) +
+                       " places B beyond the coordinate limit of 1e30 that pose lists keep to; "
+                       "give smaller --gaps");
+    }
+  }
 
   std::ofstream out(out_path, std::ios::binary | std::ios::trunc);
   if (!out) throw InputError(out_path + ": cannot be written: " + std::strerror(errno));
