@@ -97,7 +97,7 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
     make_folder(*v);
   }
   options.render_every = args.unsigned_integer("every").value_or(0);
-  if (options.render_every > 0 && !options.render_dir)
+  if (args.value("every") && !options.render_dir)
     throw UsageError(args.command() + ": --every needs --render DIR");
   options.threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));
   options.progress = !args.flag("quiet") && stderr_is_terminal();

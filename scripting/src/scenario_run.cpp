@@ -276,6 +276,10 @@ int api_set_matrix(lua_State* L) {
     lua_pop(L, 1);
     if (!std::isfinite(m[i])) return luaL_error(L, "set_matrix: numbers must be finite");
   }
+  if (lua_rawlen(L, 2) != 16) return luaL_error(L, "set_matrix: needs 16 numbers, row by row");
+  if (m[12] != 0 || m[13] != 0 || m[14] != 0 || m[15] != 1) {
+    return luaL_error(L, "set_matrix: the last row must be 0, 0, 0, 1");
+  }
   Runner* runner = runner_of(L);
   Transform X;
   for (int r = 0; r < 3; ++r) {

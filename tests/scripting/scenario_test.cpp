@@ -425,6 +425,24 @@ TEST(ScenarioRun, AMateNeverMadeSaysHowCloseItsPartCame) {
       << summary;
 }
 
+TEST(ScenarioRun, SetMatrixTakesSixteenNumbersWithTheLastRowOfAPose) {
+  for (const auto& [matrix, message] :
+       {std::pair{"{1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1, 5}", "needs 16 numbers, row by row"},
+        std::pair{"{1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,1,1}", "the last row must be 0, 0, 0, 1"},
+        std::pair{"{1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,2}", "the last row must be 0, 0, 0, 1"}}) {
+    const test::TempDir dir("dovetail_scenario");
+    const auto file = write(dir, "matrix.lua",
+                            moved_peg(std::string("    rule { when = after(0.1), act = { "
+                                                  "custom(function(dt)\n      dt.part(\"peg\"):"
+                                                  "set_matrix(") +
+                                          matrix + ")\n    end) } },",
+                                      ""));
+    const RunOutcome o = run_scenario(file);
+    ASSERT_EQ(o.status, RunOutcome::Status::kError) << matrix;
+    EXPECT_NE(o.error.find(std::string("set_matrix: ") + message), std::string::npos) << o.error;
+  }
+}
+
 TEST(ScenarioRun, RegionsTimersAttachAndCompletedEventsAsDescribed) {
   const test::TempDir dir("dovetail_scenario");
   const auto file = write(dir, "words.lua", R"(return scenario {
