@@ -575,14 +575,14 @@ bool inside(const std::filesystem::path& out, const std::string& file) {
   return end == out_folder.end();
 }
 
-/// Checks the --junit and --html files before any scenario runs and before
-/// the output folder is made: neither a scenario nor each other, and
-/// writable. One inside the output folder is checked for writing once the
-/// folder is made (regress_command).
-void check_summaries(const std::optional<std::string>& junit,
-                     const std::optional<std::string>& html,
-                     const std::vector<std::filesystem::path>& files,
-                     const std::filesystem::path& out) {
+/// Checks the outputs before any scenario runs and before the output folder
+/// is made: the --junit and --html files neither a scenario, nor each
+/// other, nor a scenario's output, and writable (one inside the output
+/// folder is checked for writing once the folder is made, regress_command);
+/// no scenario's output another scenario.
+void check_outputs(const std::optional<std::string>& junit, const std::optional<std::string>& html,
+                   const std::vector<std::filesystem::path>& files,
+                   const std::filesystem::path& out) {
   std::vector<std::string> scenarios;
   for (const std::filesystem::path& f : files) scenarios.push_back(f.string());
   for (const std::optional<std::string>& summary : {junit, html}) {
@@ -592,6 +592,19 @@ void check_summaries(const std::optional<std::string>& junit,
   }
   if (junit && html && engine::same_file(*junit, *html)) {
     throw UsageError("regress: --junit and --html name the same file '" + *junit + "'");
+  }
+  // No scenario's output is another scenario (regress DIR --out DIR: the
+  // frames folder of "b.lua.lua" is DIR/b.lua).
+  for (const std::filesystem::path& f : files) {
+    const std::string stem = f.stem().string();
+    for (const std::string& name : {stem + ".json", stem + ".log", stem}) {
+      for (const std::filesystem::path& g : files) {
+        if (engine::same_file(out / name, g)) {
+          throw UsageError("regress: " + (out / name).string() + ", an output of " + f.string() +
+                           ", is the scenario " + g.string() + "; choose another --out");
+        }
+      }
+    }
   }
   // Nor a scenario's own output: its report, its log or a frame in its folder.
   for (const auto& [option, summary] : {std::pair{"junit", junit}, std::pair{"html", html}}) {
@@ -626,7 +639,7 @@ int regress_command(std::span<const std::string> argv) {
   const auto [shard_k, shard_n] = parse_shard(args);
   const std::optional<std::string> junit = args.value("junit");
   const std::optional<std::string> html = args.value("html");
-  check_summaries(junit, html, scenario_files(folder), out);
+  check_outputs(junit, html, scenario_files(folder), out);
   check_output_names(scenario_files(folder));
   std::vector<Job> jobs = shard_jobs(folder, shard_k, shard_n);
   make_folder(out);

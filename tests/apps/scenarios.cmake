@@ -215,6 +215,12 @@ file(COPY ${out}/regress_clash/a.lua DESTINATION ${out}/regress_clash/more)
 file(RENAME ${out}/regress_clash/more/a.lua ${out}/regress_clash/a.log.lua)
 dovetail_cli_test(regress_output_names_clash EXIT 1 ARGS regress ${out}/regress_clash --out ${out}/regress_clash_out
                   STDERR "a.log.lua and .*a.lua would both write OUT/a.log; rename one of them")
+# Nor a scenario's output over another scenario (--out the scenarios' folder).
+file(WRITE ${out}/regress_into_itself/b.lua "return scenario { name = \"b\", duration = 0.1, parts = { b = part { shape = box { size = { 1, 1, 1 } } } } }\n")
+file(WRITE ${out}/regress_into_itself/b.lua.lua "return scenario { name = \"b\", duration = 0.1, parts = { b = part { shape = box { size = { 1, 1, 1 } } } } }\n")
+dovetail_cli_test(regress_output_is_a_scenario EXIT 2
+                  ARGS regress ${out}/regress_into_itself --out ${out}/regress_into_itself
+                  STDERR "regress: .*b.lua, an output of .*b.lua.lua, is the scenario .*b.lua; choose another --out")
 # A summary is not written over a scenario's report, log or frames.
 dovetail_cli_test(regress_junit_is_a_report EXIT 2
                   ARGS regress ${out}/regress_clash --out ${out}/regress_summary_out
