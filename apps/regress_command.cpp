@@ -309,16 +309,28 @@ std::string html_scenario(const Job& j, std::size_t index, const std::filesystem
     h += "</table>\n";
   }
   if (r.contains("simulation") && r["simulation"].contains("events")) {
-    const auto& events = r["simulation"]["events"];
-    h += "<details><summary>event timeline (" + std::to_string(events.size()) +
-         " events)</summary><table><tr><th>time (s)</th><th>event</th><th>a</th><th>b</th></tr>\n";
-    for (const auto& e : events) {
-      h += "<tr><td>" +
-           (e["time"].is_number() ? format_seconds(e["time"].get<double>()) : std::string()) +
-           "</td><td>" + html_text(e.value("kind", "")) + "</td><td>" +
-           html_text(e.value("a", "")) + "</td><td>" + html_text(e.value("b", "")) + "</td></tr>\n";
+    // The hand's segments touch parts many times a second: their contacts
+    // get a table of their own, so the parts' events are not lost among them.
+    std::string parts_rows, hand_rows;
+    std::size_t parts_count = 0, hand_count = 0;
+    for (const auto& e : r["simulation"]["events"]) {
+      const std::string kind = e.value("kind", "");
+      const bool hand = kind.rfind("hand_contact", 0) == 0;
+      (hand ? hand_count : parts_count) += 1;
+      (hand ? hand_rows : parts_rows) +=
+          "<tr><td>" +
+          (e["time"].is_number() ? format_seconds(e["time"].get<double>()) : std::string()) +
+          "</td><td>" + html_text(kind) + "</td><td>" + html_text(e.value("a", "")) + "</td><td>" +
+          html_text(e.value("b", "")) + "</td></tr>\n";
     }
-    h += "</table></details>\n";
+    const auto table = [&](const std::string& title, std::size_t n, const std::string& rows) {
+      h += "<details><summary>" + title + " (" + std::to_string(n) +
+           " events)</summary><table><tr><th>time (s)</th><th>event</th><th>a</th><th>b</th></tr>"
+           "\n" +
+           rows + "</table></details>\n";
+    };
+    table("event timeline", parts_count, parts_rows);
+    if (hand_count > 0) table("the hand's contacts", hand_count, hand_rows);
   }
   h += "</div>\n";
   return h;
