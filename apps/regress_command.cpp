@@ -618,13 +618,19 @@ void check_outputs(const std::optional<std::string>& junit, const std::optional<
       }
     }
   }
-  // Nor a scenario's own output: its report, its log or a frame in its folder.
+  // Nor the output folder, nor a scenario's own output: its report, its
+  // log, its frames folder or a frame in it.
   for (const auto& [option, summary] : {std::pair{"junit", junit}, std::pair{"html", html}}) {
     if (!summary) continue;
+    if (engine::same_file(*summary, out)) {
+      throw UsageError(std::string("regress: --") + option + " '" + *summary +
+                       "' is the output folder");
+    }
     for (const std::filesystem::path& f : files) {
       const std::string stem = f.stem().string();
       if (engine::same_file(*summary, out / (stem + ".json")) ||
-          engine::same_file(*summary, out / (stem + ".log")) || inside(out / stem, *summary)) {
+          engine::same_file(*summary, out / (stem + ".log")) ||
+          engine::same_file(*summary, out / stem) || inside(out / stem, *summary)) {
         throw UsageError(std::string("regress: --") + option + " '" + *summary +
                          "' is an output of " + f.string() + " in " + out.string());
       }

@@ -306,12 +306,29 @@ std::optional<std::string> check_binary_stl(std::string_view head, std::uintmax_
 
 /// A node hierarchy deeper than kMaxNodeDepth (the importer's recursion
 /// would overflow the stack on some thousands of levels).
-std::optional<std::string> check_gltf_nodes(const std::filesystem::path& path, bool binary) {
+std::optional<std::string> check_gltf_nodes(const std::filesystem::path& path, bool binary,
+                                            std::uintmax_t file_size) {
   std::ifstream in(path, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string bytes;
+  if (binary) {
+    // The header and the JSON chunk only, not the binary buffer after it.
+    bytes.resize(20);
+    in.read(bytes.data(), 20);
+    bytes.resize(static_cast<std::size_t>(in.gcount()));
+    if (bytes.size() < 20) return std::nullopt;  // the importer names a short file
+    std::uint32_t length = 0;
+    for (int k = 3; k >= 0; --k) length = (length << 8) | static_cast<unsigned char>(bytes[12 + k]);
+    std::string chunk(static_cast<std::size_t>(std::min<std::uintmax_t>(length, file_size)), '\0');
+    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    chunk.resize(static_cast<std::size_t>(in.gcount()));
+    bytes += chunk;
+  } else {
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
   const std::optional<std::string_view> json = gltf_json(bytes, binary);
   if (!json) return std::nullopt;
   const std::optional<std::size_t> depth = gltf_node_depth(*json);
+  if (depth == kJsonTooDeep) return std::string("its JSON is nested deeper than 256 levels");
   if (!depth || *depth <= kMaxNodeDepth) return std::nullopt;
   return "its node hierarchy is " + std::to_string(*depth) + " levels deep; at most " +
          std::to_string(kMaxNodeDepth) + " are read";
@@ -337,7 +354,7 @@ std::optional<std::string> check_declared_sizes(const std::filesystem::path& pat
   if (extension == ".stl") return check_binary_stl(head, file_size, limits);
   if (extension == ".obj") return check_obj_lines(path, limits);
   if (extension == ".gltf" || extension == ".glb")
-    return check_gltf_nodes(path, extension == ".glb");
+    return check_gltf_nodes(path, extension == ".glb", file_size);
   return std::nullopt;
 }
 

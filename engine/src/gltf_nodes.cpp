@@ -1,5 +1,7 @@
 #include "gltf_nodes.h"
 
+#include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -18,6 +20,8 @@ class NodeReader {
   explicit NodeReader(std::string_view text) : s_(text) {}
 
   bool ok() const { return ok_; }
+  /// The JSON nests deeper than kMaxJsonNesting.
+  bool too_deep() const { return too_deep_; }
   const std::vector<std::vector<std::uint64_t>>& children() const { return children_; }
 
   /// The top-level object, its "nodes" array read, everything else skipped.
@@ -34,9 +38,23 @@ class NodeReader {
   }
 
  private:
+  /// White space, and comments (// to the line's end, /* to */), which the
+  /// importer's JSON reader also skips.
   void space() {
-    while (i_ < s_.size() && (s_[i_] == ' ' || s_[i_] == '\t' || s_[i_] == '\n' || s_[i_] == '\r'))
-      ++i_;
+    while (i_ < s_.size()) {
+      const char c = s_[i_];
+      if (c == ' ' || c == '\t' || c == '\n' || c == '\r') {
+        ++i_;
+      } else if (c == '/' && i_ + 1 < s_.size() && s_[i_ + 1] == '/') {
+        const std::size_t end = s_.find('\n', i_);
+        i_ = end == std::string_view::npos ? s_.size() : end;
+      } else if (c == '/' && i_ + 1 < s_.size() && s_[i_ + 1] == '*') {
+        const std::size_t end = s_.find("*/", i_ + 2);
+        i_ = end == std::string_view::npos ? s_.size() : end + 2;
+      } else {
+        return;
+      }
+    }
   }
   bool take(char c) {
     space();
@@ -51,19 +69,55 @@ class NodeReader {
     return i_ < s_.size() && s_[i_] == c;
   }
 
-  /// A string's raw text between its quotes (escapes left as written).
-  std::string_view string() {
+  /// A string's text between its quotes, escapes decoded (\uXXXX outside
+  /// ASCII as '?': keys that matter here are ASCII), so that "node\u0073"
+  /// is the key "nodes", as the importer reads it.
+  std::string string() {
+    std::string out;
     if (!take('"')) {
       ok_ = false;
-      return {};
+      return out;
     }
-    const std::size_t begin = i_;
-    while (i_ < s_.size() && s_[i_] != '"') i_ += s_[i_] == '\\' ? 2 : 1;
+    while (i_ < s_.size() && s_[i_] != '"') {
+      if (s_[i_] != '\\') {
+        out += s_[i_++];
+        continue;
+      }
+      if (i_ + 1 >= s_.size()) break;
+      const char e = s_[i_ + 1];
+      i_ += 2;
+      if (e == 'u') {
+        unsigned code = 0;
+        for (int k = 0; k < 4 && i_ < s_.size(); ++k, ++i_) {
+          const char h = s_[i_];
+          const int digit = h >= '0' && h <= '9'   ? h - '0'
+                            : h >= 'a' && h <= 'f' ? h - 'a' + 10
+                            : h >= 'A' && h <= 'F' ? h - 'A' + 10
+                                                   : -1;
+          if (digit < 0) {
+            ok_ = false;
+            return out;
+          }
+          code = code * 16 + static_cast<unsigned>(digit);
+        }
+        out += code < 0x80 ? static_cast<char>(code) : '?';
+      } else {
+        const char* from = "\"\\/bfnrt";
+        const char* to = "\"\\/\b\f\n\r\t";
+        const char* at = std::strchr(from, e);
+        if (at == nullptr || e == '\0') {
+          ok_ = false;
+          return out;
+        }
+        out += to[at - from];
+      }
+    }
     if (i_ >= s_.size()) {
       ok_ = false;
-      return {};
+      return out;
     }
-    return s_.substr(begin, i_++ - begin);
+    ++i_;
+    return out;
   }
 
   /// An object, calling member(key) with the position at its value.
@@ -75,7 +129,7 @@ class NodeReader {
     }
     if (take('}')) return;
     while (ok_) {
-      const std::string_view key = string();
+      const std::string key = string();
       if (!ok_ || !take(':')) {
         ok_ = false;
         return;
@@ -120,21 +174,26 @@ class NodeReader {
     });
   }
 
+  /// A node index: a number with an integral value (1, 1.0, 1e0).
   std::uint64_t index() {
     space();
-    std::uint64_t value = 0;
     const std::size_t begin = i_;
-    while (i_ < s_.size() && s_[i_] >= '0' && s_[i_] <= '9' && value < (std::uint64_t{1} << 40)) {
-      value = value * 10 + static_cast<std::uint64_t>(s_[i_++] - '0');
+    while (i_ < s_.size() && std::strchr(",]} \t\r\n", s_[i_]) == nullptr) ++i_;
+    double value = -1;
+    const auto [end, ec] = std::from_chars(s_.data() + begin, s_.data() + i_, value);
+    if (ec != std::errc() || end != s_.data() + i_ || !(value >= 0) || value > 0x1p40 ||
+        value != std::floor(value)) {
+      ok_ = false;
+      return 0;
     }
-    if (i_ == begin) ok_ = false;
-    return value;
+    return static_cast<std::uint64_t>(value);
   }
 
   /// Any value, nested at most kMaxJsonNesting deep.
   void skip(int depth) {
     if (depth > kMaxJsonNesting) {
       ok_ = false;
+      too_deep_ = true;
       return;
     }
     space();
@@ -157,6 +216,7 @@ class NodeReader {
   std::string_view s_;
   std::size_t i_ = 0;
   bool ok_ = true;
+  bool too_deep_ = false;
   std::vector<std::vector<std::uint64_t>> children_;
 };
 
@@ -182,6 +242,7 @@ std::optional<std::string_view> gltf_json(std::string_view bytes, bool binary) {
 std::optional<std::size_t> gltf_node_depth(std::string_view json) {
   NodeReader reader(json);
   reader.read();
+  if (reader.too_deep()) return kJsonTooDeep;
   if (!reader.ok()) return std::nullopt;
   const auto& children = reader.children();
   const std::size_t n = children.size();

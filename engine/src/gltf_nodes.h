@@ -21,10 +21,14 @@ inline constexpr std::size_t kMaxNodeDepth = 1000;
 /// nullopt when `bytes` is neither (the importer decides then).
 std::optional<std::string_view> gltf_json(std::string_view bytes, bool binary);
 
+/// gltf_node_depth's answer for JSON nested deeper than 256 levels, which
+/// the importer's recursive JSON reader may not survive either.
+inline constexpr std::size_t kJsonTooDeep = static_cast<std::size_t>(-1);
+
 /// The levels of the deepest chain of nodes ("nodes" and their "children")
-/// in glTF JSON, counting a node without children as one; nullopt when the
-/// JSON cannot be read this way or the children form a cycle (the importer
-/// names those).
+/// in glTF JSON, counting a node without children as one; kJsonTooDeep for
+/// JSON nested deeper than 256 levels; nullopt when the JSON is malformed
+/// or the children form a cycle (the importer names those).
 std::optional<std::size_t> gltf_node_depth(std::string_view json);
 
 }  // namespace dovetail::engine::detail

@@ -115,16 +115,17 @@ void count_hook(lua_State* L, lua_Debug* ar) {
   if (host.exhausted) raise_exhausted(L);
 }
 
-/// Whether an error message starts with a position, "chunk:line: ".
+/// Whether an error message holds a position, "chunk:line: ", on its first
+/// line (a chunk's name may itself hold ": ").
 bool has_position(std::string_view text) {
-  const std::size_t end = text.find(": ");
-  if (end == std::string_view::npos || end == 0) return false;
-  const std::size_t colon = text.rfind(':', end - 1);
-  if (colon == std::string_view::npos || colon + 1 == end) return false;
-  for (std::size_t i = colon + 1; i < end; ++i) {
-    if (text[i] < '0' || text[i] > '9') return false;
+  const std::string_view first = text.substr(0, text.find('\n'));
+  for (std::size_t colon = first.find(':'); colon != std::string_view::npos;
+       colon = first.find(':', colon + 1)) {
+    std::size_t i = colon + 1;
+    while (i < first.size() && first[i] >= '0' && first[i] <= '9') ++i;
+    if (i > colon + 1 && first.substr(i, 2) == ": ") return true;
   }
-  return text.find('\n') > end;
+  return false;
 }
 
 // The message handler of every host call: the error message (or the

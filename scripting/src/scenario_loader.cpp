@@ -20,6 +20,7 @@
 
 #include "dovetail/collision/primitives.h"
 #include "dovetail/engine/mesh_import.h"
+#include "dovetail/engine/pose_list.h"
 #include "dovetail/scripting/lua_host.h"
 #include "dovetail/scripting/scenario.h"
 
@@ -191,7 +192,8 @@ class Loader {
   [[noreturn]] void fail(const SourceLocation& where, const std::string& message) const {
     std::vector<Problem> all = noted_;
     all.push_back({where, message});
-    throw ScenarioError(in_line_order(std::move(all)));
+    // A NUL in a name would end the message there: control bytes as \xNN.
+    throw ScenarioError(engine::escape_control_bytes(in_line_order(std::move(all)), "\n\t"));
   }
 
   /// A problem after which reading can go on: an unknown field or item is
@@ -203,7 +205,9 @@ class Loader {
   }
 
   void throw_noted() const {
-    if (!noted_.empty()) throw ScenarioError(in_line_order(noted_));
+    if (!noted_.empty()) {
+      throw ScenarioError(engine::escape_control_bytes(in_line_order(noted_), "\n\t"));
+    }
   }
 
   /// One line a problem, in the order of the file (problems of the whole
@@ -228,6 +232,11 @@ class Loader {
   /// t[key] without metamethods, pushed; `table` is an absolute index.
   int raw_getfield(int table, const char* key) {
     lua_pushstring(L_, key);
+    return lua_rawget(L_, table);
+  }
+  /// The same for a key that may hold NUL bytes (a name read from the file).
+  int raw_getfield(int table, const std::string& key) {
+    lua_pushlstring(L_, key.data(), key.size());
     return lua_rawget(L_, table);
   }
   int type_of_field(int table, const char* key) {
@@ -421,6 +430,9 @@ class Loader {
                           ", not " + describe(index));
         }
         arg.text = string_at(index);
+        if (param.type == ArgType::kFile && arg.text.find('\0') != std::string::npos) {
+          fail(where, name + ": a file name cannot hold a NUL byte: \"" + arg.text + "\"");
+        }
         if (param.type == ArgType::kGraspType && arg.text != "precision" && arg.text != "tripod" &&
             arg.text != "power") {
           fail(where,
@@ -455,7 +467,7 @@ class Loader {
         for (const std::string& key : keys) {
           if (key != "x" && key != "y" && key != "z")
             fail(where, name + ": unknown axis '" + key + "'");
-          raw_getfield(index, key.c_str());
+          raw_getfield(index, key);
           const double deg = number_at(lua_gettop(L_), where, name + "." + key);
           lua_pop(L_, 1);
           arg.vector[key[0] - 'x'] = deg;
@@ -612,7 +624,7 @@ class Loader {
             const std::string& what) {
     const Param& p = param(word, name);
     Arg arg;
-    raw_getfield(index, std::string(name).c_str());
+    raw_getfield(index, std::string(name));
     if (lua_type(L_, -1) != LUA_TNIL) {
       arg = arg_at(lua_gettop(L_), p, where, what);
     } else if (!p.optional) {
@@ -842,7 +854,7 @@ void Loader::read_parts(int map, const SourceLocation& where) {
   if (names.empty()) fail(where, "scenario: parts is empty");
   const Word& word = *find_word("part");
   for (const std::string& name : names) {
-    raw_getfield(map, name.c_str());
+    raw_getfield(map, name);
     const int declaration = lua_gettop(L_);
     const std::string what = "part '" + name + "'";
     PartSpec part;
@@ -971,7 +983,7 @@ void Loader::read_mates(int map, const SourceLocation& where) {
       declaration_names(map, where, "mates", "mate", "mates = { fit = mate { ... } }");
   const Word& word = *find_word("mate");
   for (const std::string& name : names) {
-    raw_getfield(map, name.c_str());
+    raw_getfield(map, name);
     const std::string what = "mate '" + name + "'";
     MateSpec spec;
     spec.where = open_declaration(lua_gettop(L_), "mate", where, what);
@@ -1005,7 +1017,7 @@ void Loader::read_regions(int map, const SourceLocation& where) {
       declaration_names(map, where, "regions", "region", "regions = { tray = region { ... } }");
   const Word& word = *find_word("region");
   for (const std::string& name : names) {
-    raw_getfield(map, name.c_str());
+    raw_getfield(map, name);
     const std::string what = "region '" + name + "'";
     RegionSpec spec;
     spec.where = open_declaration(lua_gettop(L_), "region", where, what);
@@ -1058,7 +1070,7 @@ void Loader::read_glove(int index, const SourceLocation& outer) {
     interaction::GloveNoise noise;
     noise.donning_sigma_deg = 0;
     for (const std::string& key : keys) {
-      raw_getfield(n, key.c_str());
+      raw_getfield(n, key);
       const double x = number_at(lua_gettop(L_), glove.where, "glove noise " + key);
       lua_pop(L_, 1);
       if (x < 0) fail(glove.where, "glove noise " + key + " must not be negative");

@@ -230,6 +230,14 @@ dovetail_cli_test(regress_html_is_a_log EXIT 2
                   ARGS regress ${out}/regress_clash --out ${out}/regress_summary_out
                        --html ${out}/regress_summary_out/a.log
                   STDERR "--html '.*a.log' is an output of")
+dovetail_cli_test(regress_junit_is_the_out_folder EXIT 2
+                  ARGS regress ${out}/regress_clash --out ${out}/regress_summary_out
+                       --junit ${out}/regress_summary_out
+                  STDERR "--junit '.*regress_summary_out' is the output folder")
+dovetail_cli_test(regress_html_is_a_frames_folder EXIT 2
+                  ARGS regress ${out}/regress_clash --out ${out}/regress_summary_out
+                       --html ${out}/regress_summary_out/a
+                  STDERR "--html '.*regress_summary_out/a' is an output of .*a.lua in")
 # A folder whose name starts with '-', a link to a missing scenario (named, not
 # skipped), and a report that is UTF-8 whatever bytes the scenario's error holds.
 file(WRITE ${out}/regress_odd/-dash/ok.lua "return scenario { name = \"ok\", duration = 0.1, parts = { b = part { shape = box { size = { 1, 1, 1 } } } } }\n")

@@ -88,6 +88,19 @@ TEST(Containment, BodiesThatTouchAreClosedTogether) {
   }
   EXPECT_EQ(locate_point(two_boxes(half, half, Vec3(2, 2, 0)), Vec3(1.5, 0.5, 0)),
             PointLocation::kOutside);
+  // Every face written twice, and two boxes that overlap: inside where the
+  // surfaces wind around the point, not by the parity of the crossings
+  // (two crossings where one would do).
+  Mesh twice = make_box(half);
+  const std::vector<TriangleIndices> faces = twice.triangles;
+  twice.triangles.insert(twice.triangles.end(), faces.begin(), faces.end());
+  EXPECT_TRUE(is_closed(twice));
+  EXPECT_EQ(locate_point(twice, Vec3(0.2, 0.1, 0.3)), PointLocation::kInside);
+  EXPECT_EQ(locate_point(twice, Vec3(3, 0, 0)), PointLocation::kOutside);
+  const Mesh overlapping = two_boxes(half, half, Vec3(1, 0.5, 0.25));
+  EXPECT_EQ(locate_point(overlapping, Vec3(0.5, 0.5, 0.5)), PointLocation::kInside);
+  EXPECT_EQ(locate_point(overlapping, Vec3(1.5, 1.2, 1)), PointLocation::kInside);
+  EXPECT_EQ(locate_point(overlapping, Vec3(-0.5, 1.2, 0)), PointLocation::kOutside);
   // Still open with a triangle missing, still inconsistent with one flipped.
   Mesh open = two_boxes(half, half, Vec3(2, 2, 0));
   open.triangles.pop_back();

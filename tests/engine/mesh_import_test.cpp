@@ -154,6 +154,20 @@ TEST(MeshImport, AGltfNodeHierarchyDeeperThanAThousandLevelsIsRefused) {
     EXPECT_NE(import_error(dir / "deep.glb").find("levels deep; at most 1000 are read"),
               std::string::npos);
   }
+  // Written as the importer reads it too: comments, an escaped key, indices
+  // written 2.0; and JSON nested deeper than 256 levels is refused.
+  std::string json = node_chain(1500);
+  json.replace(json.find("\"nodes\""), 7, "\"node\\u0073\"");
+  for (std::size_t at = json.find("\"children\": [1]"); at != std::string::npos;
+       at = std::string::npos) {
+    json.replace(at, 15, "\"children\": [1.0]");
+  }
+  write_file(dir / "written.gltf", "/* a comment */ " + json + " // end\n");
+  EXPECT_NE(import_error(dir / "written.gltf").find("is 1500 levels deep"), std::string::npos);
+  write_file(dir / "extras.gltf", R"({"asset": {"version": "2.0"}, "extras": )" +
+                                      std::string(300, '[') + std::string(300, ']') + "}");
+  EXPECT_NE(import_error(dir / "extras.gltf").find("its JSON is nested deeper than 256 levels"),
+            std::string::npos);
   // 1000 levels pass this check (the importer then finds no mesh in them).
   write_file(dir / "deep.gltf", node_chain(1000));
   EXPECT_EQ(import_error(dir / "deep.gltf").find("levels deep"), std::string::npos);

@@ -537,6 +537,9 @@ TEST(LuaHostErrors, ErrorObjectsThatAreNotStrings) {
   EXPECT_EQ(run_error(host, "error(42)").message(), "script.lua:1: 42");
   EXPECT_EQ(run_error(host, "coroutine.yield()").message(),
             "script.lua:1: attempt to yield from outside a coroutine");
+  // A chunk whose name holds ": " is given its position once.
+  EXPECT_EQ(run_error(host, "\nerror('boom')", "sp: ace.lua").message(), "sp: ace.lua:2: boom");
+  EXPECT_EQ(run_error(host, "\nerror('boom', 0)", "sp: ace.lua").message(), "sp: ace.lua:2: boom");
 }
 
 TEST(LuaHostErrors, ErrorInsideWrappedCoroutineKeepsBothPositions) {

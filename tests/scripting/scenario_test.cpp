@@ -368,6 +368,16 @@ TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
   EXPECT_EQ(logged, (std::vector<std::string>{std::string("a\0b", 3), std::string("c\0d", 3)}));
   const std::string json = o.to_json();
   EXPECT_NE(json.find(R"("text": "a\u0000b")"), std::string::npos) << json;
+  // A part's name may hold one; a file name may not (it would name another file).
+  const auto named =
+      write(dir, "named.lua",
+            "return scenario {\n  name = \"s\",\n  parts = {\n    [\"x\\0y\"] = part "
+            "{ shape = box { size = { 1, 1, 1 } } },\n    z = part { mesh = "
+            "\"cube.obj\\0junk\" },\n  },\n}\n");
+  EXPECT_NE(
+      load_error(named).find("named.lua:5: part 'z' 'mesh': a file name cannot hold a NUL byte: "
+                             "\"cube.obj\\x00junk\""),
+      std::string::npos);
   EXPECT_NE(o.failure_summary().find("failed at t=0.300 s: e\\x1B[31m\n"), std::string::npos)
       << o.failure_summary();
 }

@@ -61,10 +61,13 @@ std::pair<std::vector<std::uint32_t>, std::size_t> shells(const Mesh& mesh) {
   return {std::move(shell), count};
 }
 
-/// Parity of crossings per shell, or a verdict that needs no parity.
+/// Signed crossings per shell (the winding number of the segment's start
+/// about it), or a verdict that needs no count.
 struct RayOutcome {
   enum { kCounted, kOnSurface, kDegenerate } status = kCounted;
-  std::vector<char> odd;  ///< per shell: the segment crossed it an odd number of times
+  /// Per shell: crossings from the back of a triangle to its front, less
+  /// those from the front to its back.
+  std::vector<int> winding;
 };
 
 bool same_closed_side(int e1, int e2, int e3) {
@@ -78,7 +81,7 @@ RayOutcome cast(const std::vector<Vec3>& vertices, const std::vector<TriangleInd
                 const std::vector<std::uint32_t>& shell, std::size_t shell_count, const Vec3& p,
                 const Vec3& q) {
   RayOutcome out;
-  out.odd.assign(shell_count, 0);
+  out.winding.assign(shell_count, 0);
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const Vec3& a = vertices[triangles[t][0]];
     const Vec3& b = vertices[triangles[t][1]];
@@ -97,7 +100,8 @@ RayOutcome cast(const std::vector<Vec3>& vertices, const std::vector<TriangleInd
     }
     if (!same_closed_side(e1, e2, e3)) continue;
     if (e1 == 0 || e2 == 0 || e3 == 0) return {RayOutcome::kDegenerate, {}};
-    out.odd[shell[t]] ^= 1;
+    // Leaving through the triangle's back side or entering through it.
+    out.winding[shell[t]] += sp < 0 ? 1 : -1;
   }
   return out;
 }
@@ -155,19 +159,25 @@ Located locate(const std::vector<Vec3>& vertices, const std::vector<TriangleIndi
     const RayOutcome r = cast(vertices, triangles, shell, shell_count, p, q);
     if (r.status == RayOutcome::kOnSurface) return {PointLocation::kOnSurface, true};
     if (r.status == RayOutcome::kDegenerate) continue;
-    int total = 0;
-    for (char odd : r.odd) total ^= odd;
-    const bool any = std::find(r.odd.begin(), r.odd.end(), 1) != r.odd.end();
-    return {total ? PointLocation::kInside : PointLocation::kOutside, any};
+    // Inside where the surfaces wind around p: one body or more (bodies
+    // that touch or overlap, a face written twice); a cavity's shell winds
+    // the other way and cancels its housing's.
+    long total = 0;
+    bool any = false;
+    for (const int w : r.winding) {
+      total += w;
+      any = any || w != 0;
+    }
+    return {total != 0 ? PointLocation::kInside : PointLocation::kOutside, any};
   }
   Located out;
-  int total = 0;
+  long total = 0;
   for (std::size_t s = 0; s < shell_count; ++s) {
-    const bool odd = std::abs(std::lround(winding_number(vertices, triangles, shell, s, p))) % 2;
-    total ^= odd;
-    out.in_some_shell = out.in_some_shell || odd;
+    const long w = std::lround(winding_number(vertices, triangles, shell, s, p));
+    total += w;
+    out.in_some_shell = out.in_some_shell || w != 0;
   }
-  out.location = total ? PointLocation::kInside : PointLocation::kOutside;
+  out.location = total != 0 ? PointLocation::kInside : PointLocation::kOutside;
   return out;
 }
 
