@@ -309,7 +309,8 @@ int new_command(std::span<const std::string> argv) {
   std::string name = args.positional()[0];
   // "dovetail new peg.lua" means the scenario peg in peg.lua.
   if (name.size() > 4 && name.ends_with(".lua")) name.resize(name.size() - 4);
-  if (std::filesystem::path(name).filename().empty()) {
+  if (const std::filesystem::path file = std::filesystem::path(name).filename();
+      file.empty() || file == "." || file == "..") {
     throw UsageError("new: the name '" + name + "' names no file: dovetail new my_scenario");
   }
   const std::filesystem::path out = args.value("out").value_or(name + ".lua");

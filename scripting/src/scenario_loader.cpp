@@ -152,9 +152,15 @@ ScriptError with_word_suggested(const ScriptError& e) {
   };
   // A table's fields run on without a comma: Lua stops at the next field,
   // on the line after the one that lacks it.
-  if (e.kind() == ScriptError::Kind::kSyntax && first.find("'}' expected") != std::string::npos &&
-      first.find(" near ") != std::string::npos) {
-    return with_hint(" (is a comma missing at the end of the field before?)");
+  // Only where the next field begins (a name, a value), not at a stray ')'.
+  if (const std::size_t near = first.find(" near '");
+      e.kind() == ScriptError::Kind::kSyntax && first.find("'}' expected") != std::string::npos &&
+      near != std::string::npos && near + 7 < first.size()) {
+    const char c = first[near + 7];
+    if (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '"' || c == '\'' ||
+        c == '{' || c == '[') {
+      return with_hint(" (is a comma missing at the end of the field before?)");
+    }
   }
   const std::size_t at = first.find(kCall);
   if (at == std::string::npos) return e;
