@@ -514,24 +514,35 @@ void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
 
 std::pair<std::string, Real> Grasping::deepest_overlap(const engine::Scene& scene, PartId part,
                                                        const Transform& X_WP) {
-  const auto& mesh = scene.collision_mesh(part);
-  const auto attached = [&](PartId other) {
-    for (PartId p = scene.parent(other); p.valid(); p = scene.parent(p)) {
+  // The part and the parts attached to it move together, rigidly: each by
+  // the same move, and none is checked against another of them.
+  const auto in_family = [&](PartId other) {
+    for (PartId p = other; p.valid(); p = scene.parent(p)) {
       if (p == part) return true;
     }
     return false;
   };
-  const collision::Bounds box = collision::transformed_bounds(models_->mesh_bounds(mesh), X_WP);
-  std::pair<std::string, Real> deepest{"", 0};
-  for (const PartId other : scene.parts()) {
-    const auto& other_mesh = scene.collision_mesh(other);
-    if (other == part || !other_mesh || scene.has_tag(other, "hand") || attached(other)) continue;
-    const Transform X_WB = scene.world_pose(other);
-    if (!overlap(collision::transformed_bounds(models_->mesh_bounds(other_mesh), X_WB), box, 0)) {
-      continue;
+  const Transform move = engine::compose(X_WP, scene.world_pose(part).inverse());
+  std::vector<std::pair<PartId, Transform>> moved;
+  for (const PartId q : scene.parts()) {
+    if (in_family(q) && scene.collision_mesh(q)) {
+      moved.emplace_back(q, q == part ? X_WP : engine::compose(move, scene.world_pose(q)));
     }
-    const Real depth = overlap_.depth(mesh, X_WP, other_mesh, X_WB);
-    if (depth > deepest.second) deepest = {scene.name(other), depth};
+  }
+  std::pair<std::string, Real> deepest{"", 0};
+  for (const auto& [q, X_WQ] : moved) {
+    const auto& mesh = scene.collision_mesh(q);
+    const collision::Bounds box = collision::transformed_bounds(models_->mesh_bounds(mesh), X_WQ);
+    for (const PartId other : scene.parts()) {
+      const auto& other_mesh = scene.collision_mesh(other);
+      if (!other_mesh || scene.has_tag(other, "hand") || in_family(other)) continue;
+      const Transform X_WB = scene.world_pose(other);
+      if (!overlap(collision::transformed_bounds(models_->mesh_bounds(other_mesh), X_WB), box, 0)) {
+        continue;
+      }
+      const Real depth = overlap_.depth(mesh, X_WQ, other_mesh, X_WB);
+      if (depth > deepest.second) deepest = {scene.name(other), depth};
+    }
   }
   return deepest;
 }

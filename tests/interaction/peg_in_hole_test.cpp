@@ -29,9 +29,21 @@ constexpr Real kBlockTop = 0.03;
 
 /// The block (fixed, hole axis along y, opening at y = kBlockTop) and the peg
 /// (a cylinder along its z axis from 0 to kPegLength, turned so z points down).
-/// With a pebble of height `pebble` (a fixed 8 mm box) on the hole's bottom.
-engine::Scene peg_and_block(const Transform& X_WPeg, int sides = 64, Real pebble = 0) {
+/// With a pebble of height `pebble` (a fixed 8 mm box) on the hole's bottom,
+/// and with `tab`, a 4 mm box beside the peg, 17 mm off its axis and 21 mm
+/// below its top (attached to it by run_peg), which ends 3 mm deep in the
+/// block's top face when the peg is seated.
+engine::Scene peg_and_block(const Transform& X_WPeg, int sides = 64, Real pebble = 0,
+                            bool tab = false) {
   engine::Scene scene;
+  if (tab) {
+    Transform X_PT;  // in the peg's frame: its z axis points down, z = 0 at its top
+    X_PT.t = Vec3(0.017, 0, 0.021);
+    scene.add_part({.name = "tab",
+                    .X_QP = engine::compose(X_WPeg, X_PT),
+                    .render_mesh = std::make_shared<const collision::Mesh>(
+                        collision::make_box(Vec3(0.002, 0.002, 0.002)))});
+  }
   if (pebble > 0) {
     Transform X;
     X.t = Vec3(0, kBlockTop - kHoleDepth + pebble / 2, 0);
@@ -77,10 +89,10 @@ struct PegRun {
 /// hole's axis (20 mm past the bottom) in 2 s, waits, and opens.
 PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool measure_depth = true,
                int sides = 64, std::shared_ptr<const GloveSource> replay = nullptr, Real pebble = 0,
-               bool guide = true) {
+               bool guide = true, bool tab = false) {
   const Transform X_WPeg0 = peg_start(offset, tilt_deg);
   engine::Simulation sim(
-      peg_and_block(X_WPeg0, sides, pebble),
+      peg_and_block(X_WPeg0, sides, pebble, tab),
       {.collision_threads = threads, .contacts = collision::ContactDetail::kPairs});
   // The hand is above the peg, tilted with it, its power posture around nothing.
   GlovePlan plan;
@@ -106,6 +118,7 @@ PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool mea
                                                              .position_sigma_m = 0.001,
                                                              .orientation_sigma_deg = 0.5});
   }
+  if (tab) sim.scene().set_parent(sim.scene().get("tab"), sim.scene().get("peg"), true);
   Hand hand(sim, replay ? replay : source);
   Grasping grasping(sim, hand);
   grasping.add_mate({.name = "peg_in_hole",
@@ -224,6 +237,18 @@ TEST(PegInHole, WithoutGuidanceAPegOffTheAxisStaysOnTheRim) {
   EXPECT_FALSE(has(run.events, EventKind::kMate, "peg", "block"));
   EXPECT_LT(run.max_depth, 1e-5);
   EXPECT_GE(run.X_WPeg.apply(Vec3(0, 0, kPegLength)).y(), kBlockTop - 1e-3);
+}
+
+TEST(PegInHole, APartAttachedToThePegIsCheckedBeforeTheSnapToo) {
+  // A tab attached beside the peg ends in the block's top face (nothing
+  // stops an attached part on the way): the peg itself would seat cleanly,
+  // but the snap, which moves the tab with it, is refused, naming the block.
+  const PegRun run = run_peg(0, 0, false, 1, false, 64, nullptr, 0, true, /*tab=*/true);
+  EXPECT_TRUE(has(run.events, EventKind::kRelease, "peg", "opened"));
+  EXPECT_FALSE(has(run.events, EventKind::kMate, "peg", "block"));
+  ASSERT_EQ(run.refused.size(), 1u);
+  EXPECT_EQ(run.refused[0].blocker, "block");
+  EXPECT_NEAR(run.refused[0].depth_m, 0.003, 1e-4);
 }
 
 TEST(PegInHole, ACoarselyTessellatedHoleStillTakesThePeg) {

@@ -184,8 +184,9 @@ class Grasping {
                    const Transform& X_WP_target);
   void release(engine::Simulation& simulation, const std::string& reason);
   void snap(engine::Simulation& simulation, const std::string& part);
-  /// The part other than `part` (and the parts attached to it) that `part`
-  /// at X_WP overlaps most deeply, and how deep; depth 0 when none.
+  /// The part that `part` at X_WP, or a part attached to it and moved with
+  /// it, overlaps most deeply (none of them counted), and how deep; depth 0
+  /// when none.
   std::pair<std::string, Real> deepest_overlap(const engine::Scene& scene, engine::PartId part,
                                                const Transform& X_WP);
 
