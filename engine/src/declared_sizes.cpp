@@ -6,7 +6,6 @@
 #include <charconv>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <sstream>
 #include <string_view>
 #include <vector>
@@ -170,8 +169,7 @@ std::optional<std::string> check_ascii_ply_body(const std::filesystem::path& pat
 std::optional<std::string> check_ply(const std::filesystem::path& path, std::string_view head,
                                      std::uintmax_t file_size,
                                      const collision::MeshLimits& limits) {
-  using Element = PlyElement;
-  std::vector<Element> elements;
+  std::vector<PlyElement> elements;
   bool binary = false;
   bool has_format = false;
   std::size_t pos = 0;
@@ -203,7 +201,7 @@ std::optional<std::string> check_ply(const std::filesystem::path& path, std::str
       binary = w[1] != "ascii";
     } else if (w[0] == "element") {
       if (w.size() != 3) return bad("an element needs a name and a count");
-      Element e;
+      PlyElement e;
       e.name = std::string(w[1]);
       e.count = parse_count(w[2]);
       if (!e.count.valid) {
@@ -212,7 +210,7 @@ std::optional<std::string> check_ply(const std::filesystem::path& path, std::str
       elements.push_back(std::move(e));
     } else if (w[0] == "property") {
       if (elements.empty()) return bad("property before any element");
-      Element& e = elements.back();
+      PlyElement& e = elements.back();
       ++e.properties;
       if (w.size() >= 2 && w[1] == "list") {
         if (w.size() != 5) return bad("a list property needs two types and a name");
@@ -243,7 +241,7 @@ std::optional<std::string> check_ply(const std::filesystem::path& path, std::str
 
   const std::uintmax_t available = file_size - header_end;
   long double needed = 0;
-  for (const Element& e : elements) {
+  for (const PlyElement& e : elements) {
     if (e.count.overflow) {
       return "PLY element '" + e.name + "' declares a count beyond 64 bits";
     }
@@ -308,24 +306,7 @@ std::optional<std::string> check_binary_stl(std::string_view head, std::uintmax_
 /// would overflow the stack on some thousands of levels).
 std::optional<std::string> check_gltf_nodes(const std::filesystem::path& path, bool binary,
                                             std::uintmax_t file_size) {
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes;
-  if (binary) {
-    // The header and the JSON chunk only, not the binary buffer after it.
-    bytes.resize(20);
-    in.read(bytes.data(), 20);
-    bytes.resize(static_cast<std::size_t>(in.gcount()));
-    if (bytes.size() < 20) return std::nullopt;  // the importer names a short file
-    std::uint32_t length = 0;
-    for (int k = 3; k >= 0; --k) length = (length << 8) | static_cast<unsigned char>(bytes[12 + k]);
-    std::string chunk(static_cast<std::size_t>(std::min<std::uintmax_t>(length, file_size)), '\0');
-    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
-    chunk.resize(static_cast<std::size_t>(in.gcount()));
-    bytes += chunk;
-  } else {
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  const std::optional<std::string_view> json = gltf_json(bytes, binary);
+  const std::optional<std::string> json = gltf_json(path, binary, file_size);
   if (!json) return std::nullopt;
   const std::optional<std::size_t> depth = gltf_node_depth(*json);
   if (depth == kJsonTooDeep) return std::string("its JSON is nested deeper than 256 levels");

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <vector>
 
 namespace dovetail::engine::detail {
@@ -120,41 +122,39 @@ class NodeReader {
     return out;
   }
 
-  /// An object, calling member(key) with the position at its value.
-  template <typename Member>
-  void object(Member&& member) {
-    if (!take('{')) {
+  /// `open`, items separated by commas, `close`; item() reads one.
+  template <typename Item>
+  void sequence(char open, char close, Item&& item) {
+    if (!take(open)) {
       ok_ = false;
       return;
     }
-    if (take('}')) return;
+    if (take(close)) return;
     while (ok_) {
+      item();
+      if (take(',')) continue;
+      if (!take(close)) ok_ = false;
+      return;
+    }
+  }
+
+  /// An object, calling member(key) with the position at its value.
+  template <typename Member>
+  void object(Member&& member) {
+    sequence('{', '}', [&] {
       const std::string key = string();
       if (!ok_ || !take(':')) {
         ok_ = false;
         return;
       }
       member(key);
-      if (take(',')) continue;
-      if (!take('}')) ok_ = false;
-      return;
-    }
+    });
   }
 
   /// An array, calling element() with the position at each element.
   template <typename Element>
   void array(Element&& element) {
-    if (!take('[')) {
-      ok_ = false;
-      return;
-    }
-    if (take(']')) return;
-    while (ok_) {
-      element();
-      if (take(',')) continue;
-      if (!take(']')) ok_ = false;
-      return;
-    }
+    sequence('[', ']', element);
   }
 
   void nodes() {
@@ -228,15 +228,25 @@ std::uint32_t little_u32(std::string_view bytes, std::size_t at) {
 
 }  // namespace
 
-std::optional<std::string_view> gltf_json(std::string_view bytes, bool binary) {
-  if (!binary) return bytes;
+std::optional<std::string> gltf_json(const std::filesystem::path& path, bool binary,
+                                     std::uintmax_t file_size) {
+  std::ifstream in(path, std::ios::binary);
+  if (!binary) {
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
   // GLB: "glTF", version, length; then the first chunk: length, "JSON", data.
-  if (bytes.size() < 20 || bytes.substr(0, 4) != "glTF" || bytes.substr(16, 4) != "JSON") {
+  // The binary buffer after it is not read.
+  std::string header(20, '\0');
+  in.read(header.data(), 20);
+  if (in.gcount() < 20 || header.compare(0, 4, "glTF") != 0 || header.compare(16, 4, "JSON") != 0) {
     return std::nullopt;
   }
-  const std::uint32_t length = little_u32(bytes, 12);
-  if (length > bytes.size() - 20) return std::nullopt;
-  return bytes.substr(20, length);
+  const std::uint32_t length = little_u32(header, 12);
+  if (length > file_size) return std::nullopt;  // the importer names a truncated file
+  std::string json(length, '\0');
+  in.read(json.data(), length);
+  if (static_cast<std::uint64_t>(in.gcount()) != length) return std::nullopt;
+  return json;
 }
 
 std::optional<std::size_t> gltf_node_depth(std::string_view json) {

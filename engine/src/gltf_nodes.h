@@ -8,6 +8,8 @@
 /// dozen levels deep; a file deeper than the limit is refused with a message.
 
 #include <cstddef>
+#include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -17,9 +19,11 @@ namespace dovetail::engine::detail {
 /// The deepest node hierarchy Dovetail reads.
 inline constexpr std::size_t kMaxNodeDepth = 1000;
 
-/// The JSON of a .gltf file, or of a .glb file's first (JSON) chunk;
-/// nullopt when `bytes` is neither (the importer decides then).
-std::optional<std::string_view> gltf_json(std::string_view bytes, bool binary);
+/// The JSON of a .gltf file, or of a .glb file's first (JSON) chunk, read
+/// from `path` (`file_size` bytes); nullopt when a .glb file does not start
+/// as one or is cut short (the importer names those).
+std::optional<std::string> gltf_json(const std::filesystem::path& path, bool binary,
+                                     std::uintmax_t file_size);
 
 /// gltf_node_depth's answer for JSON nested deeper than 256 levels, which
 /// the importer's recursive JSON reader may not survive either.

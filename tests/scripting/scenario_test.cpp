@@ -36,6 +36,22 @@ std::string load_error(const std::filesystem::path& file) {
   return "";
 }
 
+/// The run's log messages, (time, text), in order.
+std::vector<std::pair<double, std::string>> logged_messages(const RunOutcome& o) {
+  std::vector<std::pair<double, std::string>> logged;
+  for (const Message& m : o.messages) {
+    if (m.level == "log") logged.emplace_back(m.time, m.text);
+  }
+  return logged;
+}
+
+/// The texts of the run's log messages, in order.
+std::vector<std::string> logged_texts(const RunOutcome& o) {
+  std::vector<std::string> texts;
+  for (const auto& [time, text] : logged_messages(o)) texts.push_back(text);
+  return texts;
+}
+
 /// A scene without a hand: the peg is moved into the hole by a rule.
 std::string moved_peg(const std::string& rules, const std::string& expect,
                       const std::string& extra = "") {
@@ -340,11 +356,7 @@ TEST(ScenarioRun, CustomActionsUseTheLowLevelApi) {
                       ""));
   const RunOutcome o = run_scenario(file);
   ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
-  std::vector<std::string> logged;
-  for (const Message& m : o.messages) {
-    if (m.level == "log") logged.push_back(m.text);
-  }
-  EXPECT_EQ(logged, (std::vector<std::string>{"0 100 0", "0 250 0"})) << o.to_json();
+  EXPECT_EQ(logged_texts(o), (std::vector<std::string>{"0 100 0", "0 250 0"})) << o.to_json();
 }
 
 TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
@@ -361,11 +373,8 @@ TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
           "    rule { when = after(0.3), act = { fail \"e\\27[31m\" }, once = true },",
           ""));
   const RunOutcome o = run_scenario(file);
-  std::vector<std::string> logged;
-  for (const Message& m : o.messages) {
-    if (m.level == "log") logged.push_back(m.text);
-  }
-  EXPECT_EQ(logged, (std::vector<std::string>{std::string("a\0b", 3), std::string("c\0d", 3)}));
+  EXPECT_EQ(logged_texts(o),
+            (std::vector<std::string>{std::string("a\0b", 3), std::string("c\0d", 3)}));
   const std::string json = o.to_json();
   EXPECT_NE(json.find(R"("text": "a\u0000b")"), std::string::npos) << json;
   // A part's name may hold one; a file name may not (it would name another file).
@@ -399,10 +408,7 @@ TEST(ScenarioRun, AMovedPartArrivesOnceInTheFrameItGetsThere) {
                 ""));
   const RunOutcome o = run_scenario(file);
   ASSERT_NE(o.status, RunOutcome::Status::kError) << o.error;
-  std::vector<std::pair<double, std::string>> logged;
-  for (const Message& m : o.messages) {
-    if (m.level == "log") logged.emplace_back(m.time, m.text);
-  }
+  const std::vector<std::pair<double, std::string>> logged = logged_messages(o);
   ASSERT_EQ(logged.size(), 2u) << o.to_json();
   EXPECT_EQ(logged[0].second, "150");
   EXPECT_GE(logged[0].first, 0.3);

@@ -218,24 +218,21 @@ std::pair<Inside, Inside> shells_inside(const Mesh& solid, const std::vector<Vec
 
 bool is_closed(const Mesh& mesh) {
   if (mesh.triangles.empty()) return false;
-  // Each edge as (lower id, higher id) with the direction it is used in:
-  // +1 from lower to higher, -1 back. Closed: every edge's directions cancel.
-  std::vector<Edge> edges = directed_edges(mesh);
-  for (Edge& e : edges) {
-    e.triangle = e.from < e.to ? 1 : 0;  // reused as the direction
-    if (e.from > e.to) std::swap(e.from, e.to);
-  }
-  std::sort(edges.begin(), edges.end());
+  // Closed: every directed edge is used as often as its reverse.
+  const std::vector<Edge> edges = directed_edges(mesh);  // sorted by (from, to)
+  const auto uses = [&](std::uint32_t from, std::uint32_t to) {
+    const auto [first, last] = std::equal_range(
+        edges.begin(), edges.end(), Edge{from, to, 0}, [](const Edge& x, const Edge& y) {
+          return std::tie(x.from, x.to) < std::tie(y.from, y.to);
+        });
+    return last - first;
+  };
   for (std::size_t k = 0; k < edges.size();) {
-    std::size_t end = k;
-    std::int64_t balance = 0;
-    for (; end < edges.size() && edges[end].from == edges[k].from && edges[end].to == edges[k].to;
-         ++end) {
-      balance += edges[end].triangle == 1 ? 1 : -1;
-    }
+    const Edge& e = edges[k];
+    const auto n = uses(e.from, e.to);
     // An edge of a triangle with two welded corners has no direction to cancel.
-    if (balance != 0 && edges[k].from != edges[k].to) return false;
-    k = end;
+    if (e.from != e.to && uses(e.to, e.from) != n) return false;
+    k += static_cast<std::size_t>(n);
   }
   return true;
 }

@@ -7,8 +7,7 @@
 /// nothing. When the surfaces do not meet, each connected shell of a part is
 /// inside the other exactly when one of its points is, and that is decided
 /// exactly: a winding number counted along a ray with orient3d signs only.
-/// See docs/proximity.md,
-/// "Containment".
+/// See docs/proximity.md, "Containment".
 
 #include <cstddef>
 #include <cstdint>
@@ -36,9 +35,10 @@ enum class PointLocation {
 
 /// Exact location of `p_M` (in the mesh's frame) against closed `mesh`, by
 /// the winding number of the surface about it: signed crossings of a
-/// segment from the point to beyond the mesh's bounds, inside when not 0. Every decision is an
-/// exact orient3d sign; a segment that grazes an edge or vertex, or lies in a triangle's plane, is
-/// discarded and the next of a fixed list of directions is tried, so the answer is exact and
+/// segment from the point to beyond the mesh's bounds, inside when not 0.
+/// Every decision is an exact orient3d sign; a segment that grazes an edge
+/// or vertex, or lies in a triangle's plane, is discarded and the next of a
+/// fixed list of directions is tried, so the answer is exact and
 /// deterministic. For an open mesh the answer is unspecified (see
 /// is_closed).
 PointLocation locate_point(const Mesh& mesh, const Vec3& p_M);
