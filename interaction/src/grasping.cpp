@@ -8,6 +8,7 @@
 
 #include "dovetail/collision/distance.h"
 #include "dovetail/engine/scene.h"
+#include "dovetail/interaction/overlap.h"
 
 namespace dovetail::interaction {
 
@@ -83,15 +84,14 @@ std::string_view grasp_type_name(GraspType type) {
 
 /// Models of the meshes met, built once each and shared.
 struct Grasping::Models {
-  std::map<const collision::Mesh*, std::shared_ptr<const collision::CollisionModel>> collision;
+  /// The OBB trees (sliding's and the snap's), and how deep parts overlap.
+  OverlapGauge overlap;
   std::map<const collision::Mesh*, std::shared_ptr<const collision::DistanceModel>> distance;
   std::map<const collision::Mesh*, collision::Bounds> bounds;
 
   const std::shared_ptr<const collision::CollisionModel>& collision_model(
       const std::shared_ptr<const collision::Mesh>& mesh) {
-    auto& m = collision[mesh.get()];
-    if (!m) m = collision::build_model(collision::Method::kObb, mesh);
-    return m;
+    return overlap.model(mesh);
   }
   const std::shared_ptr<const collision::DistanceModel>& distance_shared(
       const std::shared_ptr<const collision::Mesh>& mesh) {
@@ -540,7 +540,7 @@ std::pair<std::string, Real> Grasping::deepest_overlap(const engine::Scene& scen
       if (!overlap(collision::transformed_bounds(models_->mesh_bounds(other_mesh), X_WB), box, 0)) {
         continue;
       }
-      const Real depth = overlap_.depth(mesh, X_WQ, other_mesh, X_WB);
+      const Real depth = models_->overlap.depth(mesh, X_WQ, other_mesh, X_WB);
       if (depth > deepest.second) deepest = {scene.name(other), depth};
     }
   }

@@ -23,17 +23,17 @@ Real OverlapGauge::depth(const std::shared_ptr<const collision::Mesh>& a, const 
   }
   Real deepest = 0;
   for (const collision::ContactPatch& patch :
-       collision::compute_contacts(model(a), model(b), X_AB)) {
+       collision::compute_contacts(*model(a), *model(b), X_AB)) {
     deepest = std::max(deepest, patch.depth);
   }
   return deepest;
 }
 
-const collision::CollisionModel& OverlapGauge::model(
+const std::shared_ptr<const collision::CollisionModel>& OverlapGauge::model(
     const std::shared_ptr<const collision::Mesh>& mesh) {
   auto& slot = models_[mesh.get()];
   if (!slot) slot = collision::build_model(collision::Method::kObb, mesh);
-  return *slot;
+  return slot;
 }
 
 const collision::ConvexHull* OverlapGauge::convex_hull(

@@ -25,7 +25,6 @@
 
 #include "dovetail/engine/simulation.h"
 #include "dovetail/interaction/hand.h"
-#include "dovetail/interaction/overlap.h"
 #include "dovetail/interaction/sliding.h"
 
 namespace dovetail::interaction {
@@ -216,7 +215,6 @@ class Grasping {
   std::vector<engine::PartId> contact_parts_;  ///< the parts of last_slide_'s obstacle ids
   InteractionStats stats_{};
   std::vector<RefusedSnap> refused_snaps_;
-  OverlapGauge overlap_;  ///< what a snap may not do
 };
 
 }  // namespace dovetail::interaction

@@ -32,8 +32,12 @@ class OverlapGauge {
   Real depth(const std::shared_ptr<const collision::Mesh>& a, const Transform& X_WA,
              const std::shared_ptr<const collision::Mesh>& b, const Transform& X_WB);
 
+  /// The mesh's OBB tree, built on first use: for callers that query the
+  /// same meshes otherwise too (sliding), so that each is built once.
+  const std::shared_ptr<const collision::CollisionModel>& model(
+      const std::shared_ptr<const collision::Mesh>& mesh);
+
  private:
-  const collision::CollisionModel& model(const std::shared_ptr<const collision::Mesh>& mesh);
   /// The hull of a convex part's mesh; null for a part that is not convex.
   const collision::ConvexHull* convex_hull(const std::shared_ptr<const collision::Mesh>& mesh);
 
