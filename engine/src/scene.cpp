@@ -153,15 +153,18 @@ std::vector<PartId> Scene::children(PartId part) const {
   return out;
 }
 
+bool Scene::descends_from(PartId part, PartId ancestor) const {
+  for (PartId p = part; p.valid(); p = slot(p).parent) {
+    if (p == ancestor) return true;
+  }
+  return false;
+}
+
 void Scene::set_parent(PartId part, PartId parent, bool keep_world_pose) {
   const Transform X_WP = world_pose(part);
-  if (parent.valid()) {
-    for (PartId p = parent; p.valid(); p = slot(p).parent) {
-      if (p == part) {
-        throw SceneError("scene: making " + in_quotes(name(parent)) + " the parent of " +
-                         in_quotes(name(part)) + " would make a cycle");
-      }
-    }
+  if (parent.valid() && descends_from(parent, part)) {
+    throw SceneError("scene: making " + in_quotes(name(parent)) + " the parent of " +
+                     in_quotes(name(part)) + " would make a cycle");
   }
   slot(part).parent = parent;
   touch();

@@ -378,7 +378,18 @@ void Grasping::carry(engine::Simulation& simulation) {
   const auto& mesh = scene.collision_mesh(part);
   const Transform X_WO = scene.world_pose(part);
   const Transform X_WO_target = guided(scene, *held_, engine::compose(hand_->X_WH(), X_HO_));
-  const collision::Bounds& local = models_->mesh_bounds(mesh);
+  // The parts attached to the held part move with it and are kept out of the others as it is.
+  std::vector<SlideAttachment> attached;
+  collision::Bounds local = models_->mesh_bounds(mesh);
+  for (const PartId q : scene.parts()) {
+    const auto& q_mesh = scene.collision_mesh(q);
+    if (q == part || !q_mesh || scene.has_tag(q, "hand") || !scene.descends_from(q, part)) continue;
+    const Transform X_OA = engine::compose(X_WO.inverse(), scene.world_pose(q));
+    attached.push_back({models_->collision_model(q_mesh), X_OA});
+    const collision::Bounds box = collision::transformed_bounds(models_->mesh_bounds(q_mesh), X_OA);
+    local.min = local.min.cwiseMin(box.min);
+    local.max = local.max.cwiseMax(box.max);
+  }
   // Obstacles: every other part that the swept box of the move reaches.
   collision::Bounds swept = collision::transformed_bounds(local, X_WO);
   const collision::Bounds to = collision::transformed_bounds(local, X_WO_target);
@@ -388,7 +399,7 @@ void Grasping::carry(engine::Simulation& simulation) {
   std::vector<PartId> handles;
   for (const PartId other : scene.parts()) {
     const auto& other_mesh = scene.collision_mesh(other);
-    if (other == part || !other_mesh || scene.has_tag(other, "hand")) continue;
+    if (!other_mesh || scene.has_tag(other, "hand") || scene.descends_from(other, part)) continue;
     const Transform X_WB = scene.world_pose(other);
     if (!overlap(collision::transformed_bounds(models_->mesh_bounds(other_mesh), X_WB), swept,
                  1e-3))
@@ -400,6 +411,7 @@ void Grasping::carry(engine::Simulation& simulation) {
   SlideRequest request;
   request.part = models_->collision_model(mesh);
   request.part_distance = models_->distance_shared(mesh);
+  request.attached = attached;
   request.p_PC = (local.min + local.max) / 2;
   request.size = std::max<Real>((local.max - local.min).norm() / 2, 1e-4);
   request.X_WP = X_WO;
@@ -516,12 +528,7 @@ std::pair<std::string, Real> Grasping::deepest_overlap(const engine::Scene& scen
                                                        const Transform& X_WP) {
   // The part and the parts attached to it move together, rigidly: each by
   // the same move, and none is checked against another of them.
-  const auto in_family = [&](PartId other) {
-    for (PartId p = other; p.valid(); p = scene.parent(p)) {
-      if (p == part) return true;
-    }
-    return false;
-  };
+  const auto in_family = [&](PartId other) { return scene.descends_from(other, part); };
   const Transform move = engine::compose(X_WP, scene.world_pose(part).inverse());
   std::vector<std::pair<PartId, Transform>> moved;
   for (const PartId q : scene.parts()) {

@@ -27,35 +27,50 @@ Transform moved(const Transform& X, const Vec3& c, const Vec3& v, const Vec3& w)
 
 using Triangle = std::array<Vec3, 3>;
 
+/// The bodies that move in a step: the sliding part (body 0) and the parts
+/// attached to it (body i is attachment i - 1), rigidly together.
+std::size_t body_count(const SlideRequest& request) { return 1 + request.attached.size(); }
+const std::shared_ptr<const collision::CollisionModel>& body_model(const SlideRequest& request,
+                                                                   std::size_t body) {
+  return body == 0 ? request.part : request.attached[body - 1].model;
+}
+/// Body `body`'s pose in the world when the sliding part is at X_WP.
+Transform body_pose(const SlideRequest& request, std::size_t body, const Transform& X_WP) {
+  return body == 0 ? X_WP : engine::compose(X_WP, request.attached[body - 1].X_PA);
+}
+
 /// Where a pose of the part collides: the first intersecting triangle pair
-/// that an obstacle's query found (the obstacle's triangle, the part's).
+/// that an obstacle's query found (the obstacle's triangle, the body's).
 struct Hit {
   std::size_t obstacle = 0;  ///< index into the request's obstacles
+  std::size_t body = 0;      ///< which of the moving bodies
   collision::TrianglePair pair;
 };
 
 /// Most triangle pairs of one patch whose closest points are measured.
 constexpr std::size_t kPairsPerPatch = 64;
 
-/// The contacts met between the last free pose and the colliding one. The
-/// contact patches of the colliding pose X_WP_hit say where the part meets
-/// each obstacle and how (their kind: face, curve, point); for each patch's
-/// triangle pairs, the closest points of the two triangles at the free pose
-/// X_WP_free, a hair's breadth away, give a contact point and the normal from
-/// the obstacle's triangle toward the part's: the face normal for a vertex or
-/// an edge on a face, the common perpendicular for two edges. A patch keeps
-/// its distinct normals (1 degree apart), each at the point of its pair.
-void contacts_at(const SlideRequest& request, const Transform& X_WP_free, const Transform& X_WP_hit,
-                 std::vector<SlideContact>& out, int& queries) {
-  const collision::Mesh& part_mesh = request.part->mesh();
+/// The contacts of one moving body met between its last free pose and the
+/// colliding one. The contact patches of the colliding pose X_WB_hit say
+/// where the body meets each obstacle and how (their kind: face, curve,
+/// point); for each patch's triangle pairs, the closest points of the two
+/// triangles at the free pose X_WB_free, a hair's breadth away, give a
+/// contact point and the normal from the obstacle's triangle toward the
+/// body's: the face normal for a vertex or an edge on a face, the common
+/// perpendicular for two edges. A patch keeps its distinct normals (1 degree
+/// apart), each at the point of its pair.
+void contacts_of_body(const SlideRequest& request, std::size_t body, const Transform& X_WB_free,
+                      const Transform& X_WB_hit, std::vector<SlideContact>& out, int& queries) {
+  const std::shared_ptr<const collision::CollisionModel>& model = body_model(request, body);
+  const collision::Mesh& body_mesh = model->mesh();
   for (const SlideObstacle& o : request.obstacles) {
-    const Transform X_OP = engine::compose(o.X_WO.inverse(), X_WP_hit);
+    const Transform X_OB = engine::compose(o.X_WO.inverse(), X_WB_hit);
     ++queries;
     const std::vector<collision::ContactPatch> patches = collision::compute_contacts(
-        *o.model, *request.part, X_OP,
+        *o.model, *model, X_OB,
         {.estimate_depth = false,
          .nearly_coplanar_pairs = false,
-         .front = request.fronts ? &request.fronts->of(o.model, request.part) : nullptr});
+         .front = request.fronts ? &request.fronts->of(o.model, model) : nullptr});
     const collision::Mesh& obstacle_mesh = o.model->mesh();
     for (const collision::ContactPatch& patch : patches) {
       const std::size_t first = out.size();
@@ -66,7 +81,7 @@ void contacts_at(const SlideRequest& request, const Transform& X_WP_free, const 
         Triangle ta, tb;
         for (int k = 0; k < 3; ++k) {
           ta[k] = o.X_WO.apply(obstacle_mesh.vertices[obstacle_mesh.triangles[pair.a][k]]);
-          tb[k] = X_WP_free.apply(part_mesh.vertices[part_mesh.triangles[pair.b][k]]);
+          tb[k] = X_WB_free.apply(body_mesh.vertices[body_mesh.triangles[pair.b][k]]);
         }
         const collision::TrianglePairDistance d = collision::triangle_pair_distance(ta, tb);
         if (!(d.distance > 0)) continue;  // still touching at the free pose: no direction
@@ -84,17 +99,27 @@ void contacts_at(const SlideRequest& request, const Transform& X_WP_free, const 
   }
 }
 
+/// contacts_of_body for each moving body, the sliding part moving from X_WP_free to X_WP_hit.
+void contacts_at(const SlideRequest& request, const Transform& X_WP_free, const Transform& X_WP_hit,
+                 std::vector<SlideContact>& out, int& queries) {
+  for (std::size_t body = 0; body < body_count(request); ++body) {
+    contacts_of_body(request, body, body_pose(request, body, X_WP_free),
+                     body_pose(request, body, X_WP_hit), out, queries);
+  }
+}
+
 /// The contact of one colliding triangle pair, measured at the free pose X_WP_free as in
 /// contacts_at; nothing when the pair still touches there.
 std::optional<SlideContact> pair_contact(const SlideRequest& request, const Hit& hit,
                                          const Transform& X_WP_free) {
   const SlideObstacle& o = request.obstacles[hit.obstacle];
   const collision::Mesh& obstacle_mesh = o.model->mesh();
-  const collision::Mesh& part_mesh = request.part->mesh();
+  const collision::Mesh& body_mesh = body_model(request, hit.body)->mesh();
+  const Transform X_WB_free = body_pose(request, hit.body, X_WP_free);
   Triangle ta, tb;
   for (int k = 0; k < 3; ++k) {
     ta[k] = o.X_WO.apply(obstacle_mesh.vertices[obstacle_mesh.triangles[hit.pair.a][k]]);
-    tb[k] = X_WP_free.apply(part_mesh.vertices[part_mesh.triangles[hit.pair.b][k]]);
+    tb[k] = X_WB_free.apply(body_mesh.vertices[body_mesh.triangles[hit.pair.b][k]]);
   }
   const collision::TrianglePairDistance d = collision::triangle_pair_distance(ta, tb);
   if (!(d.distance > 0)) return std::nullopt;
@@ -118,14 +143,24 @@ std::optional<Hit> first_hit(const collision::CollisionModel& part, const Transf
     // then the same with fronts and without.
     const collision::CollideResult r =
         o.model->collide(part, X_OP, {.front = front, .nearer_first = false});
-    if (r.colliding) return Hit{i, r.pairs.front()};
+    if (r.colliding) return Hit{.obstacle = i, .pair = r.pairs.front()};
   }
   return std::nullopt;
 }
 
-/// first_hit for the request's part and obstacles, from its fronts.
+/// first_hit for each of the request's moving bodies in turn against its
+/// obstacles, from its fronts, the sliding part at X_WP.
 std::optional<Hit> first_hit(const SlideRequest& request, const Transform& X_WP, int& queries) {
-  return first_hit(*request.part, X_WP, request.obstacles, &queries, request.part, request.fronts);
+  for (std::size_t body = 0; body < body_count(request); ++body) {
+    const std::shared_ptr<const collision::CollisionModel>& model = body_model(request, body);
+    std::optional<Hit> hit = first_hit(*model, body_pose(request, body, X_WP), request.obstacles,
+                                       &queries, model, request.fronts);
+    if (hit) {
+      hit->body = body;
+      return hit;
+    }
+  }
+  return std::nullopt;
 }
 
 /// Whether the one triangle pair of `hit` intersects with the part at X_WP:
@@ -199,7 +234,8 @@ Bracket bracket_guided(const SlideRequest& request, const Move& motion, Hit hit,
     while (motion.reach(b.hit - lo, request.size) > settings.resolution_m) {
       const Real mid = (lo + b.hit) / 2;
       if (mid <= lo || mid >= b.hit) break;  // no double left between them
-      (pair_collides(*request.part, motion.at(mid), request.obstacles[hit.obstacle], hit.pair)
+      (pair_collides(*body_model(request, hit.body), body_pose(request, hit.body, motion.at(mid)),
+                     request.obstacles[hit.obstacle], hit.pair)
            ? b.hit
            : lo) = mid;
     }
@@ -219,10 +255,15 @@ Bracket bracket_guided(const SlideRequest& request, const Move& motion, Hit hit,
 bool same_bits(const Transform& a, const Transform& b) { return a.R == b.R && a.t == b.t; }
 
 /// Whether `proof` shows the request's starting pose collision-free: the same part model at
-/// the same pose, and every obstacle's model at the same pose among those it was proved against.
+/// the same pose with the same attachments, and every obstacle's model at the same pose among
+/// those it was proved against.
 bool proves_free(const SlideProof* proof, const SlideRequest& request) {
   if (!proof || !proof->part || proof->part != request.part ||
-      !same_bits(proof->X_WP, request.X_WP)) {
+      !same_bits(proof->X_WP, request.X_WP) ||
+      !std::equal(proof->attached.begin(), proof->attached.end(), request.attached.begin(),
+                  request.attached.end(), [](const SlideAttachment& a, const SlideAttachment& b) {
+                    return a.model == b.model && same_bits(a.X_PA, b.X_PA);
+                  })) {
     return false;
   }
   return std::all_of(request.obstacles.begin(), request.obstacles.end(),
@@ -245,21 +286,24 @@ std::optional<Transform> off_touching(const SlideRequest& request, const Sliding
                                       std::vector<SlideContact>& touching, int& queries) {
   const Vec3 c = request.X_WP.apply(request.p_PC);
   std::vector<Motion> constraints;
-  for (const SlideObstacle& o : request.obstacles) {
-    const Transform X_OP = engine::compose(o.X_WO.inverse(), request.X_WP);
-    ++queries;
-    for (const collision::ContactPatch& patch :
-         collision::compute_contacts(*o.model, *request.part, X_OP)) {
-      if (patch.penetrating) return std::nullopt;
-      SlideContact k;
-      k.obstacle = o.id;
-      k.p_W = o.X_WO.apply(patch.point);
-      k.n_W = o.X_WO.R * patch.normal;
-      k.kind = patch.kind;
-      Motion a;
-      a << k.n_W, (k.p_W - c).cross(k.n_W);
-      constraints.push_back(a);
-      touching.push_back(k);
+  for (std::size_t body = 0; body < body_count(request); ++body) {
+    const Transform X_WB = body_pose(request, body, request.X_WP);
+    for (const SlideObstacle& o : request.obstacles) {
+      const Transform X_OB = engine::compose(o.X_WO.inverse(), X_WB);
+      ++queries;
+      for (const collision::ContactPatch& patch :
+           collision::compute_contacts(*o.model, *body_model(request, body), X_OB)) {
+        if (patch.penetrating) return std::nullopt;
+        SlideContact k;
+        k.obstacle = o.id;
+        k.p_W = o.X_WO.apply(patch.point);
+        k.n_W = o.X_WO.R * patch.normal;
+        k.kind = patch.kind;
+        Motion a;
+        a << k.n_W, (k.p_W - c).cross(k.n_W);
+        constraints.push_back(a);
+        touching.push_back(k);
+      }
     }
   }
   if (constraints.empty()) return std::nullopt;
@@ -526,8 +570,9 @@ SlideResult slide(const SlideRequest& request, const SlidingSettings& settings) 
   // Every pose the step accepted was found free against all the obstacles.
   result.proof.part = request.part;
   result.proof.X_WP = result.X_WP;
+  result.proof.attached.assign(request.attached.begin(), request.attached.end());
   result.proof.obstacles.assign(request.obstacles.begin(), request.obstacles.end());
-  if (request.fronts) request.fronts->keep_only(request.obstacles, request.part);
+  if (request.fronts) request.fronts->keep_only(request.obstacles, request.part, request.attached);
   return result;
 }
 
@@ -542,9 +587,12 @@ collision::SeparationFront& SlideFronts::of(
 }
 
 void SlideFronts::keep_only(std::span<const SlideObstacle> obstacles,
-                            const std::shared_ptr<const collision::CollisionModel>& part) {
+                            const std::shared_ptr<const collision::CollisionModel>& part,
+                            std::span<const SlideAttachment> attached) {
   std::erase_if(fronts_, [&](const Kept& k) {
-    return k.part != part ||
+    return (k.part != part &&
+            std::none_of(attached.begin(), attached.end(),
+                         [&](const SlideAttachment& a) { return a.model == k.part; })) ||
            std::none_of(obstacles.begin(), obstacles.end(),
                         [&](const SlideObstacle& o) { return o.model == k.obstacle; });
   });

@@ -292,7 +292,9 @@ std::vector<Word> make_vocabulary() {
                WordKind::kAction,
                {{"part", kPart, kRequired, "the part"},
                 {"to", kPart, kRequired, "the part it moves with from now on"}},
-               "Fixes the part to another; it keeps its place and moves with it.",
+               "Fixes the part to another; it keeps its place and moves with it. While the "
+               "hand carries that part, the attached part is kept out of the others as the "
+               "carried part is: it slides on them or holds the carried part back.",
                "attach(\"nut\", \"bolt\")"});
   w.push_back({"detach",
                WordKind::kAction,

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <optional>
 
 #include "../support/temp_dir.h"
 #include "dovetail/collision/contacts.h"
@@ -27,22 +29,27 @@ constexpr Real kHoleDepth = 0.040;
 constexpr Real kPegLength = 0.060;
 constexpr Real kBlockTop = 0.03;
 
+/// A box attached to the peg: its half extents and its centre in the peg's
+/// frame (z points down the peg, z = 0 at its top).
+struct Tab {
+  Vec3 half;
+  Vec3 p_PT;
+};
+
 /// The block (fixed, hole axis along y, opening at y = kBlockTop) and the peg
 /// (a cylinder along its z axis from 0 to kPegLength, turned so z points down).
 /// With a pebble of height `pebble` (a fixed 8 mm box) on the hole's bottom,
-/// and with `tab`, a 4 mm box beside the peg, 17 mm off its axis and 21 mm
-/// below its top (attached to it by run_peg), which ends 3 mm deep in the
-/// block's top face when the peg is seated.
+/// and with a box "tab" (attached to the peg by run_peg).
 engine::Scene peg_and_block(const Transform& X_WPeg, int sides = 64, Real pebble = 0,
-                            bool tab = false) {
+                            const std::optional<Tab>& tab = std::nullopt) {
   engine::Scene scene;
   if (tab) {
-    Transform X_PT;  // in the peg's frame: its z axis points down, z = 0 at its top
-    X_PT.t = Vec3(0.017, 0, 0.021);
-    scene.add_part({.name = "tab",
-                    .X_QP = engine::compose(X_WPeg, X_PT),
-                    .render_mesh = std::make_shared<const collision::Mesh>(
-                        collision::make_box(Vec3(0.002, 0.002, 0.002)))});
+    Transform X_PT;
+    X_PT.t = tab->p_PT;
+    scene.add_part(
+        {.name = "tab",
+         .X_QP = engine::compose(X_WPeg, X_PT),
+         .render_mesh = std::make_shared<const collision::Mesh>(collision::make_box(tab->half))});
   }
   if (pebble > 0) {
     Transform X;
@@ -78,6 +85,7 @@ struct PegRun {
   Real max_depth = 0;
   bool ever_colliding = false;
   Transform X_WPeg;
+  Transform X_WTab;  ///< when there is a tab
   std::uint64_t state_hash = 0;
   Real max_stretch = 0;
   std::vector<GloveSample> recorded;  ///< the glove samples the run used
@@ -85,11 +93,24 @@ struct PegRun {
   std::vector<RefusedSnap> refused;
 };
 
+struct PegSetup {
+  Real offset = 0.0015;  ///< the peg's start off the hole's axis
+  Real tilt_deg = -2;    ///< and tilted about z
+  bool noise = false;    ///< glove noise
+  int threads = 1;
+  bool measure_depth = true;  ///< of the peg (and the tab) in the block, every frame
+  int sides = 64;             ///< of the hole
+  std::shared_ptr<const GloveSource> replay = nullptr;  ///< instead of the simulated glove
+  Real pebble = 0;                                      ///< on the hole's bottom
+  bool guide = true;                                    ///< the mate's guidance
+  std::optional<Tab> tab = std::nullopt;                ///< attached to the peg
+};
+
 /// The hand holds the peg from the start, carries it 90 mm down along the
 /// hole's axis (20 mm past the bottom) in 2 s, waits, and opens.
-PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool measure_depth = true,
-               int sides = 64, std::shared_ptr<const GloveSource> replay = nullptr, Real pebble = 0,
-               bool guide = true, bool tab = false) {
+PegRun run_peg(const PegSetup& setup) {
+  const auto& [offset, tilt_deg, noise, threads, measure_depth, sides, replay, pebble, guide, tab] =
+      setup;
   const Transform X_WPeg0 = peg_start(offset, tilt_deg);
   engine::Simulation sim(
       peg_and_block(X_WPeg0, sides, pebble, tab),
@@ -133,8 +154,13 @@ PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool mea
 
   const auto block = collision::build_model(collision::Method::kObb,
                                             sim.scene().collision_mesh(sim.scene().get("block")));
-  const auto peg = collision::build_model(collision::Method::kObb,
-                                          sim.scene().collision_mesh(sim.scene().get("peg")));
+  std::vector<std::pair<std::string, std::shared_ptr<const collision::CollisionModel>>> moving;
+  for (const char* name : {"peg", "tab"}) {
+    const engine::PartId p = sim.scene().find(name);
+    if (!p.valid()) continue;
+    moving.emplace_back(
+        name, collision::build_model(collision::Method::kObb, sim.scene().collision_mesh(p)));
+  }
   PegRun run;
   for (int frame = 0; frame < 270; ++frame) {
     const engine::FrameResult& r = sim.step();
@@ -142,14 +168,17 @@ PegRun run_peg(Real offset, Real tilt_deg, bool noise, int threads = 1, bool mea
     if (!measure_depth) continue;
     // Penetration every frame, by the collision layer's contact depth.
     const Transform X_WB = sim.scene().world_pose("block");
-    const Transform X_WP = sim.scene().world_pose("peg");
-    const Transform X_BP{X_WB.R.transpose() * X_WP.R, X_WB.R.transpose() * (X_WP.t - X_WB.t)};
-    for (const collision::ContactPatch& patch : collision::compute_contacts(*block, *peg, X_BP)) {
-      run.ever_colliding = true;
-      run.max_depth = std::max(run.max_depth, patch.depth);
+    for (const auto& [name, model] : moving) {
+      const Transform X_BP = engine::compose(X_WB.inverse(), sim.scene().world_pose(name));
+      for (const collision::ContactPatch& patch :
+           collision::compute_contacts(*block, *model, X_BP)) {
+        run.ever_colliding = true;
+        run.max_depth = std::max(run.max_depth, patch.depth);
+      }
     }
   }
   run.X_WPeg = sim.scene().world_pose("peg");
+  if (tab) run.X_WTab = sim.scene().world_pose("tab");
   run.state_hash = sim.state_hash();
   run.max_stretch = grasping.stats().max_stretch_m;
   run.recorded = hand.recorded();
@@ -177,22 +206,23 @@ void expect_in_the_hole(const PegRun& run) {
 }
 
 TEST(PegInHole, SlidesInWithAnOffsetAndATiltAndSnaps) {
-  const PegRun run = run_peg(0.0015, -2, false);
+  const PegRun run = run_peg({});
   expect_in_the_hole(run);
 }
 
 TEST(PegInHole, GoesInWithGloveNoise) {
-  const PegRun run = run_peg(0.0015, -2, true);
+  const PegRun run = run_peg({.noise = true});
   expect_in_the_hole(run);
 }
 
 TEST(PegInHole, ARecordedRunReplaysFromItsTraceIdenticallyAtAnyThreadCount) {
-  const PegRun original = run_peg(0.0015, -2, true, 1, false);
+  const PegRun original = run_peg({.noise = true, .measure_depth = false});
   const test::TempDir dir("dovetail_peg");
   write_trace(dir / "peg.csv", original.recorded);
   const auto trace = std::make_shared<TraceSource>(read_trace(dir / "peg.csv"));
   for (const int threads : {1, 2, 8}) {
-    const PegRun replay = run_peg(0.0015, -2, true, threads, false, 64, trace);
+    const PegRun replay =
+        run_peg({.noise = true, .threads = threads, .measure_depth = false, .replay = trace});
     EXPECT_EQ(replay.state_hash, original.state_hash) << threads << " threads";
     EXPECT_EQ(replay.report, original.report) << threads << " threads";
   }
@@ -202,7 +232,7 @@ TEST(PegInHole, ARecordedRunReplaysFromItsTraceIdenticallyAtAnyThreadCount) {
 TEST(PegInHole, APegFarOffTheHoleIsLeftBehindNotPushedThrough) {
   // 5 mm off the axis, outside the mate's capture: the peg lands on the block's
   // top face and stays there while the hand goes on down, until the band breaks.
-  const PegRun run = run_peg(0.005, 0, false);
+  const PegRun run = run_peg({.offset = 0.005, .tilt_deg = 0});
   EXPECT_TRUE(has(run.events, EventKind::kRelease, "peg", "overstretched"));
   EXPECT_FALSE(has(run.events, EventKind::kMate, "peg", "block"));
   EXPECT_LT(run.max_depth, 1e-5);
@@ -215,7 +245,7 @@ TEST(PegInHole, APegStoppedShortByAPebbleIsNotSnappedThroughIt) {
   // A 1.5 mm pebble on the hole's bottom: the peg stops on it, within the
   // mate's 2 mm tolerance, and is released there. Seated, it would overlap
   // the pebble by 1.5 mm, so it stays where it is and the refusal says why.
-  const PegRun run = run_peg(0.0015, -2, false, 1, true, 64, nullptr, 0.0015);
+  const PegRun run = run_peg({.pebble = 0.0015});
   EXPECT_TRUE(has(run.events, EventKind::kRelease, "peg", "opened"));
   EXPECT_FALSE(has(run.events, EventKind::kMate, "peg", "block"));
   ASSERT_EQ(run.refused.size(), 1u);
@@ -233,29 +263,68 @@ TEST(PegInHole, WithoutGuidanceAPegOffTheAxisStaysOnTheRim) {
   // The mate's guidance is what draws the peg 1.5 mm off the axis into the
   // hole with 0.25 mm clearance; without it (a hole without a chamfer) the
   // peg lands on the rim and is left behind, never pushed through.
-  const PegRun run = run_peg(0.0015, -2, false, 1, true, 64, nullptr, 0, /*guide=*/false);
+  const PegRun run = run_peg({.guide = false});
   EXPECT_FALSE(has(run.events, EventKind::kMate, "peg", "block"));
   EXPECT_LT(run.max_depth, 1e-5);
   EXPECT_GE(run.X_WPeg.apply(Vec3(0, 0, kPegLength)).y(), kBlockTop - 1e-3);
 }
 
+/// A 4 mm box beside the peg, 17 mm off its axis, whose lower face is `short_of_seat` above
+/// the block's top face when the peg is seated (negative: in it).
+Tab tab_beside(Real short_of_seat) {
+  return {Vec3(0.002, 0.002, 0.002),
+          Vec3(0.017, 0, kPegLength - kHoleDepth - 0.002 - short_of_seat)};
+}
+
+TEST(PegInHole, APartAttachedToThePegStopsItWhereTheAttachedPartMeetsTheBlock) {
+  // The tab would end 3 mm deep in the block's top face: it lands on the face
+  // and holds the peg 3 mm short of its seat, outside the mate's 2 mm
+  // tolerance, so the peg is released there and not snapped.
+  const PegRun run = run_peg({.offset = 0, .tilt_deg = 0, .tab = tab_beside(-0.003)});
+  EXPECT_TRUE(has(run.events, EventKind::kRelease, "peg", "opened"));
+  EXPECT_FALSE(has(run.events, EventKind::kMate, "peg", "block"));
+  EXPECT_TRUE(run.refused.empty());
+  EXPECT_LT(run.max_depth, 1e-5) << "the tab or the peg in the block";
+  // The tab rests on the face; the peg, held up by it, is about 3 mm short
+  // (tilted a little about the tab until it meets the hole's wall).
+  Real tab_low = std::numeric_limits<Real>::infinity();
+  for (const Vec3& v : collision::make_box(Vec3(0.002, 0.002, 0.002)).vertices) {
+    tab_low = std::min(tab_low, run.X_WTab.apply(v).y());
+  }
+  EXPECT_GE(tab_low, kBlockTop);
+  EXPECT_LT(tab_low, kBlockTop + 1e-5);
+  const Vec3 bottom = run.X_WPeg.apply(Vec3(0, 0, kPegLength));
+  EXPECT_NEAR(bottom.y(), kBlockTop - kHoleDepth + 0.003, 5e-4);
+}
+
 TEST(PegInHole, APartAttachedToThePegIsCheckedBeforeTheSnapToo) {
-  // A tab attached beside the peg ends in the block's top face (nothing
-  // stops an attached part on the way): the peg itself would seat cleanly,
-  // but the snap, which moves the tab with it, is refused, naming the block.
-  const PegRun run = run_peg(0, 0, false, 1, false, 64, nullptr, 0, true, /*tab=*/true);
+  // The tab would end 1 mm deep in the block's top face: it holds the peg
+  // 1 mm short of its seat, within the mate's tolerance; the peg itself would
+  // seat cleanly, but the snap, which moves the tab with it, is refused,
+  // naming the block.
+  const PegRun run = run_peg({.offset = 0, .tilt_deg = 0, .tab = tab_beside(-0.001)});
   EXPECT_TRUE(has(run.events, EventKind::kRelease, "peg", "opened"));
   EXPECT_FALSE(has(run.events, EventKind::kMate, "peg", "block"));
   ASSERT_EQ(run.refused.size(), 1u);
   EXPECT_EQ(run.refused[0].blocker, "block");
-  EXPECT_NEAR(run.refused[0].depth_m, 0.003, 1e-4);
+  EXPECT_NEAR(run.refused[0].depth_m, 0.001, 1e-4);
+  EXPECT_LT(run.max_depth, 1e-5) << "the tab or the peg in the block";
+}
+
+TEST(PegInHole, APartAttachedToThePegAndTouchingItGoesAlong) {
+  // A box pressed against the peg's side near its top (touching it, never
+  // reaching the block): no obstacle to the peg, which slides in and seats
+  // with the box.
+  const PegRun run =
+      run_peg({.tab = Tab{Vec3(0.002, 0.002, 0.002), Vec3(kPegRadius + 0.002, 0, 0.002)}});
+  expect_in_the_hole(run);
 }
 
 TEST(PegInHole, ACoarselyTessellatedHoleStillTakesThePeg) {
   // 12 flat walls whose flats lie on the hole's radius (corners 3.5 % further out): the
   // peg, 64 facets inscribed in its radius, fits with the same 0.25 mm clearance at the
   // flats, so it still slides in and mates.
-  const PegRun run = run_peg(0.0015, -2, false, 1, true, 12);
+  const PegRun run = run_peg({.sides = 12});
   expect_in_the_hole(run);
 }
 

@@ -105,6 +105,9 @@ class Scene {
   PartId parent(PartId part) const;
   /// Direct children, in name order.
   std::vector<PartId> children(PartId part) const;
+  /// Whether `part` is `ancestor` or is attached to it, directly or through
+  /// other parts: it moves when `ancestor` does.
+  bool descends_from(PartId part, PartId ancestor) const;
   /// Re-parents `part` (an invalid `parent` means the world). With
   /// keep_world_pose the local pose is changed so the part stays where it
   /// is; otherwise the local pose is kept. Throws SceneError on a cycle.

@@ -96,6 +96,14 @@ struct SlideContact {
   Real separation = 0;
 };
 
+/// A part attached to the sliding part: it moves with it, rigidly, and is kept
+/// out of the obstacles as the sliding part is (a collar fixed on a peg stops
+/// on the block's face where the peg alone would go on into the hole).
+struct SlideAttachment {
+  std::shared_ptr<const collision::CollisionModel> model;  ///< exact-level model (kObb)
+  Transform X_PA{};                                        ///< its pose in the sliding part's frame
+};
+
 /// A contact the part has moved this far away from is forgotten (metres).
 inline constexpr Real kContactExpiry = 1e-4;
 
@@ -105,7 +113,8 @@ inline constexpr Real kContactExpiry = 1e-4;
 struct SlideProof {
   std::shared_ptr<const collision::CollisionModel> part;  ///< null: nothing proved
   Transform X_WP{};
-  std::vector<SlideObstacle> obstacles;  ///< their models and poses (ids do not matter)
+  std::vector<SlideAttachment> attached;  ///< with these attached, at these poses
+  std::vector<SlideObstacle> obstacles;   ///< their models and poses (ids do not matter)
 };
 
 /// What the steps of one sliding part keep of each obstacle between their
@@ -123,9 +132,11 @@ class SlideFronts {
   /// (obstacles of one model share it: exact all the same, less to gain).
   collision::SeparationFront& of(const std::shared_ptr<const collision::CollisionModel>& obstacle,
                                  const std::shared_ptr<const collision::CollisionModel>& part);
-  /// Forgets the fronts of every obstacle not in `obstacles` or of another part.
+  /// Forgets the fronts of every obstacle not in `obstacles` and of every part
+  /// other than `part` and its attachments.
   void keep_only(std::span<const SlideObstacle> obstacles,
-                 const std::shared_ptr<const collision::CollisionModel>& part);
+                 const std::shared_ptr<const collision::CollisionModel>& part,
+                 std::span<const SlideAttachment> attached = {});
   void clear() { fronts_.clear(); }
   std::size_t size() const { return fronts_.size(); }
 
@@ -142,10 +153,15 @@ class SlideFronts {
 struct SlideRequest {
   std::shared_ptr<const collision::CollisionModel> part;          ///< the sliding part (kObb)
   std::shared_ptr<const collision::DistanceModel> part_distance;  ///< of the same mesh
+  /// The parts attached to it (not among the obstacles): they move with it
+  /// and collide as it does. Its centre and size are then those of the whole.
+  std::span<const SlideAttachment> attached;
   Vec3 p_PC = Vec3::Zero();  ///< its centre in its own frame (the point it turns about)
-  Real size = 0.05;          ///< its size L in metres (weights turning against moving)
-  Transform X_WP{};          ///< where it is: collision-free
-  Transform X_WP_target{};   ///< where the hand wants it
+  /// Its size L in metres: weights turning against moving, and no point of it
+  /// (or of what is attached) is further than L from the centre.
+  Real size = 0.05;
+  Transform X_WP{};         ///< where it is: collision-free
+  Transform X_WP_target{};  ///< where the hand wants it
   std::span<const SlideObstacle> obstacles;
   /// The contacts of the last step (SlideResult::contacts): the part is
   /// still against them, so they constrain the first move of this step and
