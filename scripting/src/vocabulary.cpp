@@ -348,8 +348,9 @@ std::vector<Word> make_vocabulary() {
                {{"depth", kLength, kRequired, "the deepest allowed, in the scenario's units"}},
                "No two parts ever overlap deeper than this, measured every frame: for two "
                "convex parts the exact penetration depth (the shortest move that parts them), "
-               "otherwise the deepest vertex of one inside the other, which misses parts that "
-               "cross with no vertex inside (check those with no_contact). The hand's segments "
+               "otherwise the deepest point of one's edges inside the other, which misses an "
+               "overlap deepest in the middle of a face (check touching with no_contact). The "
+               "hand's segments "
                "are not counted.",
                "max_penetration(0.01)"});
   w.push_back({"no_contact",

@@ -318,36 +318,57 @@ TEST(Contacts, DepthOfCurvedAndShallowOverlaps) {
 }
 
 /// Independent reference for the depth of closed parts: the largest distance
-/// to the other's surface of a vertex of either part inside the other
-/// (every vertex tested, every triangle measured), in A's frame.
-Real deepest_vertex_inside(const Mesh& a, const Mesh& b, const Transform& X_AB) {
-  const auto one_way = [](const Mesh& part, const Transform& X_AP, const Mesh& other,
-                          const Transform& X_AO) {
-    std::vector<Vec3> other_A;
-    for (const Vec3& v : other.vertices) other_A.push_back(X_AO.apply(v));
-    const Mesh placed = make_mesh(other_A, other.triangles, "placed");
+/// to the other's surface of a point of either part's edges inside the other
+/// (every vertex, and points every `spacing` along every edge, located
+/// exactly; every triangle measured), in A's frame. 0 spacing: vertices only.
+Real deepest_edge_point_inside(const Mesh& a, const Mesh& b, const Transform& X_AB,
+                               Real spacing = 0) {
+  const auto one_way = [spacing](const Mesh& part, const Transform& X_AP, const Mesh& other,
+                                 const Transform& X_AO) {
+    const PointLocator locator(other, X_AO);
+    Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity()), hi = -lo;
+    std::vector<detail::TriangleVertices> surface;
+    for (const TriangleIndices& f : other.triangles) {
+      surface.push_back({X_AO.apply(other.vertices[f[0]]), X_AO.apply(other.vertices[f[1]]),
+                         X_AO.apply(other.vertices[f[2]])});
+      for (const Vec3& v : surface.back()) {
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+      }
+    }
     Real best = 0;
-    for (const Vec3& v : part.vertices) {
-      const Vec3 p = X_AP.apply(v);
-      if (!point_inside(placed, p)) continue;
+    const auto measure = [&](const Vec3& p) {
+      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) return;
+      if (locator.locate(p) != PointLocation::kInside) return;
       Real nearest = std::numeric_limits<Real>::infinity();
-      for (const TriangleIndices& f : placed.triangles) {
-        const detail::TriangleVertices t{placed.vertices[f[0]], placed.vertices[f[1]],
-                                         placed.vertices[f[2]]};
+      for (const detail::TriangleVertices& t : surface) {
         nearest = std::min(nearest, (p - detail::closest_point_on_triangle(p, t)).norm());
       }
       best = std::max(best, nearest);
+    };
+    for (const Vec3& v : part.vertices) measure(X_AP.apply(v));
+    if (spacing == 0) return best;
+    for (const TriangleIndices& f : part.triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 p = X_AP.apply(part.vertices[f[k]]);
+        const Vec3 q = X_AP.apply(part.vertices[f[(k + 1) % 3]]);
+        const int n = static_cast<int>(std::ceil((q - p).norm() / spacing));
+        for (int i = 1; i < n; ++i) measure(p + (q - p) * (Real(i) / n));
+      }
     }
     return best;
   };
   return std::max(one_way(b, X_AB, a, Transform()), one_way(a, Transform(), b, X_AB));
 }
 
-TEST(Contacts, DepthEqualsTheDeepestVertexInsideOnTurnedBoxes) {
+TEST(Contacts, DepthEqualsTheDeepestPointInsideOnTurnedBoxes) {
   // A unit box at random rotations with one corner on a slab's top face and
-  // the lowest corner inside, the others out or nearly on the face: the
-  // depth must be the independent reference's (a corner within rounding of
-  // the face once read as the whole box's height).
+  // the lowest corner inside, the others out or nearly on the face (or
+  // through the slab's bottom): the depth must be the independent
+  // reference's (a corner within rounding of the face once read as the
+  // whole box's height). Vertices are located exactly; the deepest point of
+  // an edge is searched to a thousandth of the depth and sampled by the
+  // reference every 0.001.
   const Mesh box = make_box(Vec3(0.5, 0.5, 0.5));
   const Mesh slab = make_box(Vec3(5, 5, 0.5));
   const auto box_model = model(box), slab_model = model(slab);
@@ -366,7 +387,9 @@ TEST(Contacts, DepthEqualsTheDeepestVertexInsideOnTurnedBoxes) {
     if (patches.empty()) continue;
     Real depth = 0;
     for (const ContactPatch& p : patches) depth = std::max(depth, p.depth);
-    EXPECT_NEAR(depth, deepest_vertex_inside(box, slab, X_AB), 1e-9) << "case " << i;
+    const Real reference = deepest_edge_point_inside(box, slab, X_AB, 1e-3);
+    EXPECT_LE(depth, reference + 1e-3 / 2 + 1e-9) << "case " << i;
+    EXPECT_GE(depth, reference - 1e-3 * reference - 1e-9) << "case " << i;
     ++compared;
   }
   EXPECT_GT(compared, 100);
@@ -384,6 +407,41 @@ TEST(Contacts, DepthEqualsTheDeepestVertexInsideOnTurnedBoxes) {
   ASSERT_EQ(other.size(), 1u);
   EXPECT_NEAR(one[0].depth, 0.01, 1e-12);
   EXPECT_NEAR(other[0].depth, 0.01, 1e-12);
+}
+
+TEST(Contacts, PartsThatCrossWithNoVertexInsideHaveTheDepthOfTheirEdges) {
+  // A square rod (0.2 across, 4 long) through a slab 1 thick, turned 30
+  // degrees about y and shifted off the slab's triangle diagonals: no vertex
+  // of either is inside the other, yet the rod's long edges cross the slab,
+  // and their deepest points are at its mid-plane, 0.5 from both faces.
+  const auto slab = model(make_box(Vec3(3, 3, 0.5)));
+  const auto rod = model(make_box(Vec3(0.1, 0.1, 2)));
+  Transform X_AB;
+  X_AB.R = Eigen::AngleAxisd(std::numbers::pi / 6, Vec3::UnitY()).toRotationMatrix();
+  X_AB.t = Vec3(0.3, 0.7, 0);
+  const std::vector<ContactPatch> crossing = compute_contacts(*slab, *rod, X_AB);
+  ASSERT_EQ(crossing.size(), 2u);  // where the rod enters the top face and leaves the bottom
+  EXPECT_EQ(deepest_edge_point_inside(slab->mesh(), rod->mesh(), X_AB), 0) << "no vertex inside";
+  for (const ContactPatch& p : crossing) {
+    EXPECT_TRUE(p.penetrating);
+    EXPECT_NEAR(p.depth, 0.5, 1e-3 * 0.5);
+    EXPECT_LE(p.depth, 0.5 + 1e-12);
+  }
+  // The same both ways round.
+  for (const ContactPatch& p : compute_contacts(*rod, *slab, X_AB.inverse())) {
+    EXPECT_NEAR(p.depth, 0.5, 1e-3 * 0.5);
+  }
+  // A rod that only touches the slab's top face with one long edge, lying
+  // on it (up to the rounding of its turn), is touching.
+  Transform lying;
+  lying.R = Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitY()).toRotationMatrix();
+  lying.t = Vec3(0.3, 0.7, 0.6);
+  const std::vector<ContactPatch> resting = compute_contacts(*slab, *rod, lying);
+  ASSERT_FALSE(resting.empty());
+  for (const ContactPatch& p : resting) {
+    EXPECT_FALSE(p.penetrating);
+    EXPECT_LT(p.depth, 1e-12);
+  }
 }
 
 TEST(Contacts, DepthIntoBodiesThatTouchIsMeasuredToTheirSurface) {

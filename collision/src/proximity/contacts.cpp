@@ -32,6 +32,10 @@ struct PairPiece {
   Vec3 hi;
 };
 
+/// Most distance queries one search of the edges' deepest points makes
+/// (InsideReach::edge_reach); past it, the deepest point found so far counts.
+constexpr std::size_t kEdgeProbes = 4096;
+
 /// A face counts for the depth when its normal is within 60 degrees of the patch normal.
 constexpr Real kFacingCosine = 0.5;
 
@@ -226,19 +230,25 @@ class TriangleDistanceTree {
     if (!triangles_.empty()) build(0, static_cast<std::uint32_t>(order_.size()));
   }
 
-  /// Distance from p to the nearest triangle.
-  Real nearest(const Vec3& p) const {
-    Real best = std::numeric_limits<Real>::infinity();
+  /// The nearest triangle to a point and its distance.
+  struct Nearest {
+    Real distance = std::numeric_limits<Real>::infinity();
+    std::uint32_t triangle = 0;
+  };
+
+  /// Distance from p to the nearest triangle, and which (the first of equals).
+  Nearest nearest(const Vec3& p) const {
+    Nearest best;
     if (nodes_.empty()) return best;
     std::vector<std::uint32_t> stack{0};
     while (!stack.empty()) {
       const Node& node = nodes_[stack.back()];
       stack.pop_back();
-      if (box_distance(node, p) >= best) continue;
+      if (box_distance(node, p) >= best.distance) continue;
       if (node.right == 0) {
         for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-          const detail::TriangleVertices& t = triangles_[order_[k]];
-          best = std::min(best, (p - detail::closest_point_on_triangle(p, t)).norm());
+          const Real d = distance_to(p, order_[k]);
+          if (d < best.distance) best = {d, order_[k]};
         }
         continue;
       }
@@ -249,6 +259,11 @@ class TriangleDistanceTree {
       stack.push_back(right_nearer ? right : left);
     }
     return best;
+  }
+
+  /// Distance from p to triangle t.
+  Real distance_to(const Vec3& p, std::uint32_t t) const {
+    return (p - detail::closest_point_on_triangle(p, triangles_[t])).norm();
   }
 
  private:
@@ -309,8 +324,10 @@ class TriangleDistanceTree {
 
 /// How deep one part ("part") reaches into the other ("other"): for the
 /// regions of the part's surface inside the other, the largest distance of
-/// a vertex to the other's surface. Everything is taken in A's frame, B's
-/// vertices mapped by the same Transform::apply as the collision query.
+/// a vertex to the other's surface; and the deepest point of the part's
+/// edges that cross the other's surface (edge_reach). Everything is taken in
+/// A's frame, B's vertices mapped by the same Transform::apply as the
+/// collision query.
 ///
 /// Why this way: the part's surface is cut into regions by the intersection
 /// curves, which run through the intersecting triangle pairs. Walking the
@@ -323,15 +340,17 @@ class TriangleDistanceTree {
 /// inside after all (missing pairs let a walk cross the surface) counts 0.
 class InsideReach {
  public:
+  /// `resolution`: how close to the deepest point of an edge the search goes.
   InsideReach(const Mesh& part, const VertexTriangles& around, const Transform& X_AP,
               const Mesh& other, const Transform& X_AO,
-              std::vector<std::pair<std::uint32_t, std::uint32_t>> crossings)
+              std::vector<std::pair<std::uint32_t, std::uint32_t>> crossings, Real resolution)
       : part_(part),
         around_(around),
         X_AP_(X_AP),
         other_(other),
         X_AO_(X_AO),
-        crossings_(std::move(crossings)) {
+        crossings_(std::move(crossings)),
+        resolution_(resolution) {
     std::sort(crossings_.begin(), crossings_.end());
   }
 
@@ -352,7 +371,7 @@ class InsideReach {
       if (!label_.contains(v)) label_group(v, start);
       deepest = std::max(deepest, regions_[label_.at(v)]);
     }
-    return deepest;
+    return edge_reach(seeds, deepest);
   }
 
  private:
@@ -363,20 +382,177 @@ class InsideReach {
             X_AO_.apply(other_.vertices[f[2]])};
   }
 
-  /// Does the edge (v, w) of the part cross the other's surface? Only the
-  /// other's triangles that meet a part triangle at this edge can.
-  bool cut(std::uint32_t v, std::uint32_t w) const {
-    const Vec3 pv = vertex(v), pw = vertex(w);
+  /// Calls visit(t) for each of the other's triangles that meets a part
+  /// triangle at the edge (v, w): the only ones the edge can cross. Stops when
+  /// visit returns true; returns whether it did.
+  template <typename Visit>
+  bool for_each_crossing(std::uint32_t v, std::uint32_t w, Visit visit) const {
     for (std::uint32_t k = around_.offsets[v]; k < around_.offsets[v + 1]; ++k) {
       const std::uint32_t t = around_.triangles[k];
       const TriangleIndices& f = part_.triangles[t];
       if (f[0] != w && f[1] != w && f[2] != w) continue;
       auto it = std::lower_bound(crossings_.begin(), crossings_.end(), std::pair{t, 0u});
       for (; it != crossings_.end() && it->first == t; ++it) {
-        if (segment_meets_triangle(pv, pw, other_triangle(it->second))) return true;
+        if (visit(it->second)) return true;
       }
     }
     return false;
+  }
+
+  /// Does the edge (v, w) of the part cross the other's surface?
+  bool cut(std::uint32_t v, std::uint32_t w) const {
+    const Vec3 pv = vertex(v), pw = vertex(w);
+    return for_each_crossing(
+        v, w, [&](std::uint32_t t) { return segment_meets_triangle(pv, pw, other_triangle(t)); });
+  }
+
+  const TriangleDistanceTree& tree() {
+    if (!tree_) {
+      std::vector<detail::TriangleVertices> triangles;
+      triangles.reserve(other_.triangles.size());
+      for (std::uint32_t t = 0; t < other_.triangles.size(); ++t) {
+        triangles.push_back(other_triangle(t));
+      }
+      tree_.emplace(std::move(triangles));
+    }
+    return *tree_;
+  }
+
+  /// Where along the edge (v, w) it meets the other's surface: the
+  /// fractions of the way from v at which it meets a triangle whose plane it
+  /// does not lie in, sorted; empty when it crosses no triangle from one side
+  /// strictly to the other (an edge that only touches the surface has no
+  /// stretch inside that the vertex regions do not measure).
+  std::vector<Real> edge_crossings(std::uint32_t v, std::uint32_t w) const {
+    const Vec3 pv = vertex(v), pw = vertex(w);
+    std::vector<Real> at;
+    bool proper = false;
+    for_each_crossing(v, w, [&](std::uint32_t t) {
+      const detail::TriangleVertices tri = other_triangle(t);
+      const int sv = orient3d(tri[0], tri[1], tri[2], pv);
+      const int sw = orient3d(tri[0], tri[1], tri[2], pw);
+      if (sv * sw > 0 || (sv == 0 && sw == 0)) return false;
+      const int o0 = orient3d(pv, pw, tri[0], tri[1]);
+      const int o1 = orient3d(pv, pw, tri[1], tri[2]);
+      const int o2 = orient3d(pv, pw, tri[2], tri[0]);
+      const bool meets = (o0 >= 0 && o1 >= 0 && o2 >= 0) || (o0 <= 0 && o1 <= 0 && o2 <= 0);
+      if (!meets) return false;
+      proper = proper || sv * sw < 0;
+      const Vec3 n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+      const Real dv = n.dot(pv - tri[0]), dw = n.dot(pw - tri[0]);
+      if (dv != dw) at.push_back(std::clamp(dv / (dv - dw), Real{0}, Real{1}));
+      return false;
+    });
+    if (!proper) return {};
+    std::sort(at.begin(), at.end());
+    at.erase(std::unique(at.begin(), at.end()), at.end());
+    return at;
+  }
+
+  /// The deepest point inside the other of the edges of the part's
+  /// triangles `seeds` that cross its surface, where deeper than `known`;
+  /// `known` otherwise.
+  ///
+  /// Why: two parts can cross with no vertex of either inside the other (a
+  /// rod through a plate, both ends out), and then the vertex regions
+  /// measure nothing. But where two surfaces cross, an edge of one crosses
+  /// a face of the other, so some edge has a stretch inside.
+  ///
+  /// Each such edge is cut at its crossings with the other's surface into
+  /// stretches that lie wholly on one side. The deepest point of a stretch
+  /// is found by branch and bound on the distance to the other's surface
+  /// (1-Lipschitz along the edge, and for each triangle convex, so a piece
+  /// is no deeper than the farther of its ends from the triangle nearest
+  /// either end), best piece first over all the edges, to within the
+  /// resolution (or a thousandth of the depth) and at most kEdgeProbes
+  /// distance queries a call; a stretch is located (one exact
+  /// point-in-solid test) only when it could beat the deepest point so far.
+  /// The deepest point found is located again, as the vertex regions' is.
+  Real edge_reach(const std::vector<std::uint32_t>& seeds, Real known) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+    for (const std::uint32_t t : seeds) {
+      const TriangleIndices& f = part_.triangles[t];
+      for (int k = 0; k < 3; ++k) edges.push_back(std::minmax(f[k], f[(k + 1) % 3]));
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+
+    struct Stretch {
+      Vec3 mid;
+      PointLocation side = PointLocation::kOnSurface;
+      bool located = false;
+    };
+    struct Piece {
+      Real bound;  ///< no point of the piece is deeper
+      Vec3 p0, p1;
+      TriangleDistanceTree::Nearest n0, n1;
+      std::size_t stretch;
+      bool operator<(const Piece& other) const { return bound < other.bound; }
+    };
+    const TriangleDistanceTree* distances = nullptr;
+    std::size_t probes = 0;
+    const auto probe = [&](const Vec3& p) {
+      ++probes;
+      return distances->nearest(p);
+    };
+    const auto piece = [&](const Vec3& p0, const Vec3& p1, const TriangleDistanceTree::Nearest& n0,
+                           const TriangleDistanceTree::Nearest& n1, std::size_t stretch) {
+      const Real lipschitz = (n0.distance + n1.distance + (p1 - p0).norm()) / 2;
+      const Real by_n0 = std::max(n0.distance, distances->distance_to(p1, n0.triangle));
+      const Real by_n1 = std::max(distances->distance_to(p0, n1.triangle), n1.distance);
+      return Piece{std::min({lipschitz, by_n0, by_n1}), p0, p1, n0, n1, stretch};
+    };
+
+    std::vector<Stretch> stretches;
+    std::vector<Piece> heap;
+    for (const auto& [v, w] : edges) {
+      std::vector<Real> at = edge_crossings(v, w);
+      if (at.empty()) continue;
+      if (!distances) distances = &tree();
+      const Vec3 pv = vertex(v), pw = vertex(w);
+      at.insert(at.begin(), 0);
+      at.push_back(1);
+      TriangleDistanceTree::Nearest n0 = probe(pv);
+      for (std::size_t i = 0; i + 1 < at.size(); ++i) {
+        const Vec3 p0 = pv + at[i] * (pw - pv);
+        const Vec3 p1 = at[i + 1] == 1 ? pw : Vec3(pv + at[i + 1] * (pw - pv));
+        const TriangleDistanceTree::Nearest n1 = probe(p1);
+        if (at[i + 1] > at[i]) {
+          stretches.push_back({(p0 + p1) / 2});
+          heap.push_back(piece(p0, p1, n0, n1, stretches.size() - 1));
+        }
+        n0 = n1;
+      }
+    }
+    std::make_heap(heap.begin(), heap.end());
+    Real deepest = known;
+    Vec3 deepest_point = Vec3::Zero();
+    while (!heap.empty() && probes < kEdgeProbes) {
+      std::pop_heap(heap.begin(), heap.end());
+      const Piece p = heap.back();
+      heap.pop_back();
+      if (p.bound <= deepest + std::max(resolution_, 1e-3 * deepest)) break;
+      Stretch& stretch = stretches[p.stretch];
+      if (!stretch.located) {
+        if (!locator_) locator_.emplace(other_, X_AO_);
+        stretch.side = locator_->locate(stretch.mid);
+        stretch.located = true;
+      }
+      if (stretch.side != PointLocation::kInside) continue;
+      const Vec3 mid = (p.p0 + p.p1) / 2;
+      const TriangleDistanceTree::Nearest n = probe(mid);
+      if (n.distance > deepest) {
+        deepest = n.distance;
+        deepest_point = mid;
+      }
+      for (const Piece& half :
+           {piece(p.p0, mid, p.n0, n, p.stretch), piece(mid, p.p1, n, p.n1, p.stretch)}) {
+        heap.push_back(half);
+        std::push_heap(heap.begin(), heap.end());
+      }
+    }
+    if (deepest > known && locator_->locate(deepest_point) != PointLocation::kInside) return known;
+    return deepest;
   }
 
   /// The vertices reachable from `from` along uncut edges that had no label,
@@ -417,18 +593,10 @@ class InsideReach {
     if (locator_->locate(vertex(start)) == PointLocation::kOutside) return;
     // Inside: the rest of the region, then its deepest vertex.
     for (const std::uint32_t v : walk(group, region, nullptr)) group.push_back(v);
-    if (!tree_) {
-      std::vector<detail::TriangleVertices> triangles;
-      triangles.reserve(other_.triangles.size());
-      for (std::uint32_t t = 0; t < other_.triangles.size(); ++t) {
-        triangles.push_back(other_triangle(t));
-      }
-      tree_.emplace(std::move(triangles));
-    }
     Real reach = 0;
     std::uint32_t deepest_vertex = start;
     for (const std::uint32_t v : group) {
-      const Real d = tree_->nearest(vertex(v));
+      const Real d = tree().nearest(vertex(v)).distance;
       if (d > reach) {
         reach = d;
         deepest_vertex = v;
@@ -446,6 +614,7 @@ class InsideReach {
   const Mesh& other_;
   const Transform& X_AO_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> crossings_;  ///< (part tri, other tri)
+  Real resolution_;
   std::optional<PointLocator> locator_;       ///< the other's, in A's frame, on first need
   std::optional<TriangleDistanceTree> tree_;  ///< the other's triangles, on first need
   std::unordered_map<std::uint32_t, std::uint32_t> label_;  ///< vertex -> region
@@ -522,8 +691,10 @@ ContactPatch make_patch(const std::vector<PairPiece>& pieces,
   }
   // Depth: how deep B reaches into A and A into B, the larger. Into a
   // closed part: the deepest vertex of the other inside it, in a region
-  // connected to the patch (InsideReach), measured to its surface; this sees
-  // the caps of curved overlaps, whose deepest vertices cross nothing. Into
+  // connected to the patch, or deeper point of a crossing edge
+  // (InsideReach), measured to its surface; this sees the caps of curved
+  // overlaps, whose deepest vertices cross nothing, and parts that cross
+  // with no vertex inside. Into
   // an open part (no inside): the deepest vertex of a patch triangle behind
   // its patch face (projecting onto the face), over the pairs whose face
   // turns towards the patch normal: exact for flat faces pushed into flat
@@ -656,8 +827,9 @@ std::vector<ContactPatch> compute_contacts(const Mesh& a, const Mesh& b, const T
   const Transform identity;
   std::optional<InsideReach> b_in_a, a_in_b;
   if (request.estimate_depth) {
-    b_in_a.emplace(b, around_b, X_AB, a, identity, std::move(b_crossing_a));
-    a_in_b.emplace(a, around_a, identity, b, X_AB, std::move(a_crossing_b));
+    const Real resolution = request.touching_tolerance / 10;
+    b_in_a.emplace(b, around_b, X_AB, a, identity, std::move(b_crossing_a), resolution);
+    a_in_b.emplace(a, around_a, identity, b, X_AB, std::move(a_crossing_b), resolution);
   }
   for (const std::vector<std::size_t>& g : groups) {
     patches.push_back(make_patch(pieces, g, pairs, b_in_a ? &*b_in_a : nullptr,

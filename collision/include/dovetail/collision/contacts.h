@@ -68,8 +68,9 @@ struct ContactPatch {
   Real length = 0;  ///< total length of the patch's segments
   /// Local penetration estimate (0 when touching): how deep either part
   /// reaches into the other near the patch. Into a closed part: the deepest
-  /// vertex of the other inside it, in a region connected to the patch,
-  /// measured to its surface; into an open part: the deepest vertex behind
+  /// vertex of the other inside it, in a region connected to the patch, or
+  /// deeper point of an edge of the patch that crosses its surface, measured
+  /// to its surface; into an open part: the deepest vertex behind
   /// its patch faces (docs/proximity.md, "Depth estimate").
   Real depth = 0;
   bool penetrating = false;  ///< depth > touching_tolerance

@@ -8,8 +8,9 @@
 /// parts (closed, every triangle on the hull) it is exact: the penetration
 /// depth, the shortest move that parts them. For any other pair it is the
 /// collision layer's contact depth estimate (docs/proximity.md, "Depth
-/// estimate"): the deepest vertex of one part inside the other, measured to
-/// the other's surface, which misses parts that cross with no vertex inside.
+/// estimate"): the deepest point of one part's edges inside the other,
+/// measured to the other's surface, which misses an overlap deepest in the
+/// middle of a face.
 
 #include <map>
 #include <memory>
