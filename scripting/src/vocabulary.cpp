@@ -362,8 +362,9 @@ std::vector<Word> make_vocabulary() {
   w.push_back({"warnings_at_most",
                WordKind::kExpectation,
                {{"count", kCount, kRequired,
-                 "how many warnings may be written (`warn` actions and the run's own, such as a "
-                 "move of a fixed part)"}},
+                 "how many warnings may be written (`warn` actions and the run's own: a move of "
+                 "a fixed part, a refused snap, a glove far from every part, a rule that can "
+                 "never fire)"}},
                "At most this many warnings.",
                "warnings_at_most(0)"});
   w.push_back({"mate_made",

@@ -554,6 +554,29 @@ TEST(ScenarioRun, AGraspIsCheckedByItsType) {
   EXPECT_EQ(o.messages[0].text, "power");
 }
 
+TEST(ScenarioRun, AGloveInOtherUnitsFailsWarningsAtMostZero) {
+  // The bar's plan written in millimetres: the hand is 50 m from every part.
+  // The set-up's warning says so, and warnings_at_most(0) counts it.
+  const test::TempDir dir("dovetail_scenario");
+  std::ofstream(dir / "grasp.plan") << "reach 0.5 0 50 0 1 0 0 0\n";
+  const auto file = write(dir, "units.lua", R"(return scenario {
+  name = "bar", units = "mm",
+  parts = { bar = part { shape = cylinder { diameter = 44, length = 80 }, at = { -20, -32.6, -60 }, turn = { y = 90 } } },
+  hand = glove { plan = "grasp.plan" },
+  expect = { warnings_at_most(0) },
+})");
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed) << o.failure_summary() << o.error;
+  ASSERT_EQ(o.warnings.size(), 1u);
+  EXPECT_NE(o.warnings[0].find("is it written in other units?"), std::string::npos)
+      << o.warnings[0];
+  ASSERT_EQ(o.expectations.size(), 1u);
+  EXPECT_NE(o.expectations[0].detail.find("1 warning; first over the limit: warning before "
+                                          "the run: "),
+            std::string::npos)
+      << o.expectations[0].detail;
+}
+
 TEST(ShippedScenarios, PegInHolePassesAndGivesTheSameReportAtAnyThreadCountAndOnReplay) {
   const test::TempDir dir("dovetail_scenario");
   RunOptions options;
