@@ -155,6 +155,7 @@ void Grasping::hold(const std::string& part, GraspType type) {
   last_slide_ = {};
   fronts_.clear();
   contact_parts_.clear();
+  contact_bodies_.clear();
   X_HO_ = engine::compose(hand_->X_WH().inverse(), scene.world_pose(handle));
   for (std::size_t d = 0; d < kDigitCount; ++d) {
     flexion_at_grasp_[d] = flexion(hand_->glove_angles(), digit_joints(d));
@@ -380,12 +381,14 @@ void Grasping::carry(engine::Simulation& simulation) {
   const Transform X_WO_target = guided(scene, *held_, engine::compose(hand_->X_WH(), X_HO_));
   // The parts attached to the held part move with it and are kept out of the others as it is.
   std::vector<SlideAttachment> attached;
+  std::vector<PartId> bodies{part};  // the moving bodies: the part, then its attachments
   collision::Bounds local = models_->mesh_bounds(mesh);
   for (const PartId q : scene.parts()) {
     const auto& q_mesh = scene.collision_mesh(q);
     if (q == part || !q_mesh || scene.has_tag(q, "hand") || !scene.descends_from(q, part)) continue;
     const Transform X_OA = engine::compose(X_WO.inverse(), scene.world_pose(q));
     attached.push_back({models_->collision_model(q_mesh), X_OA});
+    bodies.push_back(q);
     const collision::Bounds box = collision::transformed_bounds(models_->mesh_bounds(q_mesh), X_OA);
     local.min = local.min.cwiseMin(box.min);
     local.max = local.max.cwiseMax(box.max);
@@ -417,13 +420,16 @@ void Grasping::carry(engine::Simulation& simulation) {
   request.X_WP = X_WO;
   request.X_WP_target = X_WO_target;
   request.obstacles = obstacles;
-  // Last frame's contacts, with their obstacles renumbered for this frame's list.
+  // Last frame's contacts, with their obstacles and bodies renumbered for this frame's
+  // lists (a part attached or detached since is a body more or less).
   std::vector<SlideContact> previous;
   for (const SlideContact& k : last_slide_.contacts) {
     const auto it = std::find(handles.begin(), handles.end(), contact_parts_[k.obstacle]);
-    if (it == handles.end()) continue;
+    const auto body = std::find(bodies.begin(), bodies.end(), contact_bodies_[k.body]);
+    if (it == handles.end() || body == bodies.end()) continue;
     SlideContact renumbered = k;
     renumbered.obstacle = static_cast<std::uint32_t>(it - handles.begin());
+    renumbered.body = static_cast<std::uint32_t>(body - bodies.begin());
     previous.push_back(renumbered);
   }
   request.previous_contacts = previous;
@@ -431,6 +437,7 @@ void Grasping::carry(engine::Simulation& simulation) {
   request.fronts = settings_.sliding.separation_fronts ? &fronts_ : nullptr;
   last_slide_ = slide(request, settings_.sliding);
   contact_parts_ = handles;
+  contact_bodies_ = bodies;
   stats_.slide_queries += static_cast<std::uint64_t>(last_slide_.collision_queries);
   stats_.max_stretch_m = std::max(stats_.max_stretch_m, last_slide_.stretch_m);
   const std::uint64_t frame = simulation.frame();
@@ -445,11 +452,13 @@ void Grasping::carry(engine::Simulation& simulation) {
   // be blocked with no contact found; it slides on nothing named.
   if (in_contact && !sliding_ && !last_slide_.contacts.empty()) {
     sliding_ = true;
-    sliding_on_ = scene.name(handles[last_slide_.contacts.front().obstacle]);
-    pending_.push_back({EventKind::kSlideBegin, frame, t, *held_, sliding_on_});
+    const SlideContact& first = last_slide_.contacts.front();
+    sliding_part_ = scene.name(bodies[first.body]);
+    sliding_on_ = scene.name(handles[first.obstacle]);
+    pending_.push_back({EventKind::kSlideBegin, frame, t, sliding_part_, sliding_on_});
   } else if (!in_contact && sliding_ && last_slide_.status == SlideStatus::kReached) {
     sliding_ = false;
-    pending_.push_back({EventKind::kSlideEnd, frame, t, *held_, sliding_on_});
+    pending_.push_back({EventKind::kSlideEnd, frame, t, sliding_part_, sliding_on_});
   }
 }
 
@@ -495,7 +504,7 @@ void Grasping::release(engine::Simulation& simulation, const std::string& reason
   pending_.push_back({EventKind::kRelease, simulation.frame(), simulation.time(), part, reason});
   if (sliding_) {
     pending_.push_back(
-        {EventKind::kSlideEnd, simulation.frame(), simulation.time(), part, sliding_on_});
+        {EventKind::kSlideEnd, simulation.frame(), simulation.time(), sliding_part_, sliding_on_});
     sliding_ = false;
   }
   held_.reset();
@@ -513,8 +522,9 @@ void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
     const Transform X_WP = scene.world_pose(p), X_WO = scene.world_pose(o);
     if (!within_tolerance(mate, X_WP, X_WO)) continue;
     const Transform X_seated = mate_pose(mate, X_WP, X_WO);
-    if (const auto [blocker, depth] = deepest_overlap(scene, p, X_seated); depth > kSnapOverlap) {
-      refused_snaps_.push_back({mate.name, part, blocker, depth, simulation.time()});
+    if (const Overlap overlap = deepest_overlap(scene, p, X_seated); overlap.depth > kSnapOverlap) {
+      refused_snaps_.push_back({mate.name, part, overlap.blocker, overlap.overlapping,
+                                overlap.depth, simulation.time()});
       continue;
     }
     scene.set_world_pose(p, X_seated);
@@ -524,8 +534,8 @@ void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
   }
 }
 
-std::pair<std::string, Real> Grasping::deepest_overlap(const engine::Scene& scene, PartId part,
-                                                       const Transform& X_WP) {
+Grasping::Overlap Grasping::deepest_overlap(const engine::Scene& scene, PartId part,
+                                            const Transform& X_WP) {
   // The part and the parts attached to it move together, rigidly: each by
   // the same move, and none is checked against another of them.
   const auto in_family = [&](PartId other) { return scene.descends_from(other, part); };
@@ -536,7 +546,7 @@ std::pair<std::string, Real> Grasping::deepest_overlap(const engine::Scene& scen
       moved.emplace_back(q, q == part ? X_WP : engine::compose(move, scene.world_pose(q)));
     }
   }
-  std::pair<std::string, Real> deepest{"", 0};
+  Overlap deepest;
   for (const auto& [q, X_WQ] : moved) {
     const auto& mesh = scene.collision_mesh(q);
     const collision::Bounds box = collision::transformed_bounds(models_->mesh_bounds(mesh), X_WQ);
@@ -548,7 +558,7 @@ std::pair<std::string, Real> Grasping::deepest_overlap(const engine::Scene& scen
         continue;
       }
       const Real depth = models_->overlap.depth(mesh, X_WQ, other_mesh, X_WB);
-      if (depth > deepest.second) deepest = {scene.name(other), depth};
+      if (depth > deepest.depth) deepest = {scene.name(q), scene.name(other), depth};
     }
   }
   return deepest;

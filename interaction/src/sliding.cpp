@@ -29,6 +29,7 @@ using Triangle = std::array<Vec3, 3>;
 
 /// The bodies that move in a step: the sliding part (body 0) and the parts
 /// attached to it (body i is attachment i - 1), rigidly together.
+std::uint32_t index(std::size_t body) { return static_cast<std::uint32_t>(body); }
 std::size_t body_count(const SlideRequest& request) { return 1 + request.attached.size(); }
 const std::shared_ptr<const collision::CollisionModel>& body_model(const SlideRequest& request,
                                                                    std::size_t body) {
@@ -89,11 +90,11 @@ void contacts_of_body(const SlideRequest& request, std::size_t body, const Trans
         bool seen = false;
         for (std::size_t j = first; j < out.size() && !seen; ++j)
           seen = out[j].n_W.dot(n_W) > 0.9998;
-        if (!seen) out.push_back({o.id, (d.p + d.q) / 2, n_W, patch.kind, 0});
+        if (!seen) out.push_back({o.id, (d.p + d.q) / 2, n_W, patch.kind, 0, index(body)});
       }
       if (out.size() == first) {
         out.push_back({o.id, o.X_WO.apply(patch.point), (o.X_WO.R * patch.normal).normalized(),
-                       patch.kind, 0});
+                       patch.kind, 0, index(body)});
       }
     }
   }
@@ -123,8 +124,9 @@ std::optional<SlideContact> pair_contact(const SlideRequest& request, const Hit&
   }
   const collision::TrianglePairDistance d = collision::triangle_pair_distance(ta, tb);
   if (!(d.distance > 0)) return std::nullopt;
-  return SlideContact{o.id, (d.p + d.q) / 2, (d.q - d.p) / d.distance,
-                      collision::ContactKind::kPoint, 0};
+  return SlideContact{
+      o.id, (d.p + d.q) / 2, (d.q - d.p) / d.distance, collision::ContactKind::kPoint,
+      0,    index(hit.body)};
 }
 
 /// The part at X_WP against every obstacle, exact first-hit queries: the
@@ -299,6 +301,7 @@ std::optional<Transform> off_touching(const SlideRequest& request, const Sliding
         k.p_W = o.X_WO.apply(patch.point);
         k.n_W = o.X_WO.R * patch.normal;
         k.kind = patch.kind;
+        k.body = index(body);
         Motion a;
         a << k.n_W, (k.p_W - c).cross(k.n_W);
         constraints.push_back(a);

@@ -717,13 +717,18 @@ void Runner::measure_penetration(double now) {
   }
 }
 
+/// Who would overlap in a refused snap: "it", or "'washer', attached to it".
+std::string overlapper(const interaction::RefusedSnap& r) {
+  return r.overlapping == r.part ? "it" : "'" + r.overlapping + "', attached to it,";
+}
+
 std::string Runner::why_not_snapped(const MateSpec& m) const {
   if (grasping_) {
     const auto& refused = grasping_->refused_snaps();
     for (auto it = refused.rbegin(); it != refused.rend(); ++it) {
       if (it->mate != m.mate.name) continue;
       return ": released within its tolerances at t=" + format_time(it->time) +
-             " s, but in place it would overlap '" + it->blocker + "' by " +
+             " s, but in place " + overlapper(*it) + " would overlap '" + it->blocker + "' by " +
              format_length(it->depth_m, out_);
     }
   }
@@ -760,8 +765,9 @@ void Runner::watch_mates(double now) {
     const MateSpec* m = mate(r.mate);
     out_.messages.push_back({r.time, "warn",
                              "'" + r.part + "' was released within the tolerances of mate '" +
-                                 r.mate + "' but not snapped: in place it would overlap '" +
-                                 r.blocker + "' by " + format_length(r.depth_m, out_),
+                                 r.mate + "' but not snapped: in place " + overlapper(r) +
+                                 " would overlap '" + r.blocker + "' by " +
+                                 format_length(r.depth_m, out_),
                              m ? m->where : SourceLocation{}});
   }
 }

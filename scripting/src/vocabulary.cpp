@@ -187,12 +187,13 @@ std::vector<Word> make_vocabulary() {
                {{"mate", kMate, kRequired, "the mate"}},
                "The mate's part snaps into place.",
                "mated \"peg_in_hole\""});
-  w.push_back(
-      {"slides",
-       WordKind::kEvent,
-       {{"part", kPart, kRequired, "the held part"}, {"on", kPart, kOptional, "only on this part"}},
-       "The held part begins to slide along another part.",
-       "slides(\"peg\", \"block\")"});
+  w.push_back({"slides",
+               WordKind::kEvent,
+               {{"part", kPart, kRequired, "the held part, or a part attached to it"},
+                {"on", kPart, kOptional, "only on this part"}},
+               "The held part begins to slide along another part (or a part attached to it does: "
+               "the one that touches is named).",
+               "slides(\"peg\", \"block\")"});
   w.push_back(
       {"enters",
        WordKind::kEvent,

@@ -252,6 +252,7 @@ TEST(PegInHole, APegStoppedShortByAPebbleIsNotSnappedThroughIt) {
   EXPECT_EQ(run.refused[0].mate, "peg_in_hole");
   EXPECT_EQ(run.refused[0].part, "peg");
   EXPECT_EQ(run.refused[0].blocker, "pebble");
+  EXPECT_EQ(run.refused[0].overlapping, "peg");
   EXPECT_NEAR(run.refused[0].depth_m, 0.0015, 1e-5);
   const Vec3 bottom = run.X_WPeg.apply(Vec3(0, 0, kPegLength));
   EXPECT_GE(bottom.y(), kBlockTop - kHoleDepth + 0.0015);
@@ -284,6 +285,9 @@ TEST(PegInHole, APartAttachedToThePegStopsItWhereTheAttachedPartMeetsTheBlock) {
   EXPECT_TRUE(has(run.events, EventKind::kRelease, "peg", "opened"));
   EXPECT_FALSE(has(run.events, EventKind::kMate, "peg", "block"));
   EXPECT_TRUE(run.refused.empty());
+  // What slides on the block is the tab: it is what touches it.
+  EXPECT_TRUE(has(run.events, EventKind::kSlideBegin, "tab", "block"));
+  EXPECT_FALSE(has(run.events, EventKind::kSlideBegin, "peg", "block"));
   EXPECT_LT(run.max_depth, 1e-5) << "the tab or the peg in the block";
   // The tab rests on the face; the peg, held up by it, is about 3 mm short
   // (tilted a little about the tab until it meets the hole's wall).
@@ -307,6 +311,7 @@ TEST(PegInHole, APartAttachedToThePegIsCheckedBeforeTheSnapToo) {
   EXPECT_FALSE(has(run.events, EventKind::kMate, "peg", "block"));
   ASSERT_EQ(run.refused.size(), 1u);
   EXPECT_EQ(run.refused[0].blocker, "block");
+  EXPECT_EQ(run.refused[0].overlapping, "tab");
   EXPECT_NEAR(run.refused[0].depth_m, 0.001, 1e-4);
   EXPECT_LT(run.max_depth, 1e-5) << "the tab or the peg in the block";
 }

@@ -114,8 +114,10 @@ struct RefusedSnap {
   std::string mate{};
   std::string part{};     ///< the released part
   std::string blocker{};  ///< the part it would overlap most deeply
-  Real depth_m = 0;       ///< how deep (OverlapGauge, as max_penetration measures)
-  Real time = 0;          ///< when it was released
+  /// The part that would overlap it: the released part, or a part attached to it.
+  std::string overlapping{};
+  Real depth_m = 0;  ///< how deep (OverlapGauge, as max_penetration measures)
+  Real time = 0;     ///< when it was released
 };
 
 /// A part in place may touch others; it is refused a snap only when it
@@ -183,11 +185,14 @@ class Grasping {
                    const Transform& X_WP_target);
   void release(engine::Simulation& simulation, const std::string& reason);
   void snap(engine::Simulation& simulation, const std::string& part);
-  /// The part that `part` at X_WP, or a part attached to it and moved with
-  /// it, overlaps most deeply (none of them counted), and how deep; depth 0
-  /// when none.
-  std::pair<std::string, Real> deepest_overlap(const engine::Scene& scene, engine::PartId part,
-                                               const Transform& X_WP);
+  /// The deepest overlap of `part` at X_WP, or of a part attached to it and
+  /// moved with it, with another part (none of them counted).
+  struct Overlap {
+    std::string overlapping;  ///< `part` or the attached part that overlaps
+    std::string blocker;      ///< the part it overlaps
+    Real depth = 0;           ///< how deep; 0 when nothing overlaps
+  };
+  Overlap deepest_overlap(const engine::Scene& scene, engine::PartId part, const Transform& X_WP);
 
   engine::Simulation* simulation_;
   Hand* hand_;
@@ -209,10 +214,12 @@ class Grasping {
   Real last_flexion_ = 0;
   std::optional<std::size_t> guiding_;  ///< the mate drawing the held part onto its axis
   bool sliding_ = false;
-  std::string sliding_on_;
+  std::string sliding_part_;  ///< the part that slides: the held part or one attached to it
+  std::string sliding_on_;    ///< ... on this one
   SlideResult last_slide_{};
-  SlideFronts fronts_;                         ///< of the held part, against each obstacle
-  std::vector<engine::PartId> contact_parts_;  ///< the parts of last_slide_'s obstacle ids
+  SlideFronts fronts_;                          ///< of the held part, against each obstacle
+  std::vector<engine::PartId> contact_parts_;   ///< the parts of last_slide_'s obstacle ids
+  std::vector<engine::PartId> contact_bodies_;  ///< and of its moving bodies (SlideContact::body)
   InteractionStats stats_{};
   std::vector<RefusedSnap> refused_snaps_;
 };

@@ -94,6 +94,9 @@ struct SlideContact {
   /// How far the part has moved away from the contact along its normal since
   /// it was found; past kContactExpiry the contact no longer constrains.
   Real separation = 0;
+  /// Which of the moving bodies touches: 0 the sliding part, i its
+  /// attachment i - 1 (SlideRequest::attached).
+  std::uint32_t body = 0;
 };
 
 /// A part attached to the sliding part: it moves with it, rigidly, and is kept
