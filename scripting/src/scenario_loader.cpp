@@ -914,6 +914,7 @@ void Loader::read_parts(int map, const SourceLocation& where) {
               .toRotationMatrix();
     }
     part.fixed = field(t, word, "fixed", part.where, what).number != 0;
+    part.attached_to = field(t, word, "attached_to", part.where, what).text;
     if (const Arg c = field(t, word, "color", part.where, what); c.given) part.color = c.color;
     part.tags = field(t, word, "tags", part.where, what).names;
     lua_pop(L_, 2);
@@ -1281,6 +1282,35 @@ void Loader::resolve() {
     for (const std::string& p : r.region.parts)
       check_part(p, r.where, "region '" + r.region.name + "'");
   }
+  // Parts attached from the start: to another part, not fixed themselves, without a cycle.
+  const auto spec = [&](const std::string& name) -> const PartSpec* {
+    for (const PartSpec& p : scenario_.parts) {
+      if (p.name == name) return &p;
+    }
+    return nullptr;
+  };
+  for (const PartSpec& p : scenario_.parts) {
+    if (p.attached_to.empty()) continue;
+    const std::string what = "part '" + p.name + "': attached_to";
+    check_part(p.attached_to, p.where, what);
+    if (p.attached_to == p.name) {
+      note(p.where, what + ": a part cannot be attached to itself");
+      continue;
+    }
+    if (p.fixed)
+      note(p.where, what + ": the part is fixed, so it cannot move with '" + p.attached_to + "'");
+    // Up the chain; back at the part within as many steps as there are parts: a cycle.
+    std::string chain = "'" + p.name + "'";
+    const PartSpec* q = &p;
+    for (std::size_t k = 0; k < scenario_.parts.size() && q && !q->attached_to.empty(); ++k) {
+      chain += " to '" + q->attached_to + "'";
+      q = spec(q->attached_to);
+      if (q == &p) {
+        note(p.where, what + " makes a cycle: " + chain);
+        break;
+      }
+    }
+  }
   if (scenario_.glove && !scenario_.glove->holding.empty()) {
     check_part(scenario_.glove->holding, scenario_.glove->where, "glove: holding");
     if (fixed(scenario_.glove->holding)) {
@@ -1323,7 +1353,17 @@ void Loader::resolve() {
       resolve_clause(*r.only_if, names);
       can_never(*r.only_if, "rule: ");
     }
-    for (const Clause& c : r.act) resolve_clause(c, names);
+    for (const Clause& c : r.act) {
+      resolve_clause(c, names);
+      if (c.word->name != "attach") continue;
+      const std::string &part = c.args[0].text, &to = c.args[1].text;
+      if (part == to) {
+        note(c.where, "attach: '" + part + "' cannot be attached to itself");
+      } else if (fixed(part)) {
+        note(c.where, "attach: '" + part + "' is fixed, so it cannot move with '" + to +
+                          "' (attach '" + to + "' to it instead)");
+      }
+    }
   }
   for (const Clause& c : scenario_.expectations) {
     resolve_clause(c, names);

@@ -392,6 +392,9 @@ void Runner::build() {
     desc.color = p.color;
     scene.add_part(desc);
   }
+  for (const PartSpec& p : scenario_.parts) {
+    if (!p.attached_to.empty()) scene.set_parent(scene.get(p.name), scene.get(p.attached_to), true);
+  }
   engine::SimulationSettings settings;
   settings.time_step = scenario_.time_step;
   settings.collision_threads = options_.threads;
@@ -520,7 +523,15 @@ void Runner::apply(const Clause& action, double now) {
     const double over = action.args[2].given ? action.args[2].number : 0;
     motions_.push_back({a, scene.world_pose(p).t, action.args[1].vector, now, now + over});
   } else if (w == "attach") {
-    scene.set_parent(scene.get(a), scene.get(action.args[1].text), true);
+    const std::string& to = action.args[1].text;
+    if (scene.descends_from(scene.get(to), scene.get(a))) {
+      out_.messages.push_back({now, "warn",
+                               "attach: '" + to + "' moves with '" + a + "' already; attaching '" +
+                                   a + "' to it would make a cycle, so it stays as it was",
+                               action.where});
+      return;
+    }
+    scene.set_parent(scene.get(a), scene.get(to), true);
   } else if (w == "detach") {
     scene.set_parent(scene.get(a), PartId{}, true);
   } else if (w == "snap") {
@@ -691,11 +702,20 @@ void Runner::complete_step(std::size_t i, double now, std::vector<Occurrence>& o
   occurrences.push_back({Happening::kCompleted, scenario_.steps[i].name, ""});
 }
 
+/// The part at the top of the chain of parts that `part` is attached to.
+PartId assembly_root(const engine::Scene& scene, PartId part) {
+  while (scene.parent(part).valid()) part = scene.parent(part);
+  return part;
+}
+
 void Runner::measure_penetration(double now) {
   const engine::Scene& scene = sim_->scene();
   for (const auto& [a, b] : touching_) {
     const PartId pa = scene.find(a), pb = scene.find(b);
     if (!pa.valid() || !pb.valid()) continue;
+    // Parts attached to each other (directly, through others or to one part) move as one:
+    // their overlap is how they were put together (a press fit), not a collision.
+    if (assembly_root(scene, pa) == assembly_root(scene, pb)) continue;
     const auto& ma = scene.collision_mesh(pa);
     const auto& mb = scene.collision_mesh(pb);
     if (!ma || !mb) continue;

@@ -54,6 +54,8 @@ std::vector<Word> make_vocabulary() {
         {"at", kVector, kOptional, "position of the part's origin (default {0, 0, 0})"},
         {"turn", kTurn, kOptional, "orientation: degrees about x, then y, then z"},
         {"fixed", kFlag, kOptional, "true: the part never moves (default false)"},
+        {"attached_to", kPart, kOptional,
+         "another part it is attached to from the start, where it is placed (as `attach`)"},
         {"color", kColor, kOptional,
          "display colour: black, blue, brass, green, grey (or gray), orange, purple, red, "
          "steel, white, yellow, or {r, g, b} in [0, 1]"},
@@ -295,7 +297,10 @@ std::vector<Word> make_vocabulary() {
                 {"to", kPart, kRequired, "the part it moves with from now on"}},
                "Fixes the part to another; it keeps its place and moves with it. While the "
                "hand carries that part, the attached part is kept out of the others as the "
-               "carried part is: it slides on them or holds the carried part back.",
+               "carried part is: it slides on them or holds the carried part back. A fixed "
+               "part cannot be attached (attach what moves to it); an attach that would make a "
+               "cycle is a warning and changes nothing. Parts attached to each other are not "
+               "counted by max_penetration while attached (a press fit overlaps on purpose).",
                "attach(\"nut\", \"bolt\")"});
   w.push_back({"detach",
                WordKind::kAction,
@@ -351,8 +356,8 @@ std::vector<Word> make_vocabulary() {
                "convex parts the exact penetration depth (the shortest move that parts them), "
                "otherwise the deepest point of one's edges inside the other, which misses an "
                "overlap deepest in the middle of a face (check touching with no_contact). The "
-               "hand's segments "
-               "are not counted.",
+               "hand's segments are not counted, nor parts attached to each other while they "
+               "are.",
                "max_penetration(0.01)"});
   w.push_back({"no_contact",
                WordKind::kExpectation,

@@ -93,6 +93,25 @@ TEST(ScenarioLoad, AMisspeltPartIsAnErrorWithFileLineAndASuggestion) {
       << what;
 }
 
+TEST(ScenarioLoad, AttachingAFixedPartOrAPartToItselfIsAnError) {
+  // A fixed part never moves, so it cannot move with another; the other way
+  // round is fine.
+  const test::TempDir dir("dovetail_scenario");
+  const std::string fixed = load_error(
+      write(dir, "fixed.lua",
+            moved_peg("    rule { when = after(0), act = { attach(\"block\", \"peg\") } },", "")));
+  EXPECT_NE(fixed.find("fixed.lua:17: attach: 'block' is fixed, so it cannot move with 'peg' "
+                       "(attach 'peg' to it instead)"),
+            std::string::npos)
+      << fixed;
+  const std::string itself = load_error(
+      write(dir, "itself.lua",
+            moved_peg("    rule { when = after(0), act = { attach(\"peg\", \"peg\") } },", "")));
+  EXPECT_NE(itself.find("itself.lua:17: attach: 'peg' cannot be attached to itself"),
+            std::string::npos)
+      << itself;
+}
+
 TEST(ScenarioLoad, TheScenarioTablesOwnFieldsAreNamedAtItsReturnLine) {
   // `return scenario { ... }` is a tail call, which keeps no line: the
   // loader names the line of the file's `return scenario`.
@@ -552,6 +571,71 @@ TEST(ScenarioRun, AGraspIsCheckedByItsType) {
       << o.expectations[1].detail;
   ASSERT_EQ(o.messages.size(), 1u);
   EXPECT_EQ(o.messages[0].text, "power");
+}
+
+TEST(ScenarioRun, AnAttachThatWouldMakeACycleIsAWarningAtItsLine) {
+  // The cap is attached to the peg, then the peg to the cap: the second is
+  // refused with a warning naming its rule, and the run goes on.
+  const test::TempDir dir("dovetail_scenario");
+  const RunOutcome o = run_scenario(write(dir, "cycle.lua", R"(return scenario {
+  name = "cycle", units = "mm", duration = 0.5,
+  parts = {
+    peg = part { shape = cylinder { diameter = 20, length = 60 } },
+    cap = part { shape = box { size = { 30, 10, 30 } }, at = { 0, 0, 70 } },
+  },
+  rules = {
+    rule { when = after(0.1), act = { attach("cap", "peg") } },
+    rule { when = after(0.2), act = { attach("peg", "cap") } },
+  },
+  expect = { warnings_at_most(0) },
+})"));
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed) << o.error;
+  ASSERT_EQ(o.messages.size(), 1u);
+  EXPECT_EQ(o.messages[0].level, "warn");
+  EXPECT_EQ(o.messages[0].where.line, 9);
+  EXPECT_EQ(o.messages[0].text,
+            "attach: 'cap' moves with 'peg' already; attaching 'peg' to it would make a cycle, so "
+            "it stays as it was");
+}
+
+TEST(ScenarioRun, APartAttachedFromTheStartMovesWithItsPartAndItsPressFitIsNotAnOverlap) {
+  // A bearing pressed on a shaft (bore 0.2 mm under the shaft): attached
+  // from the start, it moves with the shaft, and their overlap is not
+  // counted by max_penetration.
+  const test::TempDir dir("dovetail_scenario");
+  const RunOutcome o = run_scenario(write(dir, "press.lua", R"(return scenario {
+  name = "press fit", units = "mm", duration = 0.5,
+  parts = {
+    shaft = part { shape = cylinder { diameter = 20, length = 60 } },
+    bearing = part { shape = tube { outer = 40, inner = 19.8, length = 10 }, at = { 0, 0, 20 },
+                     attached_to = "shaft" },
+    block = part { shape = box { size = { 10, 10, 10 } }, at = { 100, 0, 0 }, fixed = true },
+  },
+  rules = { rule { when = after(0.1), act = { move("shaft", { 0, 50, 0 }) } } },
+  expect = { max_penetration(0.01) },
+})"));
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+  ASSERT_EQ(o.final_poses.size(), 3u);
+  for (const auto& pose : o.final_poses) {
+    if (pose.part == "bearing") {
+      EXPECT_NEAR(pose.position.y(), 0.050, 1e-12);
+    }
+  }
+  const std::string cycle = load_error(write(dir, "cycle.lua", R"(return scenario {
+  name = "cycle", units = "mm",
+  parts = {
+    a = part { shape = box { size = { 1, 1, 1 } }, attached_to = "b" },
+    b = part { shape = box { size = { 1, 1, 1 } }, attached_to = "a" },
+    c = part { shape = box { size = { 1, 1, 1 } }, fixed = true, attached_to = "a" },
+  },
+})"));
+  EXPECT_NE(cycle.find("cycle.lua:4: part 'a': attached_to makes a cycle: 'a' to 'b' to 'a'"),
+            std::string::npos)
+      << cycle;
+  EXPECT_NE(cycle.find("cycle.lua:6: part 'c': attached_to: the part is fixed, so it cannot move "
+                       "with 'a'"),
+            std::string::npos)
+      << cycle;
 }
 
 TEST(ScenarioRun, AGloveInOtherUnitsFailsWarningsAtMostZero) {

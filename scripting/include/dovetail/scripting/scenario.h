@@ -73,6 +73,7 @@ struct PartSpec {
   std::shared_ptr<const collision::Mesh> mesh{};  ///< in metres
   Transform X_WP{};
   bool fixed = false;
+  std::string attached_to{};  ///< the part it moves with from the start, or empty
   std::optional<std::array<float, 3>> color{};
   std::vector<std::string> tags{};
 };
