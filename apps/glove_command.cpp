@@ -16,6 +16,7 @@
 #include "dovetail/interaction/glove_plan.h"
 #include "dovetail/interaction/glove_source.h"
 #include "dovetail/interaction/glove_trace.h"
+#include "dovetail/interaction/hand_model.h"
 #include "dovetail/interaction/openxr_hand.h"
 
 namespace dovetail::cli {
@@ -206,8 +207,14 @@ int check(std::span<const std::string> argv) {
     return kExitOk;
   }
   args.expect_positional(1, "one trace file TRACE");
-  const auto samples = input_step(
-      [&] { return interaction::read_trace(std::filesystem::path(args.positional()[0])); });
+  const std::string& path = args.positional()[0];
+  const auto samples =
+      input_step([&] { return interaction::read_trace(std::filesystem::path(path)); });
+  for (const interaction::JointExcursion& e :
+       interaction::joints_outside(samples, interaction::kFarOutsideRange)) {
+    std::fprintf(stderr, "warning: %s: %s: is it in other units, or a column misnamed?\n",
+                 path.c_str(), interaction::describe(e).c_str());
+  }
   print_summary("check", samples, "");
   return kExitOk;
 }

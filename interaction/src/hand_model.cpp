@@ -1,6 +1,8 @@
 #include "dovetail/interaction/hand_model.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 
@@ -108,6 +110,30 @@ std::optional<Segment> segment_from_name(std::string_view name) {
 }
 
 const std::array<JointLimit, kJointCount>& joint_limits() { return kLimits; }
+
+std::vector<JointExcursion> joints_outside(std::span<const GloveSample> samples, Real margin) {
+  std::vector<JointExcursion> out;
+  for (std::size_t j = 0; j < kJointCount; ++j) {
+    JointExcursion worst{static_cast<Joint>(j)};
+    for (const GloveSample& g : samples) {
+      const Real a = g.joints[j];
+      const Real outside = std::max(kLimits[j].min - a, a - kLimits[j].max);
+      if (outside > worst.outside) worst = {worst.joint, a, g.t, outside};
+    }
+    if (worst.outside > margin) out.push_back(worst);
+  }
+  return out;
+}
+
+std::string describe(const JointExcursion& e) {
+  const JointLimit& limit = kLimits[static_cast<std::size_t>(e.joint)];
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "%s reaches %.6g deg at t=%.6g s, outside its range [%.6g, %.6g] by %.3g deg",
+                std::string(joint_name(e.joint)).c_str(), e.angle, e.t, limit.min, limit.max,
+                e.outside);
+  return text;
+}
 
 JointAngles clamp_to_limits(const JointAngles& angles, std::bitset<kJointCount>* clamped) {
   JointAngles out = angles;

@@ -177,12 +177,13 @@ ScriptError with_word_suggested(const ScriptError& e) {
 class Loader {
  public:
   Loader(LuaHost& host, const std::filesystem::path& file,
-         std::vector<std::filesystem::path>* files_read)
+         std::vector<std::filesystem::path>* files_read, bool hand_given)
       : host_(host),
         L_(host.state()),
         file_(file.string()),
         folder_(file.parent_path()),
-        files_read_(files_read) {}
+        files_read_(files_read),
+        hand_given_(hand_given) {}
 
   Scenario load();
 
@@ -725,6 +726,7 @@ class Loader {
   Scenario scenario_;
   std::vector<Problem> noted_;  ///< see note()
   std::vector<std::filesystem::path>* files_read_ = nullptr;
+  bool hand_given_ = false;  ///< a replayed trace gives the hand the scenario lacks
   std::map<std::string, engine::ImportReport> imports_;  ///< mesh files read by node
 };
 
@@ -1333,10 +1335,11 @@ void Loader::resolve() {
     }
     if ((w == "grasped" || w == "released" || w == "holding" || w == "slides" ||
          w == "grasped_as") &&
-        (fixed(c.args[0].text) || !scenario_.glove)) {
+        (fixed(c.args[0].text) || !(scenario_.glove || hand_given_))) {
       scenario_.warnings.push_back(c.where.str() + ": " + context + c.text + " can never happen: " +
-                                   (scenario_.glove ? "'" + c.args[0].text + "' is fixed"
-                                                    : std::string("the scenario has no hand")));
+                                   (fixed(c.args[0].text)
+                                        ? "'" + c.args[0].text + "' is fixed"
+                                        : std::string("the scenario has no hand")));
     }
   };
   for (const StepSpec& s : scenario_.steps) {
@@ -1374,8 +1377,8 @@ void Loader::resolve() {
 }  // namespace
 
 Scenario load_scenario(LuaHost& host, const std::filesystem::path& file,
-                       std::vector<std::filesystem::path>* files_read) {
-  Loader loader(host, file, files_read);
+                       std::vector<std::filesystem::path>* files_read, bool hand_given) {
+  Loader loader(host, file, files_read, hand_given);
   return loader.load();
 }
 

@@ -23,6 +23,7 @@
 #include "dovetail/interaction/glove_trace.h"
 #include "dovetail/interaction/grasping.h"
 #include "dovetail/interaction/hand.h"
+#include "dovetail/interaction/hand_model.h"
 #include "dovetail/interaction/overlap.h"
 
 namespace dovetail::scripting {
@@ -53,10 +54,17 @@ struct Occurrence {
   std::string a{}, b{};
 };
 
+/// Seconds to the millisecond; beyond a billion seconds in six digits.
 std::string format_time(double t) {
   char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.3f", t);
+  std::snprintf(buffer, sizeof buffer, std::abs(t) < 1e9 ? "%.3f" : "%.6g", t);
   return buffer;
+}
+
+/// When a trace starts (its first sample's time), 0 for a plan.
+double start_time(const interaction::GloveSource& source) {
+  const auto* trace = dynamic_cast<const interaction::TraceSource*>(&source);
+  return trace ? trace->samples().front().t : 0;
 }
 
 std::string format_length(double metres, const RunOutcome& o) {
@@ -96,10 +104,14 @@ std::shared_ptr<const interaction::GloveSource> glove_source(
   if (!scenario.duration && !(source->end_time() <= kMaxRunSeconds)) {
     const bool trace = replay || !glove.trace.empty();
     const std::filesystem::path& file = replay ? *replay : trace ? glove.trace : glove.plan;
+    const double start = start_time(*source);
     throw ScenarioError((replay ? std::string() : glove.where.str() + ": glove: ") + file.string() +
-                        ": the " + (trace ? "trace" : "plan") + " lasts " +
-                        format_time(source->end_time()) + " s, more than the " +
-                        format_time(kMaxRunSeconds) +
+                        ": the " + (trace ? "trace" : "plan") +
+                        " ends at t=" + format_time(source->end_time()) + " s" +
+                        (start > 1 ? " (it starts at t=" + format_time(start) +
+                                         " s; its times are seconds from the start of the run)"
+                                   : std::string()) +
+                        ", later than the " + format_time(kMaxRunSeconds) +
                         " s a run may last; give the scenario a duration");
   }
   return source;
@@ -132,6 +144,7 @@ class Runner {
   void refuse_outputs();
   void build();
   void warn_about_glove(const GloveSpec& glove, const interaction::GloveSource& source);
+  void warn_about_joints(const std::string& who, const interaction::GloveSource& source);
   void start_frame(std::uint64_t frame, double t);
   void end_frame(const engine::FrameResult& result, double previous_time);
   std::vector<Occurrence> occurrences(const engine::FrameResult& result);
@@ -470,6 +483,14 @@ void Runner::warn_about_glove(const GloveSpec& glove, const interaction::GloveSo
                             " from every part at t=" + format_time(when) +
                             " s; plans and traces are in metres: is it written in other units?");
   }
+  warn_about_joints(who, source);
+  // Device clocks (seconds since 1970) instead of seconds from the start of the run.
+  if (const double start = start_time(source); start > 1) {
+    out_.warnings.push_back(
+        who + ": the trace starts at t=" + format_time(start) +
+        " s; until then the hand stays at its first sample (its times are seconds from the "
+        "start of the run: shift them to start at 0)");
+  }
   if (!glove.holding.empty()) {
     const PartId held = scene.find(glove.holding);
     const double d = held.valid() ? box_of(held).exteriorDistance(source.sample(0).p_WH) : 0;
@@ -477,6 +498,19 @@ void Runner::warn_about_glove(const GloveSpec& glove, const interaction::GloveSo
       out_.warnings.push_back(who + ": the hand starts " + format_length(d, out_) + " from '" +
                               glove.holding + "', which it holds; the part keeps that offset");
     }
+  }
+}
+
+/// A trace whose joint angles go far outside their ranges (a glove's noise
+/// goes a degree or two past them; tens of degrees are another unit or
+/// another column): a warning per joint, at its worst sample.
+void Runner::warn_about_joints(const std::string& who, const interaction::GloveSource& source) {
+  const auto* trace = dynamic_cast<const interaction::TraceSource*>(&source);
+  if (!trace) return;
+  for (const interaction::JointExcursion& e :
+       interaction::joints_outside(trace->samples(), interaction::kFarOutsideRange)) {
+    out_.warnings.push_back(who + ": " + interaction::describe(e) +
+                            " (clamped): is the trace in other units, or a column misnamed?");
   }
 }
 
@@ -1012,7 +1046,7 @@ void Runner::run() {
   out_.file = file_;
   out_.name = file_.stem().string();
   try {
-    scenario_ = load_scenario(host_, file_, &files_read_);
+    scenario_ = load_scenario(host_, file_, &files_read_, options_.trace.has_value());
     refuse_outputs();
     out_.name = scenario_.name;
     out_.units = scenario_.units;

@@ -13,6 +13,11 @@ dovetail_cli_test(glove_unknown_action EXIT 2 ARGS glove frobnicate STDERR "unkn
 # ---- check: a good trace, and every kind of bad one names the file and line, exit 1
 dovetail_cli_test(glove_check EXIT 0 ARGS glove check ${glove}/trace_three_samples.csv
                   STDOUT "^{[^\n]*}\n$&&\"action\":\"check\"&&\"samples\":3&&\"rate_hz_median\":90")
+# A joint far outside its range (500 degrees): checked, with a warning naming it.
+dovetail_cli_test(glove_check_joint_out_of_range EXIT 0
+                  ARGS glove check ${glove}/trace_joint_out_of_range.csv
+                  STDOUT "\"samples\":3"
+                  STDERR "trace_joint_out_of_range.csv: index_mcp reaches 500 deg at t=0.0111111 s, outside its range \\[-30, 90\\] by 410 deg")
 foreach(case
     "missing_column|bad_missing_column.csv:1: missing columns: wrist_yaw"
     "unknown_column|bad_unknown_column.csv:1: unknown column 'elbow'"

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <regex>
 
 #include "../support/temp_dir.h"
@@ -659,6 +661,108 @@ TEST(ScenarioRun, AGloveInOtherUnitsFailsWarningsAtMostZero) {
                                           "the run: "),
             std::string::npos)
       << o.expectations[0].detail;
+}
+
+TEST(ScenarioReplay, ATraceOnADeviceClockIsNamedAsSuch) {
+  // A trace whose times count from 1970 (device time) rather than from the
+  // start of the run: too long without a duration, said with where it starts;
+  // with one, a warning that the hand stays at its first sample until then.
+  const test::TempDir dir("dovetail_scenario");
+  RunOptions record;
+  record.record = dir / "peg.csv";
+  ASSERT_EQ(run_scenario(kScenarios / "01_peg_in_hole.lua", record).status,
+            RunOutcome::Status::kPassed);
+  std::ifstream in(dir / "peg.csv");
+  std::ofstream out(dir / "epoch.csv");
+  std::string line;
+  std::getline(in, line);
+  out << line << "\n";
+  while (std::getline(in, line)) {
+    const std::size_t comma = line.find(',');
+    char t[64];
+    std::snprintf(t, sizeof t, "%.17g", 1732752000.25 + std::stod(line.substr(0, comma)));
+    out << t << line.substr(comma) << "\n";
+  }
+  out.close();
+  RunOptions replay;
+  replay.trace = dir / "epoch.csv";
+  const RunOutcome too_long = run_scenario(kScenarios / "01_peg_in_hole.lua", replay);
+  ASSERT_EQ(too_long.status, RunOutcome::Status::kError);
+  EXPECT_NE(too_long.error.find("epoch.csv: the trace ends at t=1.73275e+09 s (it starts at "
+                                "t=1.73275e+09 s; its times are seconds from the start of the "
+                                "run), later than the"),
+            std::string::npos)
+      << too_long.error;
+  const std::string text = [&] {
+    std::ifstream f(kScenarios / "01_peg_in_hole.lua");
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  }();
+  const std::string with_duration =
+      std::regex_replace(text, std::regex("units = \"mm\","), "units = \"mm\", duration = 1,");
+  std::filesystem::create_directories(dir / "scenarios");
+  std::ofstream(dir / "scenarios" / "short.lua") << with_duration;
+  const RunOutcome frozen = run_scenario(dir / "scenarios" / "short.lua", replay);
+  ASSERT_NE(frozen.status, RunOutcome::Status::kError) << frozen.error;
+  ASSERT_FALSE(frozen.warnings.empty());
+  EXPECT_NE(frozen.warnings[0].find("epoch.csv: the trace starts at t=1.73275e+09 s; until then "
+                                    "the hand stays at its first sample"),
+            std::string::npos)
+      << frozen.warnings[0];
+}
+
+TEST(ScenarioReplay, AJointFarOutsideItsRangeIsAWarning) {
+  // One sample's index_mcp at 500 degrees (a column misnamed, or radians
+  // scaled twice): clamped as always, and now said before the run.
+  const test::TempDir dir("dovetail_scenario");
+  RunOptions record;
+  record.record = dir / "peg.csv";
+  ASSERT_EQ(run_scenario(kScenarios / "01_peg_in_hole.lua", record).status,
+            RunOutcome::Status::kPassed);
+  std::ifstream in(dir / "peg.csv");
+  std::ofstream out(dir / "bent.csv");
+  std::string line;
+  for (int row = 0; std::getline(in, line); ++row) {
+    if (row == 2) {  // index_mcp is the 13th column
+      std::size_t at = 0;
+      for (int k = 0; k < 12; ++k) at = line.find(',', at) + 1;
+      line = line.substr(0, at) + "500" + line.substr(line.find(',', at));
+    }
+    out << line << "\n";
+  }
+  out.close();
+  RunOptions replay;
+  replay.trace = dir / "bent.csv";
+  const RunOutcome o = run_scenario(kScenarios / "01_peg_in_hole.lua", replay);
+  ASSERT_EQ(o.warnings.size(), 1u) << o.error;
+  EXPECT_NE(o.warnings[0].find("bent.csv: index_mcp reaches 500 deg at t=0.0111111 s, outside "
+                               "its range [-30, 90] by 410 deg (clamped)"),
+            std::string::npos)
+      << o.warnings[0];
+  EXPECT_EQ(o.status, RunOutcome::Status::kFailed) << "warnings_at_most(0) counts it";
+}
+
+TEST(ScenarioReplay, AScenarioWithoutAGloveGetsTheTracesHandWithoutAWarning) {
+  // Replayed, a scenario with no glove gets the trace's hand, so a rule on
+  // released() can happen: no "the scenario has no hand".
+  const test::TempDir dir("dovetail_scenario");
+  RunOptions record;
+  record.record = dir / "peg.csv";
+  ASSERT_EQ(run_scenario(kScenarios / "01_peg_in_hole.lua", record).status,
+            RunOutcome::Status::kPassed);
+  const std::string text = [&] {
+    std::ifstream f(kScenarios / "01_peg_in_hole.lua");
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  }();
+  std::filesystem::create_directories(dir / "scenarios");
+  std::ofstream(dir / "scenarios" / "noglove.lua")
+      << std::regex_replace(text, std::regex("  hand = glove [^\n]*\n"), "");
+  RunOptions replay;
+  replay.trace = dir / "peg.csv";
+  const RunOutcome o = run_scenario(dir / "scenarios" / "noglove.lua", replay);
+  ASSERT_NE(o.status, RunOutcome::Status::kError) << o.error;
+  for (const std::string& w : o.warnings) EXPECT_EQ(w.find("has no hand"), std::string::npos) << w;
+  EXPECT_FALSE(run_scenario(dir / "scenarios" / "noglove.lua").warnings.empty())
+      << "run without the trace: the rule on released() can never happen";
 }
 
 TEST(ShippedScenarios, PegInHolePassesAndGivesTheSameReportAtAnyThreadCountAndOnReplay) {

@@ -79,6 +79,22 @@ const std::array<JointLimit, kJointCount>& joint_limits();
 /// of range. A NaN is marked and becomes 0 clamped into the range.
 JointAngles clamp_to_limits(const JointAngles& angles, std::bitset<kJointCount>* clamped = nullptr);
 
+/// A joint that samples take outside its range: where it is worst.
+struct JointExcursion {
+  Joint joint{};
+  Real angle = 0;    ///< degrees, at the worst sample
+  Real t = 0;        ///< that sample's time
+  Real outside = 0;  ///< degrees past the nearer end of the range
+};
+/// The joints some sample takes more than `margin` degrees outside
+/// joint_limits(), in joint order: a glove's noise goes a degree or two past
+/// a range, tens of degrees are another unit or a column misnamed.
+std::vector<JointExcursion> joints_outside(std::span<const GloveSample> samples, Real margin);
+/// The margin past which a trace's excursion is worth a warning (degrees).
+inline constexpr Real kFarOutsideRange = 10;
+/// "index_mcp reaches 500 deg at t=0.011 s, outside its range [-30, 90] by 410 deg".
+std::string describe(const JointExcursion& excursion);
+
 /// A named hand size: its hand length in metres.
 struct HandSize {
   std::string_view name;

@@ -150,8 +150,11 @@ struct Scenario {
 /// `files_read`, when given, gets every file the scenario names as it goes:
 /// itself, its meshes and what they refer to, its glove's plan or trace (a
 /// run refuses to write over any of them), also when loading fails part-way.
+/// `hand_given`: a hand comes from elsewhere (a trace replayed with a
+/// scenario that has no glove), so events of the hand can happen.
 Scenario load_scenario(LuaHost& host, const std::filesystem::path& file,
-                       std::vector<std::filesystem::path>* files_read = nullptr);
+                       std::vector<std::filesystem::path>* files_read = nullptr,
+                       bool hand_given = false);
 
 /// A commented starting scenario named `name`, to be written to `file` (as
 /// its comments tell to run it), for `dovetail new`.
