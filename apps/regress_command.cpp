@@ -270,8 +270,33 @@ std::string html_text(const nlohmann::json& value) {
   return value.is_string() ? xml_escape(value.get<std::string>()) : xml_escape(value.dump());
 }
 
+/// The report's warnings (loading and set-up) and messages (log, warn,
+/// fail, violation, in time order) as one table; empty when there are none.
+std::string html_messages(const nlohmann::json& r) {
+  std::string rows;
+  if (r.contains("warnings") && r["warnings"].is_array()) {
+    for (const auto& w : r["warnings"]) {
+      rows += "<tr><td>before the run</td><td class=\"failed\">warn</td><td>" + html_text(w) +
+              "</td><td></td></tr>\n";
+    }
+  }
+  if (r.contains("messages") && r["messages"].is_array()) {
+    for (const auto& m : r["messages"]) {
+      const std::string level = m.value("level", "");
+      rows += "<tr><td>" +
+              (m["time"].is_number() ? format_seconds(m["time"].get<double>()) : std::string()) +
+              "</td><td" + (level == "log" ? "" : " class=\"failed\"") + ">" + html_text(level) +
+              "</td><td>" + html_text(m.value("text", "")) + "</td><td>" +
+              html_text(m.value("where", "")) + "</td></tr>\n";
+    }
+  }
+  if (rows.empty()) return "";
+  return "<table><tr><th>time (s)</th><th>level</th><th>message</th><th>where</th></tr>\n" + rows +
+         "</table>\n";
+}
+
 /// One scenario's part of the HTML report: outcome, log, final frame,
-/// expectations, steps and event timeline.
+/// expectations, steps, messages and event timeline.
 std::string html_scenario(const Job& j, std::size_t index, const std::filesystem::path& out) {
   std::string h;
   const nlohmann::json& r = j.report;
@@ -308,6 +333,7 @@ std::string html_scenario(const Job& j, std::size_t index, const std::filesystem
     }
     h += "</table>\n";
   }
+  h += html_messages(r);
   if (r.contains("simulation") && r["simulation"].contains("events")) {
     // The hand's segments touch parts many times a second: their contacts
     // get a table of their own, so the parts' events are not lost among them.

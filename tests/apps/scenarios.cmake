@@ -250,6 +250,16 @@ add_test(NAME cli.regress_odd_names
                  -DEXPECT_FILE=${out}/regress_odd/odd_out/not_utf8.json "-DEXPECT_FILE_MATCHES=bad ��"
                  -P ${CMAKE_CURRENT_SOURCE_DIR}/check_command.cmake
          WORKING_DIRECTORY ${out}/regress_odd)
+# The HTML report shows each scenario's messages: a rule's log and warn, with time and line.
+file(WRITE ${out}/regress_messages/in/talks.lua "return scenario { name = \"talks\", duration = 0.2,
+  parts = { b = part { shape = box { size = { 1, 1, 1 } } } },
+  rules = { rule { when = after(0.1), act = { log \"half way\", warn \"mind the gap\" } } },
+}\n")
+dovetail_cli_test(regress_html_messages EXIT 0
+                  ARGS regress ${out}/regress_messages/in --out ${out}/regress_messages/out
+                       --html ${out}/regress_messages/report.html
+                  FILE ${out}/regress_messages/report.html
+                  MATCHES "<td>0.1[0-9]*</td><td>log</td><td>half way</td><td>.*talks.lua:3</td>&&<td class=\"failed\">warn</td><td>mind the gap</td>")
 dovetail_cli_test(regress_shard_too_large EXIT 2 ARGS regress ${scenarios} --shard 1/18446744073709551618
                   STDERR "--shard must be K/N")
 add_test(NAME cli.regress_interrupted
