@@ -151,11 +151,15 @@ void print_problems(const scripting::RunOptions& options, const scripting::RunOu
 void print_summary(const scripting::RunOutcome& outcome) {
   std::size_t passed = 0;
   for (const auto& e : outcome.expectations) passed += e.passed ? 1 : 0;
-  std::printf("%s: %s (%zu/%zu expectations, %llu frames, %.2f s wall)\n",
-              shown(outcome.name).c_str(),
-              std::string(scripting::status_name(outcome.status)).c_str(), passed,
-              outcome.expectations.size(), static_cast<unsigned long long>(outcome.report.frames),
-              outcome.wall_seconds);
+  const bool error = outcome.status == scripting::RunOutcome::Status::kError;
+  // A run that stopped on an error judged no expectation.
+  const std::string judged = error ? std::string()
+                                   : std::to_string(passed) + "/" +
+                                         std::to_string(outcome.expectations.size()) +
+                                         " expectations, ";
+  std::printf("%s: %s (%s%llu frames, %.2f s wall)\n", shown(outcome.name).c_str(),
+              std::string(scripting::status_name(outcome.status)).c_str(), judged.c_str(),
+              static_cast<unsigned long long>(outcome.report.frames), outcome.wall_seconds);
   for (const auto& s : outcome.steps) {
     if (s.done_at) {
       std::printf("  step %-20s done at t=%.3f s%s\n", shown(s.name).c_str(), *s.done_at,
@@ -164,8 +168,11 @@ void print_summary(const scripting::RunOutcome& outcome) {
       std::printf("  step %-20s not done\n", shown(s.name).c_str());
     }
   }
-  std::printf("  state_hash 0x%016llx\n",
-              static_cast<unsigned long long>(outcome.report.state_hash));
+  // No frame, no state to hash (the scenario or its input was refused).
+  if (outcome.report.frames > 0) {
+    std::printf("  state_hash 0x%016llx\n",
+                static_cast<unsigned long long>(outcome.report.state_hash));
+  }
   if (outcome.final_frame)
     std::printf("  final frame: %s\n", outcome.final_frame->string().c_str());
 }

@@ -796,8 +796,8 @@ std::string Runner::why_not_snapped(const MateSpec& m) const {
   std::snprintf(tolerance, sizeof tolerance, "%.3g degrees", m.mate.angle_tolerance_deg);
   return ": the closest it came was " + format_length(c.offset.distance_m, out_) +
          " from its place, its axis " + angle + " off, at t=" + format_time(c.time) +
-         " s (a snap needs " + format_length(m.mate.position_tolerance, out_) + " and " +
-         tolerance + ", and the part released there)";
+         " s (a snap needs the part released within " +
+         format_length(m.mate.position_tolerance, out_) + " and " + tolerance + ")";
 }
 
 void Runner::watch_mates(double now) {
