@@ -53,7 +53,11 @@ std::vector<std::size_t> parse_header(const LineReader& reader, std::string_view
     const std::optional<std::size_t> column = column_index(fields[f]);
     if (!column) {
       if (fields[f].empty()) reader.fail("field " + std::to_string(f + 1) + " names no column");
-      reader.fail("unknown column " + quoted(fields[f]) + " (field " + std::to_string(f + 1) + ")");
+      // A header that is one field holding tabs or semicolons: another separator.
+      const bool other_separator =
+          fields.size() == 1 && fields[f].find_first_of("\t;") != std::string_view::npos;
+      reader.fail("unknown column " + quoted(fields[f]) + " (field " + std::to_string(f + 1) + ")" +
+                  (other_separator ? "; the fields of a trace are separated by commas" : ""));
     }
     if (field_of_column[*column] != 0) {
       reader.fail("duplicated column " + quoted(fields[f]) + " (fields " +

@@ -26,7 +26,8 @@ foreach(case
     "time_backwards|bad_time_backwards.csv:4: time does not increase"
     "empty|bad_empty.csv: empty, no header"
     "no_header|bad_no_header.csv:1: expected a header row"
-    "short_row|bad_short_row.csv:3: expected 30 fields, found 29")
+    "short_row|bad_short_row.csv:3: expected 30 fields, found 29"
+    "tab_separated|trace_tab_separated.csv:1: unknown column [^\n]*; the fields of a trace are separated by commas")
   string(REPLACE "|" ";" parts "${case}")
   list(GET parts 0 name)
   list(GET parts 1 message)
