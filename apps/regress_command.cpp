@@ -266,12 +266,19 @@ void write_junit(const std::vector<Job>& jobs, const std::filesystem::path& path
   if (!out.flush()) throw InputError(path.string() + ": cannot be written");
 }
 
+/// An event's or message's "time", formatted; empty when it has none.
+std::string seconds_of(const nlohmann::json& entry) {
+  const auto it = entry.find("time");
+  return it != entry.end() && it->is_number() ? format_seconds(it->get<double>()) : std::string();
+}
+
 std::string html_text(const nlohmann::json& value) {
   return value.is_string() ? xml_escape(value.get<std::string>()) : xml_escape(value.dump());
 }
 
 /// The report's warnings (loading and set-up) and messages (log, warn,
-/// fail, violation, in time order) as one table; empty when there are none.
+/// fail, violation, as the run wrote them) as one table; empty when there
+/// are none.
 std::string html_messages(const nlohmann::json& r) {
   std::string rows;
   if (r.contains("warnings") && r["warnings"].is_array()) {
@@ -283,11 +290,10 @@ std::string html_messages(const nlohmann::json& r) {
   if (r.contains("messages") && r["messages"].is_array()) {
     for (const auto& m : r["messages"]) {
       const std::string level = m.value("level", "");
-      rows += "<tr><td>" +
-              (m["time"].is_number() ? format_seconds(m["time"].get<double>()) : std::string()) +
-              "</td><td" + (level == "log" ? "" : " class=\"failed\"") + ">" + html_text(level) +
-              "</td><td>" + html_text(m.value("text", "")) + "</td><td>" +
-              html_text(m.value("where", "")) + "</td></tr>\n";
+      rows += "<tr><td>" + seconds_of(m) + "</td><td" +
+              (level == "log" ? "" : " class=\"failed\"") + ">" + html_text(level) + "</td><td>" +
+              html_text(m.value("text", "")) + "</td><td>" + html_text(m.value("where", "")) +
+              "</td></tr>\n";
     }
   }
   if (rows.empty()) return "";
@@ -327,8 +333,9 @@ std::string html_scenario(const Job& j, std::size_t index, const std::filesystem
     h += "<table><tr><th>step</th><th>done at (s)</th></tr>\n";
     for (const auto& s : r["steps"]) {
       h += "<tr><td>" + html_text(s.value("name", "")) + "</td><td>" +
-           (s["done_at"].is_number() ? format_seconds(s["done_at"].get<double>())
-                                     : std::string("not done")) +
+           (s.contains("done_at") && s["done_at"].is_number()
+                ? format_seconds(s["done_at"].get<double>())
+                : std::string("not done")) +
            (s.value("out_of_order", false) ? " (out of order)" : "") + "</td></tr>\n";
     }
     h += "</table>\n";
@@ -344,10 +351,8 @@ std::string html_scenario(const Job& j, std::size_t index, const std::filesystem
       const bool hand = kind.rfind("hand_contact", 0) == 0;
       (hand ? hand_count : parts_count) += 1;
       (hand ? hand_rows : parts_rows) +=
-          "<tr><td>" +
-          (e["time"].is_number() ? format_seconds(e["time"].get<double>()) : std::string()) +
-          "</td><td>" + html_text(kind) + "</td><td>" + html_text(e.value("a", "")) + "</td><td>" +
-          html_text(e.value("b", "")) + "</td></tr>\n";
+          "<tr><td>" + seconds_of(e) + "</td><td>" + html_text(kind) + "</td><td>" +
+          html_text(e.value("a", "")) + "</td><td>" + html_text(e.value("b", "")) + "</td></tr>\n";
     }
     const auto table = [&](const std::string& title, std::size_t n, const std::string& rows) {
       h += "<details><summary>" + title + " (" + std::to_string(n) +

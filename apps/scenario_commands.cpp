@@ -151,8 +151,9 @@ void print_problems(const scripting::RunOptions& options, const scripting::RunOu
 void print_summary(const scripting::RunOutcome& outcome) {
   std::size_t passed = 0;
   for (const auto& e : outcome.expectations) passed += e.passed ? 1 : 0;
-  const bool error = outcome.status == scripting::RunOutcome::Status::kError;
-  // A run that stopped on an error judged no expectation.
+  // A run that stopped on an error before the end judged no expectation.
+  const bool error =
+      outcome.status == scripting::RunOutcome::Status::kError && outcome.expectations.empty();
   const std::string judged = error ? std::string()
                                    : std::to_string(passed) + "/" +
                                          std::to_string(outcome.expectations.size()) +

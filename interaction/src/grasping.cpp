@@ -156,6 +156,7 @@ void Grasping::hold(const std::string& part, GraspType type) {
   fronts_.clear();
   contact_parts_.clear();
   contact_bodies_.clear();
+  sliding_pairs_.clear();
   X_HO_ = engine::compose(hand_->X_WH().inverse(), scene.world_pose(handle));
   for (std::size_t d = 0; d < kDigitCount; ++d) {
     flexion_at_grasp_[d] = flexion(hand_->glove_angles(), digit_joints(d));
@@ -386,7 +387,12 @@ void Grasping::carry(engine::Simulation& simulation) {
   for (const PartId q : scene.parts()) {
     const auto& q_mesh = scene.collision_mesh(q);
     if (q == part || !q_mesh || scene.has_tag(q, "hand") || !scene.descends_from(q, part)) continue;
-    const Transform X_OA = engine::compose(X_WO.inverse(), scene.world_pose(q));
+    // The chain of local poses from the held part down to q: the same bits every frame
+    // (relative to a moving part, the world poses round differently each time).
+    Transform X_OA = scene.local_pose(q);
+    for (PartId p = scene.parent(q); p != part; p = scene.parent(p)) {
+      X_OA = engine::compose(scene.local_pose(p), X_OA);
+    }
     attached.push_back({models_->collision_model(q_mesh), X_OA});
     bodies.push_back(q);
     const collision::Bounds box = collision::transformed_bounds(models_->mesh_bounds(q_mesh), X_OA);
@@ -447,19 +453,30 @@ void Grasping::carry(engine::Simulation& simulation) {
     return;
   }
   scene.set_world_pose(part, last_slide_.X_WP);
-  const bool in_contact = last_slide_.status != SlideStatus::kReached;
-  // A part whose start pose already touches (just snapped, then grasped again) can
-  // be blocked with no contact found; it slides on nothing named.
-  if (in_contact && !sliding_ && !last_slide_.contacts.empty()) {
-    sliding_ = true;
-    const SlideContact& first = last_slide_.contacts.front();
-    sliding_part_ = scene.name(bodies[first.body]);
-    sliding_on_ = scene.name(handles[first.obstacle]);
-    pending_.push_back({EventKind::kSlideBegin, frame, t, sliding_part_, sliding_on_});
-  } else if (!in_contact && sliding_ && last_slide_.status == SlideStatus::kReached) {
-    sliding_ = false;
-    pending_.push_back({EventKind::kSlideEnd, frame, t, sliding_part_, sliding_on_});
+  // What slides on what: each moving body against each obstacle it has a contact with.
+  std::vector<std::pair<std::string, std::string>> sliding;
+  if (last_slide_.status == SlideStatus::kReached) {
+    // Moving freely: on nothing.
+  } else if (last_slide_.contacts.empty()) {
+    // Held back with no contact found (a part grasped again where it was just snapped,
+    // its start touching): as it was.
+    sliding = sliding_pairs_;
+  } else {
+    for (const SlideContact& k : last_slide_.contacts) {
+      sliding.emplace_back(scene.name(bodies[k.body]), scene.name(handles[k.obstacle]));
+    }
+    std::sort(sliding.begin(), sliding.end());
+    sliding.erase(std::unique(sliding.begin(), sliding.end()), sliding.end());
   }
+  for (const auto& [a, b] : sliding_pairs_) {
+    if (!std::binary_search(sliding.begin(), sliding.end(), std::pair(a, b)))
+      pending_.push_back({EventKind::kSlideEnd, frame, t, a, b});
+  }
+  for (const auto& [a, b] : sliding) {
+    if (!std::binary_search(sliding_pairs_.begin(), sliding_pairs_.end(), std::pair(a, b)))
+      pending_.push_back({EventKind::kSlideBegin, frame, t, a, b});
+  }
+  sliding_pairs_ = std::move(sliding);
 }
 
 Transform Grasping::guided(const engine::Scene& scene, const std::string& part,
@@ -502,11 +519,10 @@ Transform Grasping::guided(const engine::Scene& scene, const std::string& part,
 void Grasping::release(engine::Simulation& simulation, const std::string& reason) {
   const std::string part = *held_;
   pending_.push_back({EventKind::kRelease, simulation.frame(), simulation.time(), part, reason});
-  if (sliding_) {
-    pending_.push_back(
-        {EventKind::kSlideEnd, simulation.frame(), simulation.time(), sliding_part_, sliding_on_});
-    sliding_ = false;
+  for (const auto& [a, b] : sliding_pairs_) {
+    pending_.push_back({EventKind::kSlideEnd, simulation.frame(), simulation.time(), a, b});
   }
+  sliding_pairs_.clear();
   held_.reset();
   guiding_.reset();
   opened_since_ = -1;

@@ -193,8 +193,8 @@ std::vector<Word> make_vocabulary() {
                WordKind::kEvent,
                {{"part", kPart, kRequired, "the held part, or a part attached to it"},
                 {"on", kPart, kOptional, "only on this part"}},
-               "The held part begins to slide along another part (or a part attached to it does: "
-               "the one that touches is named).",
+               "The held part (or a part attached to it) comes into contact with another part "
+               "while carried and slides along it: once for each pair, named as it touches.",
                "slides(\"peg\", \"block\")"});
   w.push_back(
       {"enters",

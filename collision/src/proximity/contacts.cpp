@@ -33,7 +33,8 @@ struct PairPiece {
 };
 
 /// Most distance queries one search of the edges' deepest points makes
-/// (InsideReach::edge_reach); past it, the deepest point found so far counts.
+/// (InsideReach::edge_reach), beyond one at each end of every stretch; past
+/// it, the deepest point found so far counts.
 constexpr std::size_t kEdgeProbes = 4096;
 
 /// A face counts for the depth when its normal is within 60 degrees of the patch normal.
@@ -465,7 +466,7 @@ class InsideReach {
   /// is no deeper than the farther of its ends from the triangle nearest
   /// either end), best piece first over all the edges, to within the
   /// resolution (or a thousandth of the depth) and at most kEdgeProbes
-  /// distance queries a call; a stretch is located (one exact
+  /// distance queries a call beyond the stretches' ends; a stretch is located (one exact
   /// point-in-solid test) only when it could beat the deepest point so far.
   /// The deepest point found is located again, as the vertex regions' is.
   Real edge_reach(const std::vector<std::uint32_t>& seeds, Real known) {
@@ -525,6 +526,8 @@ class InsideReach {
       }
     }
     std::make_heap(heap.begin(), heap.end());
+    probes =
+        0;  // the budget is the search's: the stretches' ends above are measured whatever it is
     Real deepest = known;
     Vec3 deepest_point = Vec3::Zero();
     while (!heap.empty() && probes < kEdgeProbes) {

@@ -213,9 +213,9 @@ class Grasping {
   Real candidate_start_flexion_ = 0;  ///< total glove flexion the frame before the candidate
   Real last_flexion_ = 0;
   std::optional<std::size_t> guiding_;  ///< the mate drawing the held part onto its axis
-  bool sliding_ = false;
-  std::string sliding_part_;  ///< the part that slides: the held part or one attached to it
-  std::string sliding_on_;    ///< ... on this one
+  /// What slides on what, sorted: (the held part or a part attached to it, the part it
+  /// has a contact with), as the last slide_begin events said.
+  std::vector<std::pair<std::string, std::string>> sliding_pairs_;
   SlideResult last_slide_{};
   SlideFronts fronts_;                          ///< of the held part, against each obstacle
   std::vector<engine::PartId> contact_parts_;   ///< the parts of last_slide_'s obstacle ids
