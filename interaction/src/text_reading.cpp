@@ -40,6 +40,11 @@ std::optional<std::string_view> LineReader::next() {
     fail("line longer than " + std::to_string(kMaxTraceLineBytes) + " bytes");
   }
   std::string_view text(buffer_.data(), length);
+  if (text.find('\r') != std::string_view::npos) {
+    fail(
+        "a carriage return within the line: lines end with \\n or \\r\\n, not a lone \\r "
+        "(the line endings of old Mac files)");
+  }
   // A UTF-8 byte-order mark, as some editors and spreadsheets write, is not text.
   if (line_ == 1 && text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
   return text;

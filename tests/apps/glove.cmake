@@ -27,7 +27,8 @@ foreach(case
     "empty|bad_empty.csv: empty, no header"
     "no_header|bad_no_header.csv:1: expected a header row"
     "short_row|bad_short_row.csv:3: expected 30 fields, found 29"
-    "tab_separated|trace_tab_separated.csv:1: unknown column [^\n]*; the fields of a trace are separated by commas")
+    "tab_separated|trace_tab_separated.csv:1: unknown column [^\n]*; the fields of a trace are separated by commas"
+    "cr_line_endings|bad_cr_line_endings.csv:1: a carriage return within the line")
   string(REPLACE "|" ";" parts "${case}")
   list(GET parts 0 name)
   list(GET parts 1 message)
