@@ -118,7 +118,8 @@ struct PlyElement {
   Count count;
   std::size_t binary_bytes = 0;  // fixed bytes per element in binary formats
   std::size_t properties = 0;
-  bool lists = false;  // has a list property
+  bool lists = false;         // has a list property
+  std::vector<bool> is_list;  // per property, in order
 };
 
 /// An ASCII PLY body line by line: each element's entries one a line, in
@@ -159,6 +160,25 @@ std::optional<std::string> check_ascii_ply_body(const std::filesystem::path& pat
       } else if (!e.lists && w->size() != e.properties) {
         return "PLY line " + std::to_string(line) + ": a " + e.name + " has " +
                std::to_string(e.properties) + " values, this line " + std::to_string(w->size());
+      } else if (e.lists) {  // values and lists mixed: each list its count, then its values
+        std::size_t at = 0;  // the next word; past the end: the line is wrong
+        for (const bool list : e.is_list) {
+          if (at >= w->size()) {
+            at = w->size() + 1;
+            break;
+          }
+          const Count n = list ? parse_count((*w)[at]) : Count{.valid = true, .value = 0};
+          if (!n.valid || n.value > w->size()) {
+            at = w->size() + 1;
+            break;
+          }
+          at += 1 + n.value;
+        }
+        if (at != w->size()) {
+          return "PLY line " + std::to_string(line) + ": a " + e.name + " line does not hold its " +
+                 std::to_string(e.properties) +
+                 " properties (a list: its count, then that many values)";
+        }
       }
     }
   }
@@ -212,6 +232,7 @@ std::optional<std::string> check_ply(const std::filesystem::path& path, std::str
       if (elements.empty()) return bad("property before any element");
       PlyElement& e = elements.back();
       ++e.properties;
+      e.is_list.push_back(w.size() >= 2 && w[1] == "list");
       if (w.size() >= 2 && w[1] == "list") {
         if (w.size() != 5) return bad("a list property needs two types and a name");
         const std::size_t count_size = ply_type_size(w[2]);

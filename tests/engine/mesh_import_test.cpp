@@ -202,6 +202,27 @@ TEST(MeshImport, AnAsciiPlyBodyMustMatchItsHeader) {
   EXPECT_EQ(total_triangles(import_file(dir / "ok.ply")), 2u);
 }
 
+TEST(MeshImport, AnAsciiPlyElementMixingValuesAndListsMustMatchItsHeader) {
+  // A vertex element with a list property after its coordinates, its lines
+  // without the list: the importer read on into the next lines and asked for
+  // 11 GB. Each line must hold every property, a list as its count and then
+  // that many values.
+  const TempDir dir;
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nproperty list uchar uint tags\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  write_file(dir / "bad.ply", header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_NE(import_error(dir / "bad.ply")
+                .find("bad.ply: PLY line 11: a vertex line does not hold its 4 properties"),
+            std::string::npos);
+  write_file(dir / "long.ply", header + "0 0 0 2 7\n1 0 0 0\n0 1 0 0\n3 0 1 2\n");
+  EXPECT_NE(import_error(dir / "long.ply").find("PLY line 11: a vertex line does not hold"),
+            std::string::npos);
+  write_file(dir / "ok.ply", header + "0 0 0 2 7 8\n1 0 0 0\n0 1 0 1 5\n3 0 1 2\n");
+  EXPECT_EQ(total_triangles(import_file(dir / "ok.ply")), 1u);
+}
+
 TEST(MeshImport, GlbMergedEqualsItsParts) {
   const fs::path file = kModels / "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
   const ImportReport merged = import_file(file);
