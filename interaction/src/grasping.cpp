@@ -374,16 +374,20 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   }
 }
 
-void Grasping::carry(engine::Simulation& simulation) {
-  engine::Scene& scene = simulation.scene();
-  const PartId part = scene.get(*held_);
-  const auto& mesh = scene.collision_mesh(part);
-  const Transform X_WO = scene.world_pose(part);
-  const Transform X_WO_target = guided(scene, *held_, engine::compose(hand_->X_WH(), X_HO_));
-  // The parts attached to the held part move with it and are kept out of the others as it is.
-  std::vector<SlideAttachment> attached;
-  std::vector<PartId> bodies{part};  // the moving bodies: the part, then its attachments
-  collision::Bounds local = models_->mesh_bounds(mesh);
+namespace {
+
+/// `box` grown to hold `other` too.
+void grow(collision::Bounds& box, const collision::Bounds& other) {
+  box.min = box.min.cwiseMin(other.min);
+  box.max = box.max.cwiseMax(other.max);
+}
+
+}  // namespace
+
+Grasping::MovingBodies Grasping::moving_bodies(const engine::Scene& scene, PartId part) {
+  MovingBodies out;
+  out.parts.push_back(part);
+  out.local = models_->mesh_bounds(scene.collision_mesh(part));
   for (const PartId q : scene.parts()) {
     const auto& q_mesh = scene.collision_mesh(q);
     if (q == part || !q_mesh || scene.has_tag(q, "hand") || !scene.descends_from(q, part)) continue;
@@ -393,17 +397,26 @@ void Grasping::carry(engine::Simulation& simulation) {
     for (PartId p = scene.parent(q); p != part; p = scene.parent(p)) {
       X_OA = engine::compose(scene.local_pose(p), X_OA);
     }
-    attached.push_back({models_->collision_model(q_mesh), X_OA});
-    bodies.push_back(q);
-    const collision::Bounds box = collision::transformed_bounds(models_->mesh_bounds(q_mesh), X_OA);
-    local.min = local.min.cwiseMin(box.min);
-    local.max = local.max.cwiseMax(box.max);
+    out.attached.push_back({models_->collision_model(q_mesh), X_OA});
+    out.parts.push_back(q);
+    grow(out.local, collision::transformed_bounds(models_->mesh_bounds(q_mesh), X_OA));
   }
+  return out;
+}
+
+void Grasping::carry(engine::Simulation& simulation) {
+  engine::Scene& scene = simulation.scene();
+  const PartId part = scene.get(*held_);
+  const auto& mesh = scene.collision_mesh(part);
+  const Transform X_WO = scene.world_pose(part);
+  const Transform X_WO_target = guided(scene, *held_, engine::compose(hand_->X_WH(), X_HO_));
+  // The parts attached to the held part move with it and are kept out of the others as it is.
+  const MovingBodies moving = moving_bodies(scene, part);
+  const std::vector<PartId>& bodies = moving.parts;
+  const collision::Bounds& local = moving.local;
   // Obstacles: every other part that the swept box of the move reaches.
   collision::Bounds swept = collision::transformed_bounds(local, X_WO);
-  const collision::Bounds to = collision::transformed_bounds(local, X_WO_target);
-  swept.min = swept.min.cwiseMin(to.min);
-  swept.max = swept.max.cwiseMax(to.max);
+  grow(swept, collision::transformed_bounds(local, X_WO_target));
   std::vector<SlideObstacle> obstacles;
   std::vector<PartId> handles;
   for (const PartId other : scene.parts()) {
@@ -420,7 +433,7 @@ void Grasping::carry(engine::Simulation& simulation) {
   SlideRequest request;
   request.part = models_->collision_model(mesh);
   request.part_distance = models_->distance_shared(mesh);
-  request.attached = attached;
+  request.attached = moving.attached;
   request.p_PC = (local.min + local.max) / 2;
   request.size = std::max<Real>((local.max - local.min).norm() / 2, 1e-4);
   request.X_WP = X_WO;
@@ -453,6 +466,11 @@ void Grasping::carry(engine::Simulation& simulation) {
     return;
   }
   scene.set_world_pose(part, last_slide_.X_WP);
+  report_sliding(scene, bodies, handles, frame, t);
+}
+
+void Grasping::report_sliding(const engine::Scene& scene, std::span<const PartId> bodies,
+                              std::span<const PartId> handles, std::uint64_t frame, Real t) {
   // What slides on what: each moving body against each obstacle it has a contact with.
   std::vector<std::pair<std::string, std::string>> sliding;
   if (last_slide_.status == SlideStatus::kReached) {
@@ -554,11 +572,10 @@ Grasping::Overlap Grasping::deepest_overlap(const engine::Scene& scene, PartId p
                                             const Transform& X_WP) {
   // The part and the parts attached to it move together, rigidly: each by
   // the same move, and none is checked against another of them.
-  const auto in_family = [&](PartId other) { return scene.descends_from(other, part); };
   const Transform move = engine::compose(X_WP, scene.world_pose(part).inverse());
   std::vector<std::pair<PartId, Transform>> moved;
   for (const PartId q : scene.parts()) {
-    if (in_family(q) && scene.collision_mesh(q)) {
+    if (scene.descends_from(q, part) && scene.collision_mesh(q)) {
       moved.emplace_back(q, q == part ? X_WP : engine::compose(move, scene.world_pose(q)));
     }
   }
@@ -568,7 +585,7 @@ Grasping::Overlap Grasping::deepest_overlap(const engine::Scene& scene, PartId p
     const collision::Bounds box = collision::transformed_bounds(models_->mesh_bounds(mesh), X_WQ);
     for (const PartId other : scene.parts()) {
       const auto& other_mesh = scene.collision_mesh(other);
-      if (!other_mesh || scene.has_tag(other, "hand") || in_family(other)) continue;
+      if (!other_mesh || scene.has_tag(other, "hand") || scene.descends_from(other, part)) continue;
       const Transform X_WB = scene.world_pose(other);
       if (!overlap(collision::transformed_bounds(models_->mesh_bounds(other_mesh), X_WB), box, 0)) {
         continue;

@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <regex>
 
@@ -663,27 +664,43 @@ TEST(ScenarioRun, AGloveInOtherUnitsFailsWarningsAtMostZero) {
       << o.expectations[0].detail;
 }
 
+/// The glove trace of a run of the shipped peg-in-hole scenario, recorded in `dir`.
+std::filesystem::path recorded_peg_trace(const test::TempDir& dir) {
+  RunOptions record;
+  record.record = dir / "peg.csv";
+  EXPECT_EQ(run_scenario(kScenarios / "01_peg_in_hole.lua", record).status,
+            RunOutcome::Status::kPassed);
+  return *record.record;
+}
+
+/// The file `from` written to `to` line by line, each line (0-based `row`)
+/// through `edit`.
+void rewrite_lines(const std::filesystem::path& from, const std::filesystem::path& to,
+                   const std::function<std::string(int row, const std::string& line)>& edit) {
+  std::ifstream in(from);
+  std::ofstream out(to);
+  std::string line;
+  for (int row = 0; std::getline(in, line); ++row) out << edit(row, line) << "\n";
+}
+
+/// The text of the shipped peg-in-hole scenario.
+std::string peg_in_hole_text() {
+  std::ifstream f(kScenarios / "01_peg_in_hole.lua");
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
 TEST(ScenarioReplay, ATraceOnADeviceClockIsNamedAsSuch) {
   // A trace whose times count from 1970 (device time) rather than from the
   // start of the run: too long without a duration, said with where it starts;
   // with one, a warning that the hand stays at its first sample until then.
   const test::TempDir dir("dovetail_scenario");
-  RunOptions record;
-  record.record = dir / "peg.csv";
-  ASSERT_EQ(run_scenario(kScenarios / "01_peg_in_hole.lua", record).status,
-            RunOutcome::Status::kPassed);
-  std::ifstream in(dir / "peg.csv");
-  std::ofstream out(dir / "epoch.csv");
-  std::string line;
-  std::getline(in, line);
-  out << line << "\n";
-  while (std::getline(in, line)) {
+  rewrite_lines(recorded_peg_trace(dir), dir / "epoch.csv", [](int row, const std::string& line) {
+    if (row == 0) return line;  // the header
     const std::size_t comma = line.find(',');
     char t[64];
     std::snprintf(t, sizeof t, "%.17g", 1732752000.25 + std::stod(line.substr(0, comma)));
-    out << t << line.substr(comma) << "\n";
-  }
-  out.close();
+    return t + line.substr(comma);
+  });
   RunOptions replay;
   replay.trace = dir / "epoch.csv";
   const RunOutcome too_long = run_scenario(kScenarios / "01_peg_in_hole.lua", replay);
@@ -693,14 +710,9 @@ TEST(ScenarioReplay, ATraceOnADeviceClockIsNamedAsSuch) {
                                 "run), later than the"),
             std::string::npos)
       << too_long.error;
-  const std::string text = [&] {
-    std::ifstream f(kScenarios / "01_peg_in_hole.lua");
-    return std::string(std::istreambuf_iterator<char>(f), {});
-  }();
-  const std::string with_duration =
-      std::regex_replace(text, std::regex("units = \"mm\","), "units = \"mm\", duration = 1,");
   std::filesystem::create_directories(dir / "scenarios");
-  std::ofstream(dir / "scenarios" / "short.lua") << with_duration;
+  std::ofstream(dir / "scenarios" / "short.lua") << std::regex_replace(
+      peg_in_hole_text(), std::regex("units = \"mm\","), "units = \"mm\", duration = 1,");
   const RunOutcome frozen = run_scenario(dir / "scenarios" / "short.lua", replay);
   ASSERT_NE(frozen.status, RunOutcome::Status::kError) << frozen.error;
   ASSERT_FALSE(frozen.warnings.empty());
@@ -714,22 +726,12 @@ TEST(ScenarioReplay, AJointFarOutsideItsRangeIsAWarning) {
   // One sample's index_mcp at 500 degrees (a column misnamed, or radians
   // scaled twice): clamped as always, and now said before the run.
   const test::TempDir dir("dovetail_scenario");
-  RunOptions record;
-  record.record = dir / "peg.csv";
-  ASSERT_EQ(run_scenario(kScenarios / "01_peg_in_hole.lua", record).status,
-            RunOutcome::Status::kPassed);
-  std::ifstream in(dir / "peg.csv");
-  std::ofstream out(dir / "bent.csv");
-  std::string line;
-  for (int row = 0; std::getline(in, line); ++row) {
-    if (row == 2) {  // index_mcp is the 13th column
-      std::size_t at = 0;
-      for (int k = 0; k < 12; ++k) at = line.find(',', at) + 1;
-      line = line.substr(0, at) + "500" + line.substr(line.find(',', at));
-    }
-    out << line << "\n";
-  }
-  out.close();
+  rewrite_lines(recorded_peg_trace(dir), dir / "bent.csv", [](int row, const std::string& line) {
+    if (row != 2) return line;
+    std::size_t at = 0;  // index_mcp is the 13th column
+    for (int k = 0; k < 12; ++k) at = line.find(',', at) + 1;
+    return line.substr(0, at) + "500" + line.substr(line.find(',', at));
+  });
   RunOptions replay;
   replay.trace = dir / "bent.csv";
   const RunOutcome o = run_scenario(kScenarios / "01_peg_in_hole.lua", replay);
@@ -745,19 +747,11 @@ TEST(ScenarioReplay, AScenarioWithoutAGloveGetsTheTracesHandWithoutAWarning) {
   // Replayed, a scenario with no glove gets the trace's hand, so a rule on
   // released() can happen: no "the scenario has no hand".
   const test::TempDir dir("dovetail_scenario");
-  RunOptions record;
-  record.record = dir / "peg.csv";
-  ASSERT_EQ(run_scenario(kScenarios / "01_peg_in_hole.lua", record).status,
-            RunOutcome::Status::kPassed);
-  const std::string text = [&] {
-    std::ifstream f(kScenarios / "01_peg_in_hole.lua");
-    return std::string(std::istreambuf_iterator<char>(f), {});
-  }();
+  RunOptions replay;
+  replay.trace = recorded_peg_trace(dir);
   std::filesystem::create_directories(dir / "scenarios");
   std::ofstream(dir / "scenarios" / "noglove.lua")
-      << std::regex_replace(text, std::regex("  hand = glove [^\n]*\n"), "");
-  RunOptions replay;
-  replay.trace = dir / "peg.csv";
+      << std::regex_replace(peg_in_hole_text(), std::regex("  hand = glove [^\n]*\n"), "");
   const RunOutcome o = run_scenario(dir / "scenarios" / "noglove.lua", replay);
   ASSERT_NE(o.status, RunOutcome::Status::kError) << o.error;
   for (const std::string& w : o.warnings) EXPECT_EQ(w.find("has no hand"), std::string::npos) << w;

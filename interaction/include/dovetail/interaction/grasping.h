@@ -180,7 +180,18 @@ class Grasping {
   std::vector<engine::PartId> candidates(const engine::Scene& scene, const Transform& X_WH,
                                          Real reach) const;
   std::vector<GraspContact> touches(const engine::Scene& scene, engine::PartId part);
+  /// The held part and the parts attached to it, which move with it.
+  struct MovingBodies {
+    std::vector<engine::PartId> parts;      ///< the part, then its attachments (SlideContact::body)
+    std::vector<SlideAttachment> attached;  ///< the attachments, in the part's frame
+    collision::Bounds local;                ///< a box around all of them, in the part's frame
+  };
+  MovingBodies moving_bodies(const engine::Scene& scene, engine::PartId part);
   void carry(engine::Simulation& simulation);
+  /// slide_begin and slide_end for the pairs (moving body, obstacle) whose contacts
+  /// appeared or went in the last slide, `bodies` and `handles` naming its indices.
+  void report_sliding(const engine::Scene& scene, std::span<const engine::PartId> bodies,
+                      std::span<const engine::PartId> handles, std::uint64_t frame, Real t);
   Transform guided(const engine::Scene& scene, const std::string& part,
                    const Transform& X_WP_target);
   void release(engine::Simulation& simulation, const std::string& reason);
