@@ -22,6 +22,7 @@
 
 #include "declared_sizes.h"
 #include "folder_io_system.h"
+#include "import_process.h"
 
 namespace dovetail::engine {
 
@@ -491,13 +492,10 @@ void check_format(const fs::path& path) {
                  "; meshes are read from .obj, .stl, .ply, .gltf and .glb files");
 }
 
-ImportReport import_file(const fs::path& path, const ImportOptions& options) {
-  const std::uintmax_t size = check_file(path);
-  check_format(path);
-  if (std::optional<std::string> wrong = detail::check_declared_sizes(path, size, options.limits)) {
-    fail(path, *wrong);
-  }
+namespace {
 
+/// assimp's part of an import: the file read, checked and turned into parts.
+ImportReport read_with_assimp(const fs::path& path, const ImportOptions& options) {
   // The folder resolved as the file system does: "link/../x" is x beside
   // the link's target, not beside the link, as a textual normalisation would
   // have it. The file keeps its name, so a linked mesh finds its companion
@@ -561,6 +559,23 @@ ImportReport import_file(const fs::path& path, const ImportOptions& options) {
   ImportReport report = import_scene(path, *scene, options, std::move(notes));
   report.files = io->opened();
   return report;
+}
+
+}  // namespace
+
+ImportReport import_file(const fs::path& path, const ImportOptions& options) {
+  const std::uintmax_t size = check_file(path);
+  check_format(path);
+  if (std::optional<std::string> wrong = detail::check_declared_sizes(path, size, options.limits)) {
+    fail(path, *wrong);
+  }
+  if (!options.in_child_process) return read_with_assimp(path, options);
+  // What a legitimate import needs is some tens of times the file's size;
+  // the cap stops a file that talks assimp into allocating tens of gigabytes.
+  constexpr std::uintmax_t kGiB = std::uintmax_t{1} << 30;
+  const std::uintmax_t budget = 4 * kGiB + std::min<std::uintmax_t>(size, 16 * kGiB) * 64;
+  return detail::import_in_child(
+      path, [&] { return read_with_assimp(path, options); }, budget);
 }
 
 collision::Mesh import_mesh(const fs::path& path, collision::MeshValidation* validation) {

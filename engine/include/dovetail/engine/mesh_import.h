@@ -41,6 +41,12 @@ struct ImportOptions {
   bool part_frames = false;
   /// Checked before allocating (declared counts) and again by make_mesh.
   collision::MeshLimits limits;
+  /// true: the importer (assimp) reads the file in a child process, so that
+  /// a crash inside it on a malformed file is an ImportError naming the file
+  /// and the signal, and its memory is capped (4 GiB plus 64 times the
+  /// file's size). false: in this process, as the fuzz targets read, to see
+  /// the importer's own crashes, leaks and memory.
+  bool in_child_process = true;
 };
 
 /// One imported mesh, in the file's root frame (node transforms applied).
