@@ -131,7 +131,9 @@ class Runner {
   /// Fills `error` and returns false for an unknown part.
   bool part_pose(const char* name, Transform& X, char* error, std::size_t size);
   bool set_part_pose(const char* name, const Transform& X, char* error, std::size_t size);
-  double time() const { return sim_ ? sim_->time() : 0; }
+  /// The time of the frame whose start runs the action (or of the last
+  /// frame, for actions applied after it).
+  double time() const { return action_time_; }
   void log(std::string text) {
     out_.messages.push_back({time(), "log", std::move(text), current_where_});
   }
@@ -186,6 +188,7 @@ class Runner {
   std::vector<std::size_t> completion_order_;  ///< step indices in the order completed
   std::vector<std::optional<double>> rule_last_;
   std::vector<std::pair<const Clause*, double>> pending_;  ///< actions for the next frame
+  double action_time_ = 0;                                 ///< see time()
   std::vector<std::size_t> forced_steps_;                  ///< `complete` actions this frame
   std::vector<Event> injected_;                            ///< `snap` mate events this frame
   struct Motion {
@@ -578,6 +581,7 @@ void Runner::apply(const Clause& action, double now) {
       if (scenario_.steps[i].name == a) forced_steps_.push_back(i);
     }
   } else if (w == "custom") {
+    action_time_ = now;
     lua_State* L = host_.state();
     lua_rawgeti(L, LUA_REGISTRYINDEX, action.args[0].function_ref);
     push_api(L);
@@ -1095,6 +1099,11 @@ void Runner::run() {
       }
       if (meter) meter->update(f + 1);
     }
+    // Actions of rules that fired in the last frame would apply at the start
+    // of the next one, which does not come: they apply now, at the end time,
+    // before the expectations are judged (a `custom` action runs, a `move`
+    // without `over` lands). No frame follows to find their contacts.
+    if (!failed_by_rule_ && !pending_.empty()) start_frame(frames, previous);
     if (meter) meter->finish();
     out_.loop_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
@@ -1220,12 +1229,16 @@ std::string RunOutcome::to_json() const {
 std::string RunOutcome::failure_summary() const {
   std::string out;
   if (status == Status::kError) out += "error: " + error + "\n";
+  // A `fail` stops the run, and expectations may fail only because it did:
+  // the fail comes first, as the cause.
+  for (const Message& m : messages) {
+    if (m.level == "fail")
+      out += m.where.str() + ": failed at t=" + format_time(m.time) + " s: " + m.text + "\n";
+  }
   for (const ExpectationOutcome& e : expectations) {
     if (!e.passed) out += e.where.str() + ": expectation " + e.text + " failed: " + e.detail + "\n";
   }
   for (const Message& m : messages) {
-    if (m.level == "fail")
-      out += m.where.str() + ": failed at t=" + format_time(m.time) + " s: " + m.text + "\n";
     if (m.level == "violation")
       out += m.where.str() + ": at t=" + format_time(m.time) + " s: " + m.text + "\n";
   }

@@ -381,6 +381,48 @@ TEST(ScenarioRun, CustomActionsUseTheLowLevelApi) {
   EXPECT_EQ(logged_texts(o), (std::vector<std::string>{"0 100 0", "0 250 0"})) << o.to_json();
 }
 
+TEST(ScenarioRun, ActionsOfARuleFiredInTheLastFrameApplyBeforeTheEnd) {
+  // The run is 1 s long; after(1) fires in its last frame, whose actions
+  // would apply at the start of a frame that does not come.
+  const test::TempDir dir("dovetail_scenario");
+  const auto logs = write(dir, "last.lua",
+                          moved_peg("    rule { when = after(1), act = { custom(function(dt)\n"
+                                    "      dt.log(string.format(\"at %g\", dt.time())) end),\n"
+                                    "      move(\"peg\", { 0, 250, 0 }) } },",
+                                    ""));
+  const RunOutcome o = run_scenario(logs);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+  EXPECT_EQ(logged_texts(o), (std::vector<std::string>{"at 1"})) << o.to_json();
+  ASSERT_FALSE(o.final_poses.empty());
+  bool moved = false;
+  for (const auto& pose : o.final_poses) {
+    if (pose.part == "peg") moved = std::abs(pose.position.y() - 0.25) < 1e-12;
+  }
+  EXPECT_TRUE(moved) << o.to_json();  // final poses are in metres
+
+  const auto fails = write(dir, "last_error.lua",
+                           moved_peg("    rule { when = after(1), act = { custom(function(dt)\n"
+                                     "      error(\"boom\") end) } },",
+                                     ""));
+  const RunOutcome e = run_scenario(fails);
+  ASSERT_EQ(e.status, RunOutcome::Status::kError) << e.failure_summary();
+  EXPECT_NE(e.error.find("boom"), std::string::npos) << e.error;
+}
+
+TEST(ScenarioRun, AFailIsTheFirstReasonGivenBeforeExpectationsItCutShort) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file =
+      write(dir, "fail.lua",
+            moved_peg("    rule { when = after(0.1), act = { fail \"the peg was dropped\" } },",
+                      "    steps_in_order { \"insert\", \"check\" },"));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed);
+  const std::string summary = o.failure_summary();
+  EXPECT_EQ(summary.rfind(file.string() + ":17: failed at t=0.100 s: the peg was dropped\n", 0), 0u)
+      << summary;
+  EXPECT_NE(summary.find("steps_in_order"), std::string::npos) << summary;
+}
+
 TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
   // A NUL inside a logged text (a log action's and dt.log's) is kept, and
   // the report writes it as \u0000; the failure summary for the terminal
