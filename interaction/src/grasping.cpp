@@ -160,6 +160,7 @@ void Grasping::hold(const std::string& part, GraspType type) {
   X_HO_ = engine::compose(hand_->X_WH().inverse(), scene.world_pose(handle));
   for (std::size_t d = 0; d < kDigitCount; ++d) {
     flexion_at_grasp_[d] = flexion(hand_->glove_angles(), digit_joints(d));
+    release_opening_[d] = settings_.grasp.release_open_deg;
     grasping_digit_[d] = type == GraspType::kPower || d <= (type == GraspType::kTripod ? 2U : 1U);
   }
   opened_since_ = -1;
@@ -303,9 +304,8 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
     // Release: a grasping digit opened past its flexion at the grasp, long enough.
     bool opened = false;
     for (std::size_t d = 0; d < kDigitCount; ++d) {
-      opened =
-          opened || (grasping_digit_[d] &&
-                     digit_flexion[d] < flexion_at_grasp_[d] - settings_.grasp.release_open_deg);
+      opened = opened || (grasping_digit_[d] &&
+                          digit_flexion[d] < flexion_at_grasp_[d] - release_opening_[d]);
     }
     if (!opened) {
       opened_since_ = -1;
@@ -318,6 +318,7 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
       carry(simulation);
     }
     last_flexion_ = total_flexion;
+    last_digit_flexion_ = digit_flexion;
     return;
   }
 
@@ -348,11 +349,13 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
     candidate_type_ = *found;
     candidate_frames_ = 1;
     candidate_start_flexion_ = last_flexion_;
+    candidate_start_digits_ = last_digit_flexion_;
   } else {
     candidate_.clear();
     candidate_frames_ = 0;
   }
   last_flexion_ = total_flexion;
+  last_digit_flexion_ = digit_flexion;
   // The grasp holds for onset_frames; its type is taken once the hand stops closing
   // (or after four times as long), so that the last fingers to arrive count.
   // And the hand must have closed while the grasp built up: an open or still hand
@@ -367,6 +370,16 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
     grasping_digit_.fill(false);
     for (const GraspContact& touch : found_contacts) {
       if (const std::optional<std::size_t> d = digit_of(touch.segment)) grasping_digit_[*d] = true;
+    }
+    // A grasp made as the fingers barely moved (a bar against the palm, the
+    // fingers stopped on it at once) may sit less than release_open_deg above
+    // the open hand, which could then never release it: such a digit
+    // releases when it opens back half of what it closed while the grasp
+    // built up (at least a degree, for the glove's jitter).
+    constexpr Real kMinOpening = 1;  // degrees
+    for (std::size_t d = 0; d < kDigitCount; ++d) {
+      const Real closed = flexion_at_grasp_[d] - candidate_start_digits_[d];
+      release_opening_[d] = std::clamp(closed / 2, kMinOpening, settings_.grasp.release_open_deg);
     }
     emit(EventKind::kGrasp, candidate_, std::string(grasp_type_name(candidate_type_)));
     candidate_.clear();

@@ -423,6 +423,44 @@ TEST(ScenarioRun, AFailIsTheFirstReasonGivenBeforeExpectationsItCutShort) {
   EXPECT_NE(summary.find("steps_in_order"), std::string::npos) << summary;
 }
 
+TEST(ScenarioRun, AGraspMadeAsTheFingersBarelyMovedIsReleasedWhenTheHandOpens) {
+  // The palm comes against a vertical bar and the fingers stop on it a few
+  // degrees into the close; opening the hand must let the bar go, which a
+  // release 8 degrees below the flexion at the grasp never could.
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "vbar.plan",
+        "start -0.070 0.060 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
+        "reach 0.6  -0.010 0.060 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
+        "close 0.4 power\n"
+        "reach 1.0  -0.010 0.110 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
+        "open 0.3\n"
+        "reach 1.0  -0.010 0.160 0.080  0.7071067811865476 0 0 0.7071067811865476\n");
+  const auto file = write(dir, "vbar.lua", R"(return scenario {
+  name = "vertical bar", units = "mm",
+  parts = {
+    bar = part { shape = cylinder { diameter = 40, length = 120 }, at = { 0, 120, 0 }, turn = { x = 90 } },
+  },
+  hand = glove { plan = "vbar.plan" },
+  rules = {
+    rule { when = grasped "bar", act = { log "grasped" } },
+    rule { when = released "bar", act = { log "released" } },
+  },
+  expect = { grasped_as("bar", "power") },
+}
+)");
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+  const auto logged = logged_messages(o);
+  ASSERT_EQ(logged.size(), 2u) << o.to_json();
+  EXPECT_EQ(logged[1].second, "released");
+  // Opened over 2.0-2.3 s, released 50 ms after a digit opened far enough.
+  EXPECT_GT(logged[1].first, 2.0);
+  EXPECT_LT(logged[1].first, 2.4);
+  // Carried up 50 mm while held, left there when the hand went on up.
+  ASSERT_EQ(o.final_poses.size(), 1u);
+  EXPECT_NEAR(o.final_poses[0].position.y(), 0.170, 1e-4);
+}
+
 TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
   // A NUL inside a logged text (a log action's and dt.log's) is kept, and
   // the report writes it as \u0000; the failure summary for the terminal

@@ -56,11 +56,13 @@ std::optional<GraspType> classify_grasp(std::span<const GraspContact> contacts, 
 
 /// When a grasp begins and ends (defaults: notes/grasping.md).
 struct GraspSettings {
-  Real contact_gap = 0.0002;   ///< a segment within this of a part touches it (GraspIt!'s 0.2 mm)
-  Real friction = 0.5;         ///< mu: contacts oppose inside cones of half-angle atan(mu)
-  int onset_frames = 3;        ///< the grasp must hold this many frames while the hand closes
-  Real release_open_deg = 8;   ///< a grasping digit opened this far past its flexion at the grasp
-  Real release_time_s = 0.05;  ///< ... for this long releases the part
+  Real contact_gap = 0.0002;  ///< a segment within this of a part touches it (GraspIt!'s 0.2 mm)
+  Real friction = 0.5;        ///< mu: contacts oppose inside cones of half-angle atan(mu)
+  int onset_frames = 3;       ///< the grasp must hold this many frames while the hand closes
+  /// A grasping digit opened this far past its flexion at the grasp releases
+  /// (or half of what it closed while the grasp built up, when that is less).
+  Real release_open_deg = 8;
+  Real release_time_s = 0.05;       ///< ... for this long releases the part
   int finger_bisection_steps = 12;  ///< halvings toward a finger's first contact (0.02 deg)
 };
 
@@ -216,13 +218,19 @@ class Grasping {
   GraspType type_ = GraspType::kPrecision;
   Transform X_HO_{};
   std::array<Real, kDigitCount> flexion_at_grasp_{};
+  /// How far a grasping digit must open below flexion_at_grasp_ to release
+  /// (see release_open_deg).
+  std::array<Real, kDigitCount> release_opening_{};
   std::array<bool, kDigitCount> grasping_digit_{};
   Real opened_since_ = -1;  ///< time the release condition began to hold; < 0: not holding
   std::string candidate_;   ///< part whose grasp is building up
   GraspType candidate_type_ = GraspType::kPrecision;
   int candidate_frames_ = 0;
   Real candidate_start_flexion_ = 0;  ///< total glove flexion the frame before the candidate
+  /// Each digit's glove flexion the frame before the candidate.
+  std::array<Real, kDigitCount> candidate_start_digits_{};
   Real last_flexion_ = 0;
+  std::array<Real, kDigitCount> last_digit_flexion_{};
   std::optional<std::size_t> guiding_;  ///< the mate drawing the held part onto its axis
   /// What slides on what, sorted: (the held part or a part attached to it, the part it
   /// has a contact with), as the last slide_begin events said.
