@@ -150,20 +150,53 @@ void Grasping::hold(const std::string& part, GraspType type) {
   if (!scene.collision_mesh(handle)) {
     throw engine::SceneError("grasping: part '" + part + "' has no collision mesh to hold");
   }
+  const PartId root = carried_root(scene, handle);
+  if (!scene.movable(root)) {
+    throw engine::SceneError("grasping: part '" + part + "' is attached to '" + scene.name(root) +
+                             "', which is fixed, so it cannot be held");
+  }
   held_ = part;
+  carried_ = scene.name(root);
   type_ = type;
   last_slide_ = {};
   fronts_.clear();
   contact_parts_.clear();
   contact_bodies_.clear();
   sliding_pairs_.clear();
-  X_HO_ = engine::compose(hand_->X_WH().inverse(), scene.world_pose(handle));
+  X_HO_ = engine::compose(hand_->X_WH().inverse(), scene.world_pose(root));
   for (std::size_t d = 0; d < kDigitCount; ++d) {
     flexion_at_grasp_[d] = flexion(hand_->glove_angles(), digit_joints(d));
+    peak_flexion_[d] = flexion_at_grasp_[d];
     release_opening_[d] = settings_.grasp.release_open_deg;
     grasping_digit_[d] = type == GraspType::kPower || d <= (type == GraspType::kTripod ? 2U : 1U);
   }
   opened_since_ = -1;
+}
+
+PartId Grasping::carried_root(const engine::Scene& scene, PartId part) {
+  PartId root = part;
+  for (PartId p = scene.parent(part); p.valid() && !scene.has_tag(p, "hand"); p = scene.parent(p)) {
+    root = p;
+  }
+  return root;
+}
+
+Transform Grasping::pose_in(const engine::Scene& scene, PartId root, PartId part) {
+  if (part == root) return Transform{};
+  Transform X_RP = scene.local_pose(part);
+  for (PartId p = scene.parent(part); p != root; p = scene.parent(p)) {
+    X_RP = engine::compose(scene.local_pose(p), X_RP);
+  }
+  return X_RP;
+}
+
+Transform Grasping::carried_pose(const engine::Scene& scene, PartId part,
+                                 const Transform& X_WH) const {
+  if (!carried_) return scene.world_pose(part);
+  const PartId root = scene.get(*carried_);
+  if (part == root) return engine::compose(X_WH, X_HO_);
+  if (!scene.descends_from(part, root)) return scene.world_pose(part);
+  return engine::compose(engine::compose(X_WH, X_HO_), pose_in(scene, root, part));
 }
 
 std::vector<PartId> Grasping::candidates(const engine::Scene& scene, const Transform& X_WH,
@@ -173,8 +206,7 @@ std::vector<PartId> Grasping::candidates(const engine::Scene& scene, const Trans
   for (const PartId part : scene.parts()) {
     const auto& mesh = scene.collision_mesh(part);
     if (!mesh || scene.has_tag(part, "hand")) continue;
-    const Transform X_WP =
-        held_ && scene.name(part) == *held_ ? engine::compose(X_WH, X_HO_) : scene.world_pose(part);
+    const Transform X_WP = carried_pose(scene, part, X_WH);
     if (overlap(collision::transformed_bounds(models_->mesh_bounds(mesh), X_WP), around, 0))
       out.push_back(part);
   }
@@ -188,9 +220,8 @@ void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
   if (parts.empty()) return;
   std::vector<SlideObstacle> obstacles;
   for (const PartId part : parts) {
-    const bool held = held_ && scene.name(part) == *held_;
     obstacles.push_back({models_->collision_model(scene.collision_mesh(part)), nullptr,
-                         held ? engine::compose(X_WH, X_HO_) : scene.world_pose(part), part.index});
+                         carried_pose(scene, part, X_WH), part.index});
   }
   auto digit_collides = [&](const JointAngles& q, const DigitJoints& d) {
     const HandPose pose = model.forward_kinematics(q);
@@ -302,10 +333,17 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
 
   if (held_) {
     // Release: a grasping digit opened past its flexion at the grasp, long enough.
+    // Or opened by release_opening_, less, after closing release_open_deg past
+    // the grasp: squeezing, then opening, is a gesture glove jitter does not make.
     bool opened = false;
+    const Real open_deg = settings_.grasp.release_open_deg;
     for (std::size_t d = 0; d < kDigitCount; ++d) {
+      peak_flexion_[d] = std::max(peak_flexion_[d], digit_flexion[d]);
+      const Real at_grasp = flexion_at_grasp_[d];
+      const bool squeezed = peak_flexion_[d] >= at_grasp + open_deg;
       opened = opened || (grasping_digit_[d] &&
-                          digit_flexion[d] < flexion_at_grasp_[d] - release_opening_[d]);
+                          (digit_flexion[d] < at_grasp - open_deg ||
+                           (squeezed && digit_flexion[d] < at_grasp - release_opening_[d])));
     }
     if (!opened) {
       opened_since_ = -1;
@@ -327,7 +365,8 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   std::string found_part;
   std::vector<GraspContact> found_contacts;
   for (const PartId part : candidates(scene, hand_->X_WH(), 1.2 * hand_->model().hand_length())) {
-    if (!scene.movable(part)) continue;  // fixed parts stop the fingers but are not grasped
+    // Fixed parts, and parts attached to a fixed one, stop the fingers but are not grasped.
+    if (!scene.movable(part) || !scene.movable(carried_root(scene, part))) continue;
     std::vector<GraspContact> touching = touches(scene, part);
     if (touching.empty()) continue;
     if (const std::optional<GraspType> type = classify_grasp(touching, settings_.grasp.friction)) {
@@ -375,11 +414,12 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
     // fingers stopped on it at once) may sit less than release_open_deg above
     // the open hand, which could then never release it: such a digit
     // releases when it opens back half of what it closed while the grasp
-    // built up (at least a degree, for the glove's jitter).
-    constexpr Real kMinOpening = 1;  // degrees
+    // built up.
     for (std::size_t d = 0; d < kDigitCount; ++d) {
       const Real closed = flexion_at_grasp_[d] - candidate_start_digits_[d];
-      release_opening_[d] = std::clamp(closed / 2, kMinOpening, settings_.grasp.release_open_deg);
+      if (closed > 0) {
+        release_opening_[d] = std::min(closed / 2, settings_.grasp.release_open_deg);
+      }
     }
     emit(EventKind::kGrasp, candidate_, std::string(grasp_type_name(candidate_type_)));
     candidate_.clear();
@@ -404,12 +444,9 @@ Grasping::MovingBodies Grasping::moving_bodies(const engine::Scene& scene, PartI
   for (const PartId q : scene.parts()) {
     const auto& q_mesh = scene.collision_mesh(q);
     if (q == part || !q_mesh || scene.has_tag(q, "hand") || !scene.descends_from(q, part)) continue;
-    // The chain of local poses from the held part down to q: the same bits every frame
-    // (relative to a moving part, the world poses round differently each time).
-    Transform X_OA = scene.local_pose(q);
-    for (PartId p = scene.parent(q); p != part; p = scene.parent(p)) {
-      X_OA = engine::compose(scene.local_pose(p), X_OA);
-    }
+    // From the chain of local poses: relative to a moving part, the world poses
+    // round differently each frame.
+    const Transform X_OA = pose_in(scene, part, q);
     out.attached.push_back({models_->collision_model(q_mesh), X_OA});
     out.parts.push_back(q);
     grow(out.local, collision::transformed_bounds(models_->mesh_bounds(q_mesh), X_OA));
@@ -419,11 +456,23 @@ Grasping::MovingBodies Grasping::moving_bodies(const engine::Scene& scene, PartI
 
 void Grasping::carry(engine::Simulation& simulation) {
   engine::Scene& scene = simulation.scene();
-  const PartId part = scene.get(*held_);
+  const PartId held = scene.get(*held_);
+  const PartId part = carried_root(scene, held);
+  if (scene.name(part) != *carried_) {
+    // Attached or detached while held (a rule's attach): the hand carries the
+    // new top of the sub-assembly from where it is now, or lets go of a part
+    // now attached to a fixed one.
+    if (!scene.movable(part)) {
+      release(simulation, "attached");
+      return;
+    }
+    carried_ = scene.name(part);
+    X_HO_ = engine::compose(hand_->X_WH().inverse(), scene.world_pose(part));
+  }
   const auto& mesh = scene.collision_mesh(part);
   const Transform X_WO = scene.world_pose(part);
-  const Transform X_WO_target = guided(scene, *held_, engine::compose(hand_->X_WH(), X_HO_));
-  // The parts attached to the held part move with it and are kept out of the others as it is.
+  const Transform X_WO_target = guided(scene, part, engine::compose(hand_->X_WH(), X_HO_));
+  // The parts attached to the carried part move with it and are kept out of the others as it is.
   const MovingBodies moving = moving_bodies(scene, part);
   const std::vector<PartId>& bodies = moving.parts;
   const collision::Bounds& local = moving.local;
@@ -510,13 +559,15 @@ void Grasping::report_sliding(const engine::Scene& scene, std::span<const PartId
   sliding_pairs_ = std::move(sliding);
 }
 
-Transform Grasping::guided(const engine::Scene& scene, const std::string& part,
-                           const Transform& X_WP_target) {
+Transform Grasping::guided(const engine::Scene& scene, PartId root, const Transform& X_WR_target) {
   for (std::size_t m = 0; m < mates_.size(); ++m) {
     const Mate& mate = mates_[m];
-    if (mate.part != part || !mate.guide) continue;
-    const PartId o = scene.find(mate.other);
-    if (!o.valid()) continue;
+    if (!mate.guide) continue;
+    // A mate of the carried part or of a part attached to it (the held part among them).
+    const PartId p = scene.find(mate.part), o = scene.find(mate.other);
+    if (!p.valid() || !o.valid() || !scene.descends_from(p, root)) continue;
+    const Transform X_RP = pose_in(scene, root, p);
+    const Transform X_WP_target = p == root ? X_WR_target : engine::compose(X_WR_target, X_RP);
     const Transform X_WO = scene.world_pose(o);
     const Vec3 q_W = X_WO.apply(mate.p_OF);
     const Vec3 b_W = (X_WO.R * mate.axis_O).normalized();
@@ -542,9 +593,9 @@ Transform Grasping::guided(const engine::Scene& scene, const std::string& part,
     const Vec3 p_new = X.apply(mate.p_PF);
     const Vec3 on_line = q_W + b_W * b_W.dot(p_new - q_W);
     X.t += on_line - p_new;
-    return X;
+    return p == root ? X : engine::compose(X, X_RP.inverse());
   }
-  return X_WP_target;
+  return X_WR_target;
 }
 
 void Grasping::release(engine::Simulation& simulation, const std::string& reason) {
@@ -555,6 +606,7 @@ void Grasping::release(engine::Simulation& simulation, const std::string& reason
   }
   sliding_pairs_.clear();
   held_.reset();
+  carried_.reset();
   guiding_.reset();
   opened_since_ = -1;
   snap(simulation, part);
@@ -562,19 +614,25 @@ void Grasping::release(engine::Simulation& simulation, const std::string& reason
 
 void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
   engine::Scene& scene = simulation.scene();
+  // The first mate of the released part's sub-assembly within its tolerances
+  // seats it, moving the whole sub-assembly.
+  const PartId root = carried_root(scene, scene.get(part));
+  if (!scene.movable(root)) return;
   for (const Mate& mate : mates_) {
-    if (mate.part != part) continue;
     const PartId p = scene.find(mate.part), o = scene.find(mate.other);
-    if (!p.valid() || !o.valid()) continue;
+    if (!p.valid() || !o.valid() || !scene.descends_from(p, root)) continue;
     const Transform X_WP = scene.world_pose(p), X_WO = scene.world_pose(o);
     if (!within_tolerance(mate, X_WP, X_WO)) continue;
     const Transform X_seated = mate_pose(mate, X_WP, X_WO);
-    if (const Overlap overlap = deepest_overlap(scene, p, X_seated); overlap.depth > kSnapOverlap) {
-      refused_snaps_.push_back({mate.name, part, overlap.blocker, overlap.overlapping,
+    const Transform X_WR_seated =
+        p == root ? X_seated : engine::compose(X_seated, pose_in(scene, root, p).inverse());
+    if (const Overlap overlap = deepest_overlap(scene, root, X_WR_seated);
+        overlap.depth > kSnapOverlap) {
+      refused_snaps_.push_back({mate.name, mate.part, overlap.blocker, overlap.overlapping,
                                 overlap.depth, simulation.time()});
       continue;
     }
-    scene.set_world_pose(p, X_seated);
+    scene.set_world_pose(root, X_WR_seated);
     pending_.push_back(
         {EventKind::kMate, simulation.frame(), simulation.time(), mate.part, mate.other});
     return;

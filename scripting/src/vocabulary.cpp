@@ -182,7 +182,8 @@ std::vector<Word> make_vocabulary() {
   w.push_back({"released",
                WordKind::kEvent,
                {{"part", kPart, kRequired, "the part"}},
-               "The hand lets go of the part (opened, or the band overstretched).",
+               "The hand lets go of the part (opened, the band overstretched, or attached to a "
+               "fixed part while held).",
                "released \"peg\""});
   w.push_back({"mated",
                WordKind::kEvent,

@@ -461,6 +461,48 @@ TEST(ScenarioRun, AGraspMadeAsTheFingersBarelyMovedIsReleasedWhenTheHandOpens) {
   EXPECT_NEAR(o.final_poses[0].position.y(), 0.170, 1e-4);
 }
 
+TEST(ScenarioRun, GraspingAPartAttachedToAnotherCarriesTheWholeSubAssembly) {
+  // The hand closes on a collar pressed on a shaft (attached to it) and
+  // carries both 85 mm down; before, the collar was held against its own
+  // shaft and nothing moved until the hand let go of it, overstretched.
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "collar.plan",
+        "start -0.070 0.125 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
+        "reach 0.6  -0.010 0.125 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
+        "close 0.4 power\n"
+        "reach 2.0  -0.010 0.040 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
+        "open 0.3\n"
+        "reach 0.5  -0.070 0.040 0.080  0.7071067811865476 0 0 0.7071067811865476\n");
+  const auto file = write(dir, "collar.lua", R"(return scenario {
+  name = "collar on a shaft", units = "mm",
+  parts = {
+    shaft = part { shape = cylinder { diameter = 24, length = 50 }, at = { 0, 150, 0 }, turn = { x = 90 } },
+    collar = part { shape = tube { outer = 40, inner = 23.9, length = 10 }, at = { 0, 150, 0 },
+                    turn = { x = 90 }, attached_to = "shaft" },
+  },
+  hand = glove { plan = "collar.plan" },
+  expect = { grasped_as("collar", "power"), max_penetration(0.01) },
+}
+)");
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+  std::vector<std::string> grasps;
+  for (const engine::Event& e : o.report.events) {
+    if (e.kind == engine::EventKind::kGrasp || e.kind == engine::EventKind::kRelease) {
+      grasps.push_back(e.a + " " + e.b);
+    }
+  }
+  EXPECT_EQ(grasps, (std::vector<std::string>{"collar power", "collar opened"}));
+  ASSERT_EQ(o.final_poses.size(), 2u);
+  for (const auto& pose : o.final_poses) {
+    // Both went down with the hand (the hand's grip shifts them a little sideways).
+    EXPECT_NEAR(pose.position.y(), 0.065, 1e-4) << pose.part;
+    EXPECT_NEAR(pose.position.x(), 0, 1e-3) << pose.part;
+  }
+  // The collar where it was on the shaft.
+  EXPECT_LT((o.final_poses[0].position - o.final_poses[1].position).norm(), 1e-12);
+}
+
 TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
   // A NUL inside a logged text (a log action's and dt.log's) is kept, and
   // the report writes it as \u0000; the failure summary for the terminal

@@ -60,7 +60,8 @@ struct GraspSettings {
   Real friction = 0.5;        ///< mu: contacts oppose inside cones of half-angle atan(mu)
   int onset_frames = 3;       ///< the grasp must hold this many frames while the hand closes
   /// A grasping digit opened this far past its flexion at the grasp releases
-  /// (or half of what it closed while the grasp built up, when that is less).
+  /// (or half of what it closed while the grasp built up, when that is less,
+  /// once it has closed this far past its flexion at the grasp).
   Real release_open_deg = 8;
   Real release_time_s = 0.05;       ///< ... for this long releases the part
   int finger_bisection_steps = 12;  ///< halvings toward a finger's first contact (0.02 deg)
@@ -114,9 +115,9 @@ Transform mate_pose(const Mate& mate, const Transform& X_WP, const Transform& X_
 /// too small), which no real part can do.
 struct RefusedSnap {
   std::string mate{};
-  std::string part{};     ///< the released part
+  std::string part{};     ///< the mate's part: the released part, or one of its sub-assembly
   std::string blocker{};  ///< the part it would overlap most deeply
-  /// The part that would overlap it: the released part, or a part attached to it.
+  /// The part that would overlap it: a part of the moved sub-assembly.
   std::string overlapping{};
   Real depth_m = 0;  ///< how deep (OverlapGauge, as max_penetration measures)
   Real time = 0;     ///< when it was released
@@ -166,7 +167,11 @@ class Grasping {
   std::optional<GraspType> grasp_type() const {
     return held_ ? std::optional(type_) : std::nullopt;
   }
-  /// X_HO of the part held.
+  /// The part the hand carries: the held part, or the part it is attached to
+  /// (through any number of parts) that is attached to none; the whole
+  /// sub-assembly under it moves with the hand.
+  const std::optional<std::string>& carried() const { return carried_; }
+  /// X_HO of the part carried.
   const Transform& X_HO() const { return X_HO_; }
   /// The last sliding step of the part held.
   const SlideResult& last_slide() const { return last_slide_; }
@@ -194,9 +199,22 @@ class Grasping {
   /// appeared or went in the last slide, `bodies` and `handles` naming its indices.
   void report_sliding(const engine::Scene& scene, std::span<const engine::PartId> bodies,
                       std::span<const engine::PartId> handles, std::uint64_t frame, Real t);
-  Transform guided(const engine::Scene& scene, const std::string& part,
-                   const Transform& X_WP_target);
+  /// The part carried when `part` is held: the top of its sub-assembly.
+  static engine::PartId carried_root(const engine::Scene& scene, engine::PartId part);
+  /// `part`'s pose in the frame of `root`, which it descends from, from the
+  /// chain of local poses (the same bits every frame).
+  static Transform pose_in(const engine::Scene& scene, engine::PartId root, engine::PartId part);
+  /// Where the hand at X_WH puts `part`: the carried sub-assembly's parts by
+  /// the grasp, the others where they are.
+  Transform carried_pose(const engine::Scene& scene, engine::PartId part,
+                         const Transform& X_WH) const;
+  /// The carried part's target, moved so that the first guiding mate of a part
+  /// of its sub-assembly whose capture region the move reaches draws that part
+  /// onto its axis.
+  Transform guided(const engine::Scene& scene, engine::PartId root, const Transform& X_WR_target);
   void release(engine::Simulation& simulation, const std::string& reason);
+  /// Seats the sub-assembly of the released `part` by the first of its mates
+  /// within tolerance whose seat overlaps nothing.
   void snap(engine::Simulation& simulation, const std::string& part);
   /// The deepest overlap of `part` at X_WP, or of a part attached to it and
   /// moved with it, with another part (none of them counted).
@@ -215,12 +233,16 @@ class Grasping {
   std::vector<engine::Event> pending_;
 
   std::optional<std::string> held_;
+  std::optional<std::string> carried_;  ///< see carried()
   GraspType type_ = GraspType::kPrecision;
   Transform X_HO_{};
   std::array<Real, kDigitCount> flexion_at_grasp_{};
-  /// How far a grasping digit must open below flexion_at_grasp_ to release
-  /// (see release_open_deg).
+  /// How far below flexion_at_grasp_ a grasping digit that closed
+  /// release_open_deg past it since may open to release: half of what it
+  /// closed while the grasp built up, at most release_open_deg.
   std::array<Real, kDigitCount> release_opening_{};
+  /// Each digit's largest glove flexion since the grasp.
+  std::array<Real, kDigitCount> peak_flexion_{};
   std::array<bool, kDigitCount> grasping_digit_{};
   Real opened_since_ = -1;  ///< time the release condition began to hold; < 0: not holding
   std::string candidate_;   ///< part whose grasp is building up
