@@ -140,20 +140,23 @@ std::vector<Word> make_vocabulary() {
   w.push_back({"block_with_hole",
                WordKind::kShape,
                {{"size", kVector, kRequired, "edge lengths; the top face is at y = size.y / 2"},
-                {"hole", kLength, kRequired, "the hole's diameter, down along -y from the top"},
+                {"hole", kLength, kRequired,
+                 "the hole's diameter across the flats (a pin of this diameter fits), down along "
+                 "-y from the top"},
                 {"depth", kLength, kRequired, "the hole's depth (less than size.y)"},
                 {"sides", kCount, kOptional, "facets of the hole's wall, 3 to 4096 (default 64)"}},
                "A block centred on the origin with a blind round hole down from its top.",
                "block_with_hole { size = { 80, 60, 80 }, hole = 20.5, depth = 40 }"});
-  w.push_back(
-      {"tube",
-       WordKind::kShape,
-       {{"outer", kLength, kRequired, "outer diameter"},
-        {"inner", kLength, kRequired, "inner diameter (the bore)"},
-        {"length", kLength, kRequired, "length along z, from z = 0"},
-        {"sides", kCount, kOptional, "facets around, 3 to 4096 (default 64; 6 gives a hexagon)"}},
-       "A tube, ring or nut: a prism around z with a bore.",
-       "tube { outer = 24, inner = 10.5, length = 3 }"});
+  w.push_back({"tube",
+               WordKind::kShape,
+               {{"outer", kLength, kRequired, "outer diameter, through the corners"},
+                {"inner", kLength, kRequired,
+                 "inner diameter (the bore), across the flats: a shaft of this diameter fits"},
+                {"length", kLength, kRequired, "length along z, from z = 0"},
+                {"sides", kCount, kOptional,
+                 "facets around, inside and out, 3 to 4096 (default 64; 6 gives a hexagon)"}},
+               "A tube, ring or nut: a prism around z with a bore.",
+               "tube { outer = 24, inner = 10.5, length = 3 }"});
   w.push_back({"sphere",
                WordKind::kShape,
                {{"diameter", kLength, kRequired, "diameter, centred on the origin"}},

@@ -142,6 +142,24 @@ TEST(Primitives, PegFitsTheHoleOnlyWhenNoWiderThanItsRadius) {
   }
 }
 
+TEST(Primitives, AShaftFitsATubesBoreOnlyWhenNoWiderThanItsRadius) {
+  // A hexagon socket too: the bore's flats, not its corners, are on the radius.
+  const Real outer = 0.019, inner = 0.01225, height = 0.012;
+  for (int sides : {6, 8, 64}) {
+    SCOPED_TRACE("sides " + std::to_string(sides));
+    const auto tube = build_model(
+        Method::kObb, std::make_shared<const Mesh>(make_tube(outer, inner, height, sides)));
+    Transform X;
+    X.t = Vec3(0, 0, -0.01);  // the shaft runs through the whole tube
+    for (const auto& [scale, colliding] : {std::pair{0.999, false}, std::pair{1.01, true}}) {
+      const auto shaft = build_model(
+          Method::kObb, std::make_shared<const Mesh>(make_cylinder(scale * inner, 0.04, 256)));
+      EXPECT_EQ(tube->collide(*shaft, X).colliding, colliding) << "shaft radius x" << scale;
+    }
+  }
+  EXPECT_THROW(make_tube(0.0101, 0.01, 0.01, 6), std::invalid_argument);  // corners reach out
+}
+
 TEST(Primitives, BlockWithHoleRejectsHolesThatDoNotFit) {
   const Vec3 half(0.01, 0.02, 0.01);
   EXPECT_NO_THROW(make_block_with_hole(half, 0.009, 0.01, 8));

@@ -125,6 +125,12 @@ Mesh make_tube(Real outer_radius, Real inner_radius, Real height, int sides) {
     throw std::invalid_argument("make_tube: need 0 < inner < outer and a positive height");
   }
   if (sides < 3) throw std::invalid_argument("make_tube: sides must be at least 3");
+  // The bore's flats, not its corners, on the inner radius: a shaft of that
+  // radius fits any bore (six sides make a hexagon socket, not a smaller hole).
+  const Real bore = inner_radius / std::cos(std::numbers::pi / sides);
+  if (!(bore < outer_radius)) {
+    throw std::invalid_argument("make_tube: the bore's corners reach the outer wall");
+  }
   std::vector<Vec3> v;
   Triangles t;
   // Per side j: outer bottom, outer top, inner bottom, inner top.
@@ -133,8 +139,8 @@ Mesh make_tube(Real outer_radius, Real inner_radius, Real height, int sides) {
     const Real c = std::cos(w), s = std::sin(w);
     v.emplace_back(outer_radius * c, outer_radius * s, 0);
     v.emplace_back(outer_radius * c, outer_radius * s, height);
-    v.emplace_back(inner_radius * c, inner_radius * s, 0);
-    v.emplace_back(inner_radius * c, inner_radius * s, height);
+    v.emplace_back(bore * c, bore * s, 0);
+    v.emplace_back(bore * c, bore * s, height);
   }
   for (int j = 0; j < sides; ++j) {
     const std::size_t a = 4 * j, b = 4 * ((j + 1) % sides);

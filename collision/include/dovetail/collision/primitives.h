@@ -31,9 +31,12 @@ Mesh make_cylinder(Real radius, Real height, int sides);
 /// finite, when the hole does not fit inside the box (the polygon's corner radius
 /// hole_radius / cos(pi / sides) >= min(hx, hz)), when hole_depth >= 2 hy, or sides < 3.
 /// A tube along z from 0 to `height`: outer and inner walls of `sides` facets
-/// each (vertices on the radii), closed by flat rings at both ends; a washer,
-/// a ring or (with 6 sides) a nut. Throws std::invalid_argument unless
-/// 0 < inner < outer, height > 0 and sides >= 3.
+/// each, closed by flat rings at both ends; a washer, a ring or (with 6 sides)
+/// a nut with a hexagon socket. The outer wall's corners lie on outer_radius
+/// (the tube fits a hole of that radius), the bore's flats on inner_radius
+/// (a shaft of that radius fits the bore), as block_with_hole's hole. Throws
+/// std::invalid_argument unless 0 < inner < outer, height > 0, sides >= 3 and
+/// the bore's corners (inner_radius / cos(pi / sides)) stay inside outer_radius.
 Mesh make_tube(Real outer_radius, Real inner_radius, Real height, int sides);
 
 Mesh make_block_with_hole(const Vec3& half_extents, Real hole_radius, Real hole_depth, int sides);
