@@ -218,10 +218,15 @@ void check_writable(const std::string& path) {
     }
     return;
   }
+  // A missing folder is made, as --out and --render make theirs: an output
+  // into reports/junit.xml works on a fresh CI runner.
   const fs::path folder = fs::path(path).parent_path();
   if (!folder.empty() && !fs::is_directory(folder, ec)) {
-    throw InputError(path + ": cannot be written: the folder " + folder.string() +
-                     " does not exist");
+    fs::create_directories(folder, ec);
+    if (ec || !fs::is_directory(folder)) {
+      throw InputError(path + ": cannot be written: the folder " + folder.string() +
+                       " cannot be made: " + (ec ? ec.message() : "a file is in the way"));
+    }
   }
   if (::access(folder.empty() ? "." : folder.c_str(), W_OK) != 0) {
     throw InputError(path + ": cannot be written: " + std::strerror(errno));

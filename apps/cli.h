@@ -87,9 +87,10 @@ void refuse_overwriting_input(const std::string& command, const std::string& out
                               std::span<const std::string> inputs);
 
 /// InputError unless `path` can be written: not a folder, in a folder that
-/// exists and, when the file exists, open for writing. Creates and truncates
-/// nothing, so that a command can check its outputs before any work and still
-/// leave an existing file as it was when the run fails on its inputs.
+/// exists (a missing one is made) and, when the file exists, open for
+/// writing. Creates and truncates no file, so that a command can check its
+/// outputs before any work and still leave an existing file as it was when
+/// the run fails on its inputs.
 void check_writable(const std::string& path);
 
 /// --gaps of the contact-distance poses: fractions of the larger bounding-box

@@ -427,6 +427,13 @@ std::pair<std::size_t, std::size_t> parse_shard(const Args& args) {
 std::vector<Job> shard_jobs(const std::filesystem::path& folder, std::size_t shard_k,
                             std::size_t shard_n) {
   const std::vector<std::filesystem::path> files = scenario_files(folder);
+  // An empty folder is most likely a wrong path: it fails, where an empty
+  // shard (more shards than scenarios) passes.
+  if (files.empty()) {
+    throw InputError(folder.string() +
+                     ": no scenarios in this folder (regress runs its *.lua files, not those "
+                     "of its subfolders)");
+  }
   std::vector<Job> jobs;
   for (std::size_t i = 0; i < files.size(); ++i) {
     if (i % shard_n != shard_k - 1) continue;
@@ -436,8 +443,8 @@ std::vector<Job> shard_jobs(const std::filesystem::path& folder, std::size_t sha
     jobs.push_back(std::move(job));
   }
   if (jobs.empty()) {
-    std::fprintf(stderr, "dovetail: note: regress: no scenarios in %s%s\n", folder.string().c_str(),
-                 shard_n > 1 ? " for this shard" : "");
+    std::fprintf(stderr, "dovetail: note: regress: no scenarios in %s for this shard\n",
+                 folder.string().c_str());
   }
   return jobs;
 }

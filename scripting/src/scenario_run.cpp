@@ -163,7 +163,10 @@ class Runner {
   /// close its part came to its place against the tolerances.
   std::string why_not_snapped(const MateSpec& mate) const;
   void evaluate_expectations();
-  void render(const std::filesystem::path& path);
+  /// Draws the scene to `path`: the frames of --every from one camera, fitted
+  /// to the first; the final picture from one fitted to the final scene (so
+  /// that it does not depend on --every), unless the scenario has a camera.
+  void render(const std::filesystem::path& path, bool final_picture);
   const MateSpec* mate(const std::string& name) const;
 
   std::filesystem::path file_;
@@ -871,12 +874,20 @@ void Runner::end_frame(const engine::FrameResult& result, double previous_time) 
   }
 }
 
-void Runner::render(const std::filesystem::path& path) {
+void Runner::render(const std::filesystem::path& path, bool final_picture) {
   // The parts in their own colours and the rules' highlights (contacts are not marked).
   engine::RenderScene scene = engine::render_scene(sim_->scene());
   const double aspect = static_cast<double>(options_.render_width) / options_.render_height;
-  if (!camera_) camera_ = scenario_.camera ? *scenario_.camera : engine::auto_camera(scene, aspect);
-  scene.cameras.push_back({"dovetail.run", *camera_});
+  engine::Camera camera;
+  if (scenario_.camera) {
+    camera = *scenario_.camera;
+  } else if (final_picture) {
+    camera = engine::auto_camera(scene, aspect);
+  } else {
+    if (!camera_) camera_ = engine::auto_camera(scene, aspect);
+    camera = *camera_;
+  }
+  scene.cameras.push_back({"dovetail.run", camera});
   engine::RenderSettings settings;
   settings.width = options_.render_width;
   settings.height = options_.render_height;
@@ -1095,7 +1106,7 @@ void Runner::run() {
       if (options_.render_dir && options_.render_every > 0 && f % options_.render_every == 0) {
         char name[32];
         std::snprintf(name, sizeof name, "frame_%06llu.png", static_cast<unsigned long long>(f));
-        render(*options_.render_dir / name);
+        render(*options_.render_dir / name, false);
       }
       if (meter) meter->update(f + 1);
     }
@@ -1140,7 +1151,7 @@ void Runner::run() {
   if (options_.render_dir) {
     output([&] {
       const std::filesystem::path final_frame = *options_.render_dir / "final.png";
-      render(final_frame);
+      render(final_frame, true);
       out_.final_frame = final_frame;
     });
   }

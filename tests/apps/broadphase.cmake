@@ -61,10 +61,11 @@ dovetail_cli_test(broadphase_missing_file EXIT 1 ARGS broadphase --boxes ${bp_da
                   STDERR "no_such.txt: file not found")
 dovetail_cli_test(broadphase_directory EXIT 1 ARGS broadphase --boxes ${bp_data}
                   STDERR "is a directory")
+file(WRITE ${out}/broadphase_file_in_the_way "")
 dovetail_cli_test(broadphase_unwritable_out EXIT 1
                   ARGS broadphase --boxes ${bp_data}/touching.txt
-                       --out ${out}/no/such/folder/pairs.txt
-                  STDERR "no/such/folder/pairs.txt: cannot be written")
+                       --out ${out}/broadphase_file_in_the_way/pairs.txt
+                  STDERR "broadphase_file_in_the_way/pairs.txt: cannot be written")
 
 # ---- usage errors
 dovetail_cli_test(broadphase_unknown_method EXIT 2

@@ -18,7 +18,7 @@ if(NOT DEFINED PROGRAM OR NOT DEFINED EXPECT_EXIT)
 endif()
 string(REPLACE "|" ";" argv "${ARGS}")
 if(DEFINED REMOVE_FIRST)
-  file(REMOVE "${REMOVE_FIRST}")
+  file(REMOVE_RECURSE "${REMOVE_FIRST}")
 endif()
 
 set(keep_text "written before the run; must be kept\n")

@@ -37,9 +37,14 @@ dovetail_cli_test(render_missing_input EXIT 1
 dovetail_cli_test(render_bad_input EXIT 1
                   ARGS render ${data}/nan_vertex.obj --out ${out}/render_nan.png
                   STDERR "^dovetail: [^\n]*nan_vertex.obj: [^\n]*not finite")
+file(WRITE ${out}/render_file_in_the_way "")
 dovetail_cli_test(render_unwritable_out EXIT 1
-                  ARGS render ${cube} --out ${out}/no/such/folder/image.png
-                  STDERR "^dovetail: [^\n]*no/such/folder/image.png: cannot be written")
+                  ARGS render ${cube} --out ${out}/render_file_in_the_way/image.png
+                  STDERR "^dovetail: [^\n]*render_file_in_the_way/image.png: cannot be written: the folder [^\n]* cannot be made")
+dovetail_cli_test(render_into_a_missing_folder EXIT 0
+                  ARGS render ${cube} --out ${out}/render_made_folder/deeper/image.png
+                  FILE ${out}/render_made_folder/deeper/image.png MATCHES "^.PNG"
+                  REMOVE ${out}/render_made_folder)
 dovetail_cli_test(render_out_is_directory EXIT 1
                   ARGS render ${cube} --out ${out}
                   STDERR "cli_out: cannot be written: is a directory")

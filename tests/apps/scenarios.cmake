@@ -75,8 +75,12 @@ dovetail_cli_test(new_quotes_in_the_name EXIT 0 ARGS new "a\"b" --out ${out}/new
 dovetail_cli_test(new_placeholder_in_the_path EXIT 0 ARGS new x --out ${out}/new_named/MYNAME.lua
                   FILE ${out}/new_named/MYNAME.lua MATCHES "dovetail check .*/MYNAME.lua &&name = \"x\""
                   REMOVE ${out}/new_named/MYNAME.lua)
-dovetail_cli_test(new_into_a_missing_folder EXIT 1 ARGS new x --out ${out}/no_such_folder/x.lua
-                  STDERR "cannot be written: the folder .*no_such_folder does not exist")
+dovetail_cli_test(new_into_a_missing_folder EXIT 0 ARGS new x --out ${out}/new_made_folder/deeper/x.lua
+                  FILE ${out}/new_made_folder/deeper/x.lua MATCHES "name = \"x\""
+                  REMOVE ${out}/new_made_folder)
+file(WRITE ${out}/a_file_in_the_way "")
+dovetail_cli_test(new_into_a_folder_that_is_a_file EXIT 1 ARGS new x --out ${out}/a_file_in_the_way/x.lua
+                  STDERR "cannot be written: the folder .*a_file_in_the_way cannot be made")
 
 # check reads the glove's plan or trace as the run does: a wrong line is named.
 file(WRITE ${out}/check_plan/bad.plan "start 0 0.1 0 1 0 0 0 power\nreach 2.0 0 0.06\n")
@@ -268,6 +272,12 @@ add_test(NAME cli.regress_interrupted
 set_tests_properties(cli.regress_interrupted PROPERTIES TIMEOUT 300)
 
 dovetail_cli_test(regress_bad_jobs EXIT 2 ARGS regress ${scenarios} -j 0 STDERR "regress: -j must be an integer from 1 to 256")
+file(MAKE_DIRECTORY ${out}/regress_empty_folder)
+dovetail_cli_test(regress_empty_folder EXIT 1 ARGS regress ${out}/regress_empty_folder
+                  STDERR "regress_empty_folder: no scenarios in this folder")
+dovetail_cli_test(regress_empty_shard EXIT 0 ARGS regress ${scenarios} --shard 18/18
+                  --out ${out}/regress_empty_shard
+                  STDERR "no scenarios in .* for this shard")
 dovetail_cli_test(regress_bad_shard EXIT 2 ARGS regress ${scenarios} --shard 3/2 STDERR "--shard must be K/N")
 dovetail_cli_test(regress_not_a_folder EXIT 1 ARGS regress ${out}/no_such_folder STDERR "not a folder")
 

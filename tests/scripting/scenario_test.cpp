@@ -503,6 +503,33 @@ TEST(ScenarioRun, GraspingAPartAttachedToAnotherCarriesTheWholeSubAssembly) {
   EXPECT_LT((o.final_poses[0].position - o.final_poses[1].position).norm(), 1e-12);
 }
 
+TEST(ScenarioRun, TheFinalPictureIsTheSameWithOrWithoutFrames) {
+  // No scenario camera: the frames share one camera fitted to the first; the
+  // final picture is fitted to the final scene either way (the peg moves 60 mm).
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(
+      dir, "pictures.lua",
+      moved_peg("    rule { when = after(0.1), act = { move(\"peg\", { 0, 160, 0 }, 0.2) } },",
+                ""));
+  auto final_png = [&](const std::string& folder, std::uint64_t every) {
+    RunOptions options;
+    options.render_dir = dir / folder;
+    std::filesystem::create_directories(*options.render_dir);
+    options.render_every = every;
+    options.render_width = 160;
+    options.render_height = 120;
+    const RunOutcome o = run_scenario(file, options);
+    EXPECT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+    std::ifstream in(dir / folder / "final.png", std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string alone = final_png("alone", 0);
+  const std::string with_frames = final_png("frames", 30);
+  EXPECT_FALSE(alone.empty());
+  EXPECT_EQ(alone, with_frames);
+  EXPECT_TRUE(std::filesystem::exists(dir / "frames" / "frame_000030.png"));
+}
+
 TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
   // A NUL inside a logged text (a log action's and dt.log's) is kept, and
   // the report writes it as \u0000; the failure summary for the terminal
