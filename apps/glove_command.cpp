@@ -215,6 +215,9 @@ int check(std::span<const std::string> argv) {
     std::fprintf(stderr, "warning: %s: %s: is it in other units, or a column misnamed?\n",
                  path.c_str(), interaction::describe(e).c_str());
   }
+  for (const std::string& doubt : interaction::trace_doubts(path, samples)) {
+    std::fprintf(stderr, "warning: %s: %s\n", path.c_str(), doubt.c_str());
+  }
   print_summary("check", samples, "");
   return kExitOk;
 }

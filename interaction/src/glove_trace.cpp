@@ -1,11 +1,14 @@
 #include "dovetail/interaction/glove_trace.h"
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <optional>
+#include <vector>
 
 #include "text_reading.h"
 
@@ -137,6 +140,39 @@ std::vector<GloveSample> read_trace(std::istream& in, std::string_view name) {
                      ": header but no samples");
   }
   return samples;
+}
+
+std::vector<std::string> trace_doubts(const fs::path& path, std::span<const GloveSample> samples) {
+  std::vector<std::string> doubts;
+  // Gloves sample 30 to 200 times a second; under 10 is another time unit.
+  if (samples.size() >= 3) {
+    std::vector<Real> gaps;
+    for (std::size_t i = 1; i < samples.size(); ++i)
+      gaps.push_back(samples[i].t - samples[i - 1].t);
+    std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+    const Real median = gaps[gaps.size() / 2];
+    constexpr Real kSparse = 0.1;  // seconds
+    if (median > kSparse) {
+      char text[200];
+      std::snprintf(
+          text, sizeof text,
+          "its samples are %.4g s apart (the median), %.3g samples a second, where gloves "
+          "sample 30 to 200 times a second: are its times in milliseconds?",
+          median, 1 / median);
+      doubts.emplace_back(text);
+    }
+  }
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (in && in.tellg() > 0) {
+    in.seekg(-1, std::ios::end);
+    const int last = in.get();
+    if (last != '\n' && last != '\r') {
+      doubts.emplace_back(
+          "its last line has no line end: if the file was cut short while written, its last "
+          "sample may be cut too (traces written by Dovetail end every line)");
+    }
+  }
+  return doubts;
 }
 
 std::vector<GloveSample> read_trace(const fs::path& path) {

@@ -490,6 +490,13 @@ void Runner::warn_about_glove(const GloveSpec& glove, const interaction::GloveSo
                             " s; plans and traces are in metres: is it written in other units?");
   }
   warn_about_joints(who, source);
+  const std::filesystem::path trace = options_.trace ? *options_.trace : glove.trace;
+  if (const auto* samples = dynamic_cast<const interaction::TraceSource*>(&source);
+      samples && !trace.empty()) {
+    for (const std::string& doubt : interaction::trace_doubts(trace, samples->samples())) {
+      out_.warnings.push_back(who + ": " + doubt);
+    }
+  }
   // Device clocks (seconds since 1970) instead of seconds from the start of the run.
   if (const double start = start_time(source); start > 1) {
     out_.warnings.push_back(

@@ -18,6 +18,15 @@ dovetail_cli_test(glove_check_joint_out_of_range EXIT 0
                   ARGS glove check ${glove}/trace_joint_out_of_range.csv
                   STDOUT "\"samples\":3"
                   STDERR "trace_joint_out_of_range.csv: index_mcp reaches 500 deg at t=0.0111111 s, outside its range \\[-30, 90\\] by 410 deg")
+# Times in milliseconds read as seconds, and a file cut short: read, with a warning each.
+dovetail_cli_test(glove_check_times_in_milliseconds EXIT 0
+                  ARGS glove check ${glove}/trace_times_in_milliseconds.csv
+                  STDOUT "\"samples\":3"
+                  STDERR "trace_times_in_milliseconds.csv: its samples are 11.11 s apart \\(the median\\), 0.09 samples a second[^\n]*are its times in milliseconds\\?")
+dovetail_cli_test(glove_check_no_final_line_end EXIT 0
+                  ARGS glove check ${glove}/trace_no_final_line_end.csv
+                  STDOUT "\"samples\":3"
+                  STDERR "trace_no_final_line_end.csv: its last line has no line end")
 foreach(case
     "missing_column|bad_missing_column.csv:1: missing columns: wrist_yaw"
     "unknown_column|bad_unknown_column.csv:1: unknown column 'elbow'"

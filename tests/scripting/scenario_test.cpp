@@ -892,6 +892,25 @@ TEST(ScenarioReplay, AJointFarOutsideItsRangeIsAWarning) {
   EXPECT_EQ(o.status, RunOutcome::Status::kFailed) << "warnings_at_most(0) counts it";
 }
 
+TEST(ScenarioReplay, ATraceCutShortIsAWarning) {
+  // A file cut short after its last value, before the line end: it reads
+  // (so would one cut inside a value of several digits), so the replay says
+  // what may have happened.
+  const test::TempDir dir("dovetail_scenario");
+  std::ifstream in(recorded_peg_trace(dir), std::ios::binary);
+  std::string text(std::istreambuf_iterator<char>(in), {});
+  ASSERT_EQ(text.back(), '\n');
+  text.pop_back();
+  std::ofstream(dir / "cut.csv", std::ios::binary) << text;
+  RunOptions replay;
+  replay.trace = dir / "cut.csv";
+  const RunOutcome o = run_scenario(kScenarios / "01_peg_in_hole.lua", replay);
+  ASSERT_EQ(o.warnings.size(), 1u) << o.error;
+  EXPECT_NE(o.warnings[0].find("cut.csv: its last line has no line end"), std::string::npos)
+      << o.warnings[0];
+  EXPECT_EQ(o.status, RunOutcome::Status::kFailed) << "warnings_at_most(0) counts it";
+}
+
 TEST(ScenarioReplay, AScenarioWithoutAGloveGetsTheTracesHandWithoutAWarning) {
   // Replayed, a scenario with no glove gets the trace's hand, so a rule on
   // released() can happen: no "the scenario has no hand".

@@ -58,6 +58,13 @@ std::vector<GloveSample> read_trace(std::istream& in, std::string_view name);
 /// a directory, unreadable, or bad.
 std::vector<GloveSample> read_trace(const std::filesystem::path& path);
 
+/// What makes a trace that reads cleanly doubtful, one sentence each, without
+/// the file's name: samples far sparser than any glove's (times written in
+/// milliseconds read as seconds), and a last line without a line end (a file
+/// cut short while written, whose last value may be cut too). For warnings.
+std::vector<std::string> trace_doubts(const std::filesystem::path& path,
+                                      std::span<const GloveSample> samples);
+
 /// The header row and one row per sample, each ending in '\n'. The samples
 /// are not checked: ones that read_trace refuses (none, non-finite values, a
 /// zero quaternion, time that does not increase) are written as they are.
