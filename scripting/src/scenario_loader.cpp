@@ -186,6 +186,7 @@ class Loader {
         hand_given_(hand_given) {}
 
   Scenario load();
+  void warn_about_mesh_sizes();
 
  private:
   /// A mistake in the file, where it is.
@@ -906,6 +907,7 @@ void Loader::read_parts(int map, const SourceLocation& where) {
       }
       for (Vec3& v : loaded.vertices) v *= scenario_.metres_per_unit;
       part.mesh = std::make_shared<const collision::Mesh>(std::move(loaded));
+      part.file = mesh.text;
     }
     if (const Arg at = field(t, word, "at", part.where, what); at.given) part.X_WP.t = at.vector;
     if (const Arg turn = field(t, word, "turn", part.where, what); turn.given) {
@@ -1255,6 +1257,46 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
   }
 }
 
+/// A part from a mesh file hundreds of times smaller or larger than the
+/// scenario's other parts: most likely a file in other units (a plate in
+/// metres in a scenario in millimetres is 80 micrometres across, and any
+/// part passes through it in a frame).
+void Loader::warn_about_mesh_sizes() {
+  const auto across = [&](const PartSpec& p) {
+    Eigen::AlignedBox<double, 3> box;
+    for (const Vec3& v : p.mesh->vertices) box.extend(v);
+    return box.diagonal().norm() / scenario_.metres_per_unit;
+  };
+  constexpr double kRatio = 500;  // parts of one product differ less; units by 1000 (or 25.4)
+  for (const PartSpec& p : scenario_.parts) {
+    if (p.file.empty() || !p.mesh) continue;
+    std::vector<double> others;
+    for (const PartSpec& q : scenario_.parts) {
+      if (&q != &p && q.mesh) others.push_back(across(q));
+    }
+    if (others.empty()) continue;
+    std::nth_element(others.begin(), others.begin() + others.size() / 2, others.end());
+    const double median = others[others.size() / 2], size = across(p);
+    if (!(size > 0) || !(median > 0)) continue;
+    const double ratio = median / size;
+    if (ratio < kRatio && ratio > 1 / kRatio) continue;
+    const auto brief = [](double x) {
+      char buffer[32];
+      std::snprintf(buffer, sizeof buffer, "%.3g", x);
+      return std::string(buffer);
+    };
+    const std::string& units = scenario_.units;
+    scenario_.warnings.push_back(
+        p.where.str() + ": part '" + p.name + "' (" + p.file + ") is " + brief(size) + " " + units +
+        " across, " +
+        (ratio > 1 ? "1/" + brief(std::round(ratio)) + " of"
+                   : brief(std::round(1 / ratio)) + " times") +
+        " the other parts (a median of " + brief(median) + " " + units +
+        "): is the file in other units? A mesh file's numbers are read in the scenario's (" +
+        units + ")");
+  }
+}
+
 void Loader::resolve() {
   Names names;
   for (const PartSpec& p : scenario_.parts) names.parts.push_back(p.name);
@@ -1313,6 +1355,7 @@ void Loader::resolve() {
       }
     }
   }
+  warn_about_mesh_sizes();
   if (scenario_.glove && !scenario_.glove->holding.empty()) {
     check_part(scenario_.glove->holding, scenario_.glove->where, "glove: holding");
     if (fixed(scenario_.glove->holding)) {

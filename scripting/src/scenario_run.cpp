@@ -67,6 +67,80 @@ double start_time(const interaction::GloveSource& source) {
   return trace ? trace->samples().front().t : 0;
 }
 
+/// Warnings about a glove that cannot be what was meant, each starting with
+/// `who`: a hand that goes far from every part (a plan written in
+/// millimetres reads as metres); joints far outside their ranges (another
+/// unit, or a column misnamed); a trace (read from `trace`) sampled too
+/// sparsely or cut short; times on a device's clock; a hand that holds a
+/// part it starts far from (the part keeps that offset).
+std::vector<std::string> glove_warnings(const Scenario& scenario, const GloveSpec& glove,
+                                        const interaction::GloveSource& source,
+                                        const std::string& who,
+                                        const std::filesystem::path& trace) {
+  std::vector<std::string> out;
+  const auto length = [&](double metres) {
+    char buffer[48];
+    std::snprintf(buffer, sizeof buffer, "%.4g %s", metres / scenario.metres_per_unit,
+                  scenario.units.c_str());
+    return std::string(buffer);
+  };
+  const auto box_of = [&](const PartSpec& p) {
+    Eigen::AlignedBox<double, 3> box;
+    if (p.mesh) {
+      for (const Vec3& v : p.mesh->vertices) box.extend(p.X_WP.apply(v));
+    }
+    return box;
+  };
+  Eigen::AlignedBox<double, 3> parts;
+  for (const PartSpec& p : scenario.parts) parts.extend(box_of(p));
+  if (parts.isEmpty()) return out;
+  // Farther than ten times the parts' size, and a metre, from all of them.
+  const double limit = std::max(1.0, 10 * parts.diagonal().norm());
+  double farthest = 0, when = 0;
+  constexpr int kSamples = 200;
+  for (int k = 0; k <= kSamples; ++k) {
+    const double t = source.end_time() * k / kSamples;
+    const double d = parts.exteriorDistance(source.sample(t).p_WH);
+    if (d > farthest) farthest = d, when = t;
+  }
+  if (farthest > limit) {
+    out.push_back(who + ": the hand is " + length(farthest) +
+                  " from every part at t=" + format_time(when) +
+                  " s; plans and traces are in metres: is it written in other units?");
+  }
+  if (const auto* samples = dynamic_cast<const interaction::TraceSource*>(&source)) {
+    // A glove's noise goes a degree or two past a joint's range; tens of
+    // degrees are another unit or another column: a warning per joint.
+    for (const interaction::JointExcursion& e :
+         interaction::joints_outside(samples->samples(), interaction::kFarOutsideRange)) {
+      out.push_back(who + ": " + interaction::describe(e) +
+                    " (clamped): is the trace in other units, or a column misnamed?");
+    }
+    if (!trace.empty()) {
+      for (const std::string& doubt : interaction::trace_doubts(trace, samples->samples())) {
+        out.push_back(who + ": " + doubt);
+      }
+    }
+  }
+  // Device clocks (seconds since 1970) instead of seconds from the start of the run.
+  if (const double start = start_time(source); start > 1) {
+    out.push_back(who + ": the trace starts at t=" + format_time(start) +
+                  " s; until then the hand stays at its first sample (its times are seconds "
+                  "from the start of the run: shift them to start at 0)");
+  }
+  if (!glove.holding.empty()) {
+    for (const PartSpec& p : scenario.parts) {
+      if (p.name != glove.holding) continue;
+      const double d = box_of(p).exteriorDistance(source.sample(0).p_WH);
+      if (d > 0.5) {
+        out.push_back(who + ": the hand starts " + length(d) + " from '" + glove.holding +
+                      "', which it holds; the part keeps that offset");
+      }
+    }
+  }
+  return out;
+}
+
 std::string format_length(double metres, const RunOutcome& o) {
   char buffer[48];
   std::snprintf(buffer, sizeof buffer, "%.4g %s", metres / o.metres_per_unit, o.units.c_str());
@@ -146,7 +220,6 @@ class Runner {
   void refuse_outputs();
   void build();
   void warn_about_glove(const GloveSpec& glove, const interaction::GloveSource& source);
-  void warn_about_joints(const std::string& who, const interaction::GloveSource& source);
   void start_frame(std::uint64_t frame, double t);
   void end_frame(const engine::FrameResult& result, double previous_time);
   std::vector<Occurrence> occurrences(const engine::FrameResult& result);
@@ -455,75 +528,11 @@ void Runner::build() {
   });
 }
 
-/// Warnings about a glove that cannot be what was meant: a hand that goes
-/// far from every part (a plan written in millimetres reads as metres), and
-/// one that holds a part it starts far from (the part keeps that offset).
 void Runner::warn_about_glove(const GloveSpec& glove, const interaction::GloveSource& source) {
-  const engine::Scene& scene = sim_->scene();
-  const auto box_of = [&](PartId id) {
-    Eigen::AlignedBox<double, 3> box;
-    if (const auto& mesh = scene.collision_mesh(id)) {
-      const Transform X_WP = scene.world_pose(id);
-      for (const Vec3& v : mesh->vertices) box.extend(X_WP.apply(v));
-    }
-    return box;
-  };
-  Eigen::AlignedBox<double, 3> parts;
-  for (const PartId id : scene.parts()) {
-    if (!scene.has_tag(id, "hand"))
-      parts.extend(box_of(id));  // the hand's own segments are not parts
-  }
-  if (parts.isEmpty()) return;
   const std::string who = options_.trace ? options_.trace->string() : glove.where.str() + ": glove";
-  // Farther than ten times the parts' size, and a metre, from all of them.
-  const double limit = std::max(1.0, 10 * parts.diagonal().norm());
-  double farthest = 0, when = 0;
-  constexpr int kSamples = 200;
-  for (int k = 0; k <= kSamples; ++k) {
-    const double t = source.end_time() * k / kSamples;
-    const double d = parts.exteriorDistance(source.sample(t).p_WH);
-    if (d > farthest) farthest = d, when = t;
-  }
-  if (farthest > limit) {
-    out_.warnings.push_back(who + ": the hand is " + format_length(farthest, out_) +
-                            " from every part at t=" + format_time(when) +
-                            " s; plans and traces are in metres: is it written in other units?");
-  }
-  warn_about_joints(who, source);
   const std::filesystem::path trace = options_.trace ? *options_.trace : glove.trace;
-  if (const auto* samples = dynamic_cast<const interaction::TraceSource*>(&source);
-      samples && !trace.empty()) {
-    for (const std::string& doubt : interaction::trace_doubts(trace, samples->samples())) {
-      out_.warnings.push_back(who + ": " + doubt);
-    }
-  }
-  // Device clocks (seconds since 1970) instead of seconds from the start of the run.
-  if (const double start = start_time(source); start > 1) {
-    out_.warnings.push_back(
-        who + ": the trace starts at t=" + format_time(start) +
-        " s; until then the hand stays at its first sample (its times are seconds from the "
-        "start of the run: shift them to start at 0)");
-  }
-  if (!glove.holding.empty()) {
-    const PartId held = scene.find(glove.holding);
-    const double d = held.valid() ? box_of(held).exteriorDistance(source.sample(0).p_WH) : 0;
-    if (d > 0.5) {
-      out_.warnings.push_back(who + ": the hand starts " + format_length(d, out_) + " from '" +
-                              glove.holding + "', which it holds; the part keeps that offset");
-    }
-  }
-}
-
-/// A trace whose joint angles go far outside their ranges (a glove's noise
-/// goes a degree or two past them; tens of degrees are another unit or
-/// another column): a warning per joint, at its worst sample.
-void Runner::warn_about_joints(const std::string& who, const interaction::GloveSource& source) {
-  const auto* trace = dynamic_cast<const interaction::TraceSource*>(&source);
-  if (!trace) return;
-  for (const interaction::JointExcursion& e :
-       interaction::joints_outside(trace->samples(), interaction::kFarOutsideRange)) {
-    out_.warnings.push_back(who + ": " + interaction::describe(e) +
-                            " (clamped): is the trace in other units, or a column misnamed?");
+  for (std::string& w : glove_warnings(scenario_, glove, source, who, trace)) {
+    out_.warnings.push_back(std::move(w));
   }
 }
 
@@ -1289,7 +1298,12 @@ Scenario check_scenario(const std::filesystem::path& file, const SandboxLimits& 
           glove.where.str() + ": glove: " + shown.string() +
           (std::filesystem::exists(source, ec) ? ": not a file" : ": file not found"));
     }
-    glove_source(scenario, std::nullopt);  // read as the run reads it
+    // Read as the run reads it, and doubted as the run doubts it.
+    const auto read = glove_source(scenario, std::nullopt);
+    for (std::string& w :
+         glove_warnings(scenario, glove, *read, glove.where.str() + ": glove", glove.trace)) {
+      scenario.warnings.push_back(std::move(w));
+    }
   }
   return scenario;
 }

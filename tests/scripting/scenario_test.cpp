@@ -530,6 +530,44 @@ TEST(ScenarioRun, TheFinalPictureIsTheSameWithOrWithoutFrames) {
   EXPECT_TRUE(std::filesystem::exists(dir / "frames" / "frame_000030.png"));
 }
 
+TEST(ScenarioLoad, AMeshFileInOtherUnitsThanTheScenarioIsAWarning) {
+  // A 60 x 5 x 60 mm plate written in metres, in a scenario in millimetres:
+  // 0.085 mm across, where the other parts are some 66 mm.
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "plate_m.obj",
+        "v -0.03 0 -0.03\nv 0.03 0 -0.03\nv 0.03 0 0.03\nv -0.03 0 0.03\n"
+        "v -0.03 0.005 -0.03\nv 0.03 0.005 -0.03\nv 0.03 0.005 0.03\nv -0.03 0.005 0.03\n"
+        "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\n"
+        "f 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n");
+  const auto file =
+      write(dir, "plate.lua",
+            std::regex_replace(moved_peg("", ""), std::regex("    lid = part"),
+                               "    plate = part { mesh = \"plate_m.obj\", at = { 0, 200, 0 } },\n"
+                               "    lid = part"));
+  const Scenario s = check_scenario(file);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("plate.lua:6: part 'plate' (plate_m.obj) is 0.085 mm across, "
+                               "1/780 of the other parts (a median of 66.3 mm)"),
+            std::string::npos)
+      << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("is the file in other units?"), std::string::npos) << s.warnings[0];
+}
+
+TEST(ScenarioLoad, CheckWarnsOfAPlanInOtherUnitsAsTheRunDoes) {
+  // A plan in millimetres: the hand goes some 100 m from the parts.
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "mm.plan", "start 0 100 0 1 0 0 0\nreach 1.0 0 60 0 1 0 0 0\n");
+  const auto file =
+      write(dir, "mm.lua", moved_peg("", "", "  hand = glove { plan = \"mm.plan\" },\n"));
+  const Scenario s = check_scenario(file);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("glove: the hand is 9.99e+04 mm from every part at t=0.000 s; "
+                               "plans and traces are in metres"),
+            std::string::npos)
+      << s.warnings[0];
+  EXPECT_EQ(run_scenario(file).warnings, s.warnings);
+}
+
 TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
   // A NUL inside a logged text (a log action's and dt.log's) is kept, and
   // the report writes it as \u0000; the failure summary for the terminal
