@@ -1218,8 +1218,23 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
   auto check = [&](const std::string& name, const std::vector<std::string>& known,
                    const char* kind) {
     if (std::find(known.begin(), known.end(), name) == known.end()) {
+      // A name of another kind (a part where a mate belongs) is said so.
+      std::string other;
+      for (const auto& [list, what] : {std::pair{&parts, "part"}, std::pair{&mates, "mate"},
+                                       std::pair{&steps, "step"}, std::pair{&regions, "region"}}) {
+        if (what != std::string_view(kind) &&
+            std::find(list->begin(), list->end(), name) != list->end()) {
+          other = " ('" + name + "' is a " + what + "; " + kind + "s: " +
+                  (known.empty() ? std::string("none") : [&] {
+                    std::string all;
+                    for (const std::string& k : known) all += (all.empty() ? "" : ", ") + k;
+                    return all;
+                  }()) +
+                  ")";
+        }
+      }
       note(clause.where, std::string(clause.word->name) + ": no " + kind + " '" + name + "'" +
-                             did_you_mean(name, known));
+                             (other.empty() ? did_you_mean(name, known) : other));
     }
   };
   for (std::size_t i = 0; i < clause.args.size(); ++i) {

@@ -812,6 +812,27 @@ std::string Runner::why_not_snapped(const MateSpec& m) const {
   const auto i = static_cast<std::size_t>(&m - scenario_.mates.data());
   if (i >= closest_.size() || !closest_[i].seen) return "";
   const Closest& c = closest_[i];
+  // A part snaps when the hand lets it go (or by a rule's snap): one the hand
+  // never held could not, however close it came.
+  // Held, or carried as part of a held sub-assembly.
+  const engine::Scene& scene = sim_->scene();
+  const auto top = [&](const std::string& name) {
+    PartId p = scene.find(name);
+    while (p.valid() && scene.parent(p).valid() && !scene.has_tag(scene.parent(p), "hand")) {
+      p = scene.parent(p);
+    }
+    return p;
+  };
+  const PartId mate_top = top(m.mate.part);
+  bool held = scenario_.glove && !scenario_.glove->holding.empty() &&
+              top(scenario_.glove->holding) == mate_top;
+  for (const Event& ev : sim_->report().events) {
+    held = held || (ev.kind == EventKind::kGrasp && top(ev.a) == mate_top);
+  }
+  const std::string never_held =
+      held ? ""
+           : "; the hand never held it, and a part snaps when the hand lets it go (or by a "
+             "rule's snap)";
   char angle[64];
   // Rounded to a millionth of a degree: turns given in degrees leave ~1e-15.
   std::snprintf(angle, sizeof angle, "%.3g degrees", std::round(c.offset.angle_deg * 1e6) / 1e6);
@@ -820,7 +841,7 @@ std::string Runner::why_not_snapped(const MateSpec& m) const {
   return ": the closest it came was " + format_length(c.offset.distance_m, out_) +
          " from its place, its axis " + angle + " off, at t=" + format_time(c.time) +
          " s (a snap needs the part released within " +
-         format_length(m.mate.position_tolerance, out_) + " and " + tolerance + ")";
+         format_length(m.mate.position_tolerance, out_) + " and " + tolerance + ")" + never_held;
 }
 
 void Runner::watch_mates(double now) {

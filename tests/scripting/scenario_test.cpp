@@ -568,6 +568,32 @@ TEST(ScenarioLoad, CheckWarnsOfAPlanInOtherUnitsAsTheRunDoes) {
   EXPECT_EQ(run_scenario(file).warnings, s.warnings);
 }
 
+TEST(ScenarioLoad, APartNamedWhereAMateBelongsIsSaidToBeAPart) {
+  const test::TempDir dir("dovetail_scenario");
+  const std::string what =
+      load_error(write(dir, "kinds.lua", moved_peg("", "    mate_made \"peg\",")));
+  EXPECT_NE(what.find("kinds.lua:20: mate_made: no mate 'peg' ('peg' is a part; mates: "
+                      "peg_in_hole)"),
+            std::string::npos)
+      << what;
+}
+
+TEST(ScenarioRun, AMateOfAPartTheHandNeverHeldSaysWhyItCouldNotSnap) {
+  // The peg is moved next to its place by a rule, never held: it cannot snap.
+  const test::TempDir dir("dovetail_scenario");
+  const auto file =
+      write(dir, "unheld.lua",
+            moved_peg("    rule { when = after(0.1), act = { move(\"peg\", { 0, 21, 0 }) } },",
+                      "    mate_made \"peg_in_hole\","));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed) << o.error;
+  ASSERT_EQ(o.expectations.size(), 1u);
+  EXPECT_NE(o.expectations[0].detail.find("; the hand never held it, and a part snaps when the "
+                                          "hand lets it go (or by a rule's snap)"),
+            std::string::npos)
+      << o.expectations[0].detail;
+}
+
 TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
   // A NUL inside a logged text (a log action's and dt.log's) is kept, and
   // the report writes it as \u0000; the failure summary for the terminal
