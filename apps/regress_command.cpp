@@ -368,7 +368,7 @@ std::string html_scenario(const Job& j, std::size_t index, const std::filesystem
 }
 
 void write_html(const std::vector<Job>& jobs, const std::filesystem::path& path,
-                const std::filesystem::path& out) {
+                const std::filesystem::path& out, int interrupted) {
   std::size_t passed = 0;
   for (const Job& j : jobs) passed += j.status == "passed";
   std::string h = R"(<!DOCTYPE html>
@@ -385,8 +385,10 @@ details{margin:.5em 0}
 <h1>Dovetail regression</h1>
 )";
   h += "<p id=\"summary\">" + std::to_string(passed) + " of " + std::to_string(jobs.size()) +
-       " scenarios "
-       "passed.</p>\n<table><tr><th>scenario</th><th>outcome</th><th>seconds</th><th>reason</th></"
+       " scenarios passed" +
+       (interrupted != 0 ? "; interrupted by signal " + std::to_string(interrupted)
+                         : std::string()) +
+       ".</p>\n<table><tr><th>scenario</th><th>outcome</th><th>seconds</th><th>reason</th></"
        "tr>\n";
   for (std::size_t i = 0; i < jobs.size(); ++i) {
     const Job& j = jobs[i];
@@ -715,7 +717,7 @@ int regress_command(std::span<const std::string> argv) {
   std::printf("%zu of %zu scenarios passed (%.1f s)%s\n", passed, jobs.size(), total,
               interrupted != 0 ? ", interrupted" : "");
   if (junit) write_junit(jobs, *junit, total);
-  if (html) write_html(jobs, *html, out);
+  if (html) write_html(jobs, *html, out, interrupted);
   if (interrupted != 0) {
     // Ended by the signal, as a caller (a shell loop) expects of an interrupt.
     std::fflush(nullptr);

@@ -15,7 +15,7 @@ done
 mkdir -p "$out/reports/c" && echo '{"outcome": "passed"}' > "$out/reports/c.json" &&
   echo 'an old log' > "$out/reports/c.log" && echo 'not a png' > "$out/reports/c/final.png" || exit 1
 "$program" regress "$out/scenarios" --out "$out/reports" -j 2 --junit "$out/junit.xml" \
-  > "$out/stdout.txt" 2>&1 &
+  --html "$out/report.html" > "$out/stdout.txt" 2>&1 &
 regress=$!
 # Both runs have started once their logs exist.
 tries=0
@@ -40,6 +40,8 @@ if pgrep -f "$out/scenarios" > /dev/null; then fail "a run outlived regress"; fi
 grep -q "stopped: regress was interrupted by signal 15" "$out/stdout.txt" || fail "no stopped run"
 grep -q "c .*not run: regress was interrupted" "$out/stdout.txt" || fail "no run left out"
 grep -q 'tests="3" failures="0" errors="3"' "$out/junit.xml" || fail "no JUnit summary"
+grep -q '0 of 3 scenarios passed; interrupted by signal 15\.' "$out/report.html" ||
+  fail "the HTML summary does not say it was interrupted"
 for name in a b c; do
   grep -q '"outcome": "error"' "$out/reports/$name.json" || fail "no report for $name"
 done
