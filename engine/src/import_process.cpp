@@ -141,30 +141,40 @@ constexpr bool kSanitized =
 
 /// The child's side: caps its memory, imports, sends 'R' and the report or
 /// 'E' and the error, and leaves without running the parent's exit handlers
-/// (they would flush the parent's buffered output a second time).
+/// (they would flush the parent's buffered output a second time). Nothing
+/// may unwind out of it: the child would go on as a second copy of the
+/// program.
 [[noreturn]] void run_child(int fd, pid_t parent, const fs::path& path,
                             const std::function<ImportReport()>& import,
-                            std::uintmax_t memory_budget_bytes) {
-  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-  if (::getppid() != parent) ::_exit(1);
-  if (!kSanitized) {
-    const std::uintmax_t limit = mapped_bytes() + memory_budget_bytes;
-    const rlimit cap{static_cast<rlim_t>(limit), static_cast<rlim_t>(limit)};
-    ::setrlimit(RLIMIT_AS, &cap);
-  }
-  std::string answer;
+                            std::uintmax_t memory_budget_bytes) noexcept {
   try {
-    answer = 'R' + encode_report(import());
-  } catch (const ImportError& e) {
-    answer = std::string("E") + e.what();
-  } catch (const std::bad_alloc&) {
-    answer = "E" + path.string() + ": ran out of memory while reading";
-  } catch (const std::exception& e) {
-    answer = "E" + path.string() + ": cannot be read as a mesh: " + e.what();
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(1);
+    // The parent's handlers (an interrupt that sets a flag) are not the child's.
+    for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) {
+      ::signal(signal_number, SIG_DFL);
+    }
+    if (!kSanitized) {
+      const std::uintmax_t limit = mapped_bytes() + memory_budget_bytes;
+      const rlimit cap{static_cast<rlim_t>(limit), static_cast<rlim_t>(limit)};
+      ::setrlimit(RLIMIT_AS, &cap);
+    }
+    std::string answer;
+    try {
+      answer = 'R' + encode_report(import());
+    } catch (const ImportError& e) {
+      answer = std::string("E") + e.what();
+    } catch (const std::bad_alloc&) {
+      answer = "E" + path.string() + ": ran out of memory while reading";
+    } catch (const std::exception& e) {
+      answer = "E" + path.string() + ": cannot be read as a mesh: " + e.what();
+    } catch (...) {
+      answer = "E" + path.string() + ": cannot be read as a mesh: unknown failure in the importer";
+    }
+    ::_exit(write_all(fd, answer) ? 0 : 1);
   } catch (...) {
-    answer = "E" + path.string() + ": cannot be read as a mesh: unknown failure in the importer";
+    ::_exit(2);  // the parent says the importer's process ended without an answer
   }
-  ::_exit(write_all(fd, answer) ? 0 : 1);
 }
 
 /// Why a child that ended this way gave no answer.
@@ -178,6 +188,9 @@ std::string child_failure(int status) {
       return "the mesh importer was killed (" + name +
              ") while reading it, most likely for running out of memory";
     }
+    if (signal_number == SIGINT || signal_number == SIGTERM || signal_number == SIGHUP) {
+      return "the mesh importer was stopped (" + name + ") while reading it";
+    }
     return "the mesh importer (assimp) crashed on it (" + name + ", " + ::strsignal(signal_number) +
            "): the file is malformed in a way Dovetail does not check itself; "
            "open it in another tool, or export it again";
@@ -185,6 +198,24 @@ std::string child_failure(int status) {
   return "the mesh importer's process ended without an answer (exit status " +
          std::to_string(WEXITSTATUS(status)) + ")";
 }
+
+/// The parent's hold on a child: its pipe closed, and the child killed and
+/// reaped, however the parent leaves (an exception while reading included).
+struct Child {
+  pid_t pid = -1;
+  int fd = -1;
+  Child() = default;
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+  ~Child() {
+    if (fd >= 0) ::close(fd);
+    if (pid > 0) {
+      ::kill(pid, SIGKILL);
+      while (::waitpid(pid, nullptr, 0) < 0 && errno == EINTR) {
+      }
+    }
+  }
+};
 
 /// Pipes and forks one import at a time: a child forked while another
 /// import's pipe was open would hold that pipe's write end, and its reader
@@ -271,31 +302,53 @@ ImportReport decode_report(std::string_view bytes) {
 
 ImportReport import_in_child(const fs::path& path, const std::function<ImportReport()>& import,
                              std::uintmax_t memory_budget_bytes) {
-  int fds[2] = {-1, -1};
-  pid_t pid = -1;
+  Child child;
+  std::string why_not;  // why no child could be started
   {
     const std::lock_guard<std::mutex> lock(g_fork_mutex);
-    if (::pipe2(fds, O_CLOEXEC) != 0) return import();  // no pipe: import here, unguarded
-    const pid_t parent = ::getpid();
-    pid = ::fork();
-    if (pid == 0) {
-      ::close(fds[0]);
-      run_child(fds[1], parent, path, import, memory_budget_bytes);
-    }
-    ::close(fds[1]);
-    if (pid < 0) {
-      ::close(fds[0]);
-      return import();  // no process to spare: import here, unguarded
+    int fds[2] = {-1, -1};
+    if (::pipe2(fds, O_CLOEXEC) != 0) {
+      why_not = std::string("no pipe: ") + std::strerror(errno);
+    } else {
+      const pid_t parent = ::getpid();
+      const pid_t pid = ::fork();
+      if (pid == 0) {
+        ::close(fds[0]);
+        run_child(fds[1], parent, path, import, memory_budget_bytes);
+      }
+      const int fork_errno = errno;
+      ::close(fds[1]);
+      if (pid < 0) {
+        ::close(fds[0]);
+        why_not = std::string("no process: ") + std::strerror(fork_errno);
+      } else {
+        child.pid = pid;
+        child.fd = fds[0];
+      }
     }
   }
-  const std::string answer = read_all(fds[0]);
-  ::close(fds[0]);
+  if (child.pid < 0) {
+    // Read here, unguarded, rather than not at all; and said so.
+    ImportReport report = import();
+    report.notes.push_back(
+        "read in Dovetail's own process, without the guard of a process of "
+        "its own (" +
+        why_not + ")");
+    return report;
+  }
+  const std::string answer = read_all(child.fd);
   int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  pid_t waited = -1;
+  while ((waited = ::waitpid(child.pid, &status, 0)) < 0 && errno == EINTR) {
   }
-  const bool exited_cleanly = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  if (waited == child.pid) child.pid = -1;  // reaped
+  // A child that could not be waited for (its exit collected elsewhere) is
+  // judged by its answer alone.
+  const bool exited_cleanly = waited < 0 || (WIFEXITED(status) && WEXITSTATUS(status) == 0);
   if (!exited_cleanly || answer.empty()) {
-    throw ImportError(path.string() + ": " + child_failure(status));
+    throw ImportError(path.string() + ": " +
+                      (waited < 0 ? std::string("the mesh importer's process gave no answer")
+                                  : child_failure(status)));
   }
   if (answer[0] == 'E') throw ImportError(answer.substr(1));
   try {

@@ -12,6 +12,7 @@
 /// parent names the file and the signal. The result is the same bits as an
 /// import in the process itself: numbers cross the pipe as their bytes.
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -25,7 +26,14 @@ namespace dovetail::engine::detail {
 /// the child throws is thrown again here with the same message; any other
 /// failure of the child (another exception, a signal, memory beyond
 /// `memory_budget_bytes` more than the parent's) becomes an ImportError
-/// whose message starts with `path`.
+/// whose message starts with `path`. When no process can be started (no
+/// pipe or process to spare), `import` runs here, and the report's notes
+/// say so.
+///
+/// The child is forked, not executed afresh: it must not need a lock that
+/// another thread of the process may hold. Imports happen while no collision
+/// work runs (scenario loading, the commands' reading of their inputs), and
+/// glibc's allocator and stdio are fork-safe.
 ImportReport import_in_child(const std::filesystem::path& path,
                              const std::function<ImportReport()>& import,
                              std::uintmax_t memory_budget_bytes);

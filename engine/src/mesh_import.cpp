@@ -570,10 +570,25 @@ ImportReport import_file(const fs::path& path, const ImportOptions& options) {
     fail(path, *wrong);
   }
   if (!options.in_child_process) return read_with_assimp(path, options);
-  // What a legitimate import needs is some tens of times the file's size;
-  // the cap stops a file that talks assimp into allocating tens of gigabytes.
+  // What a legitimate import needs is some tens of times the size of what it
+  // reads; the cap stops a file that talks assimp into allocating tens of
+  // gigabytes. A .gltf names its buffers, files beside it: the folder's
+  // files count.
+  std::uintmax_t reads = size;
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension == ".gltf") {
+    std::error_code ec;
+    const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    for (auto it = fs::directory_iterator(folder, ec); !ec && it != fs::directory_iterator();
+         it.increment(ec)) {
+      std::error_code kind;
+      if (it->is_regular_file(kind)) reads += it->file_size(kind);
+    }
+  }
   constexpr std::uintmax_t kGiB = std::uintmax_t{1} << 30;
-  const std::uintmax_t budget = 4 * kGiB + std::min<std::uintmax_t>(size, 16 * kGiB) * 64;
+  const std::uintmax_t budget = 4 * kGiB + std::min<std::uintmax_t>(reads, 16 * kGiB) * 64;
   return detail::import_in_child(
       path, [&] { return read_with_assimp(path, options); }, budget);
 }

@@ -415,10 +415,15 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
     // the open hand, which could then never release it: such a digit
     // releases when it opens back half of what it closed while the grasp
     // built up.
+    // Not less than a degree (the glove's jitter), where the open hand can
+    // still get there: half the flexion at the grasp, when that is less.
+    constexpr Real kJitter = 1;  // degrees
     for (std::size_t d = 0; d < kDigitCount; ++d) {
       const Real closed = flexion_at_grasp_[d] - candidate_start_digits_[d];
       if (closed > 0) {
-        release_opening_[d] = std::min(closed / 2, settings_.grasp.release_open_deg);
+        const Real floor = std::min(kJitter, flexion_at_grasp_[d] / 2);
+        release_opening_[d] =
+            std::min(std::max(closed / 2, floor), settings_.grasp.release_open_deg);
       }
     }
     emit(EventKind::kGrasp, candidate_, std::string(grasp_type_name(candidate_type_)));
@@ -563,9 +568,11 @@ Transform Grasping::guided(const engine::Scene& scene, PartId root, const Transf
   for (std::size_t m = 0; m < mates_.size(); ++m) {
     const Mate& mate = mates_[m];
     if (!mate.guide) continue;
-    // A mate of the carried part or of a part attached to it (the held part among them).
+    // A mate of the carried part or of a part attached to it (the held part among
+    // them) into a part outside the sub-assembly: one inside it moves with it.
     const PartId p = scene.find(mate.part), o = scene.find(mate.other);
-    if (!p.valid() || !o.valid() || !scene.descends_from(p, root)) continue;
+    if (!p.valid() || !o.valid() || !scene.descends_from(p, root) || scene.descends_from(o, root))
+      continue;
     const Transform X_RP = pose_in(scene, root, p);
     const Transform X_WP_target = p == root ? X_WR_target : engine::compose(X_WR_target, X_RP);
     const Transform X_WO = scene.world_pose(o);
@@ -620,7 +627,8 @@ void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
   if (!scene.movable(root)) return;
   for (const Mate& mate : mates_) {
     const PartId p = scene.find(mate.part), o = scene.find(mate.other);
-    if (!p.valid() || !o.valid() || !scene.descends_from(p, root)) continue;
+    if (!p.valid() || !o.valid() || !scene.descends_from(p, root) || scene.descends_from(o, root))
+      continue;
     const Transform X_WP = scene.world_pose(p), X_WO = scene.world_pose(o);
     if (!within_tolerance(mate, X_WP, X_WO)) continue;
     const Transform X_seated = mate_pose(mate, X_WP, X_WO);

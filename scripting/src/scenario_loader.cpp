@@ -1273,16 +1273,18 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
 }
 
 /// A part from a mesh file hundreds of times smaller or larger than the
-/// scenario's other parts: most likely a file in other units (a plate in
-/// metres in a scenario in millimetres is 80 micrometres across, and any
-/// part passes through it in a frame).
+/// scenario's other parts, and under 2 mm or over 20 m across (or under
+/// 0.05 mm or over 200 m whatever the others): most likely a file in other
+/// units (a plate in metres in a scenario in millimetres is 80 micrometres
+/// across, and any part passes through it in a frame). A 4 mm screw in a
+/// 3 m frame is no such part.
 void Loader::warn_about_mesh_sizes() {
   const auto across = [&](const PartSpec& p) {
     Eigen::AlignedBox<double, 3> box;
     for (const Vec3& v : p.mesh->vertices) box.extend(v);
     return box.diagonal().norm() / scenario_.metres_per_unit;
   };
-  constexpr double kRatio = 500;  // parts of one product differ less; units by 1000 (or 25.4)
+  constexpr double kRatio = 500;  // units differ by 1000 (m and mm)
   for (const PartSpec& p : scenario_.parts) {
     if (p.file.empty() || !p.mesh) continue;
     std::vector<double> others;
@@ -1294,7 +1296,12 @@ void Loader::warn_about_mesh_sizes() {
     const double median = others[others.size() / 2], size = across(p);
     if (!(size > 0) || !(median > 0)) continue;
     const double ratio = median / size;
-    if (ratio < kRatio && ratio > 1 / kRatio) continue;
+    // Far from the others and of a size few parts have; or of a size no part has.
+    const double metres = size * scenario_.metres_per_unit;
+    const bool far = ratio >= kRatio || ratio <= 1 / kRatio;
+    const bool rare = metres < 2e-3 || metres > 20;
+    const bool never = metres < 5e-5 || metres > 200;
+    if (!(far && rare) && !never) continue;
     const auto brief = [](double x) {
       char buffer[32];
       std::snprintf(buffer, sizeof buffer, "%.3g", x);
@@ -1376,6 +1383,17 @@ void Loader::resolve() {
     if (fixed(scenario_.glove->holding)) {
       note(scenario_.glove->where,
            "glove: the hand cannot hold the fixed part '" + scenario_.glove->holding + "'");
+    } else {
+      // Holding a part carries its sub-assembly: one attached to a fixed part
+      // cannot move. (The chain has no cycle: those are refused above.)
+      const PartSpec* q = spec(scenario_.glove->holding);
+      for (std::size_t k = 0; q && !q->attached_to.empty() && k < scenario_.parts.size(); ++k) {
+        q = spec(q->attached_to);
+      }
+      if (q && q->fixed) {
+        note(scenario_.glove->where, "glove: the hand cannot hold '" + scenario_.glove->holding +
+                                         "': it is attached to '" + q->name + "', which is fixed");
+      }
     }
   }
   auto can_never = [&](const Clause& c, const std::string& context) {

@@ -794,9 +794,9 @@ void Runner::measure_penetration(double now) {
   }
 }
 
-/// Who would overlap in a refused snap: "it", or "'washer', attached to it".
+/// Who would overlap in a refused snap: "it", or "'washer', moved with it".
 std::string overlapper(const interaction::RefusedSnap& r) {
-  return r.overlapping == r.part ? "it" : "'" + r.overlapping + "', attached to it,";
+  return r.overlapping == r.part ? "it" : "'" + r.overlapping + "', moved with it,";
 }
 
 std::string Runner::why_not_snapped(const MateSpec& m) const {
@@ -1147,11 +1147,21 @@ void Runner::run() {
       }
       if (meter) meter->update(f + 1);
     }
-    // Actions of rules that fired in the last frame would apply at the start
-    // of the next one, which does not come: they apply now, at the end time,
-    // before the expectations are judged (a `custom` action runs, a `move`
-    // without `over` lands). No frame follows to find their contacts.
-    if (!failed_by_rule_ && !pending_.empty()) start_frame(frames, previous);
+    // Actions of rules that fired in the last frame are done at the start of
+    // the next: one frame more, a whole one (its contacts found, its events
+    // and steps counted, the state hashed), so that no action is lost.
+    if (!failed_by_rule_ && !pending_.empty()) {
+      const engine::FrameResult& result = sim_->step();
+      end_frame(result, previous);
+    }
+    // What rules of that frame left for another is not done, and said so.
+    for (const auto& [action, fired] : pending_) {
+      out_.messages.push_back(
+          {fired, "warn",
+           std::string(action->word->name) + ": not done: its rule fired in the run's last frame",
+           action->where});
+    }
+    pending_.clear();
     if (meter) meter->finish();
     out_.loop_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();

@@ -193,13 +193,14 @@ std::vector<Word> make_vocabulary() {
                {{"mate", kMate, kRequired, "the mate"}},
                "The mate's part snaps into place.",
                "mated \"peg_in_hole\""});
-  w.push_back({"slides",
-               WordKind::kEvent,
-               {{"part", kPart, kRequired, "the held part, or a part attached to it"},
-                {"on", kPart, kOptional, "only on this part"}},
-               "The held part (or a part attached to it) comes into contact with another part "
-               "while carried and slides along it: once for each pair, named as it touches.",
-               "slides(\"peg\", \"block\")"});
+  w.push_back(
+      {"slides",
+       WordKind::kEvent,
+       {{"part", kPart, kRequired, "a carried part: the held one, or one of its sub-assembly"},
+        {"on", kPart, kOptional, "only on this part"}},
+       "A carried part (the held part, or a part of its sub-assembly) comes into contact "
+       "with another part and slides along it: once for each pair, named as it touches.",
+       "slides(\"peg\", \"block\")"});
   w.push_back(
       {"enters",
        WordKind::kEvent,

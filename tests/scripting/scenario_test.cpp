@@ -8,6 +8,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <map>
 #include <regex>
 
 #include "../support/temp_dir.h"
@@ -381,24 +382,21 @@ TEST(ScenarioRun, CustomActionsUseTheLowLevelApi) {
   EXPECT_EQ(logged_texts(o), (std::vector<std::string>{"0 100 0", "0 250 0"})) << o.to_json();
 }
 
-TEST(ScenarioRun, ActionsOfARuleFiredInTheLastFrameApplyBeforeTheEnd) {
-  // The run is 1 s long; after(1) fires in its last frame, whose actions
-  // would apply at the start of a frame that does not come.
+TEST(ScenarioRun, ARuleFiredInTheLastFrameGetsOneFrameMoreForItsActions) {
+  // The run is 1 s long (91 frames); after(1) fires in its last frame, whose
+  // actions are done at the start of a 92nd: the custom function runs, the
+  // snap is an event and mate_made sees it, the state hash includes it.
   const test::TempDir dir("dovetail_scenario");
   const auto logs = write(dir, "last.lua",
                           moved_peg("    rule { when = after(1), act = { custom(function(dt)\n"
-                                    "      dt.log(string.format(\"at %g\", dt.time())) end),\n"
-                                    "      move(\"peg\", { 0, 250, 0 }) } },",
-                                    ""));
+                                    "      dt.log(string.format(\"at %.6f\", dt.time())) end),\n"
+                                    "      snap \"peg_in_hole\" } },",
+                                    "    mate_made \"peg_in_hole\","));
   const RunOutcome o = run_scenario(logs);
   ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
-  EXPECT_EQ(logged_texts(o), (std::vector<std::string>{"at 1"})) << o.to_json();
-  ASSERT_FALSE(o.final_poses.empty());
-  bool moved = false;
-  for (const auto& pose : o.final_poses) {
-    if (pose.part == "peg") moved = std::abs(pose.position.y() - 0.25) < 1e-12;
-  }
-  EXPECT_TRUE(moved) << o.to_json();  // final poses are in metres
+  EXPECT_EQ(logged_texts(o), (std::vector<std::string>{"at 1.011111"})) << o.to_json();
+  EXPECT_EQ(o.report.frames, 92u);
+  EXPECT_TRUE(o.warnings.empty());
 
   const auto fails = write(dir, "last_error.lua",
                            moved_peg("    rule { when = after(1), act = { custom(function(dt)\n"
@@ -407,6 +405,21 @@ TEST(ScenarioRun, ActionsOfARuleFiredInTheLastFrameApplyBeforeTheEnd) {
   const RunOutcome e = run_scenario(fails);
   ASSERT_EQ(e.status, RunOutcome::Status::kError) << e.failure_summary();
   EXPECT_NE(e.error.find("boom"), std::string::npos) << e.error;
+
+  // A rule firing every frame leaves a move for a 93rd frame: not done, said.
+  const auto every =
+      write(dir, "every.lua",
+            moved_peg("    rule { when = after(1), act = { move(\"lid\", { 100, 5, 0 }) } },\n"
+                      "    rule { when = every(1 / 90), cooldown = 0, act = { move(\"peg\", { 0, "
+                      "200, 0 }) } },",
+                      ""));
+  const RunOutcome m = run_scenario(every);
+  bool said = false;
+  for (const Message& msg : m.messages) {
+    said = said || (msg.level == "warn" &&
+                    msg.text == "move: not done: its rule fired in the run's last frame");
+  }
+  EXPECT_TRUE(said) << m.to_json();
 }
 
 TEST(ScenarioRun, AFailIsTheFirstReasonGivenBeforeExpectationsItCutShort) {
@@ -461,11 +474,10 @@ TEST(ScenarioRun, AGraspMadeAsTheFingersBarelyMovedIsReleasedWhenTheHandOpens) {
   EXPECT_NEAR(o.final_poses[0].position.y(), 0.170, 1e-4);
 }
 
-TEST(ScenarioRun, GraspingAPartAttachedToAnotherCarriesTheWholeSubAssembly) {
-  // The hand closes on a collar pressed on a shaft (attached to it) and
-  // carries both 85 mm down; before, the collar was held against its own
-  // shaft and nothing moved until the hand let go of it, overstretched.
-  const test::TempDir dir("dovetail_scenario");
+/// A collar pressed on a shaft, grasped by the collar and carried 85 mm down
+/// by `collar.plan`; `mates` and `rules` go into the scenario.
+std::filesystem::path collar_on_shaft(const test::TempDir& dir, const std::string& name,
+                                      const std::string& mates, const std::string& rules) {
   write(dir, "collar.plan",
         "start -0.070 0.125 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
         "reach 0.6  -0.010 0.125 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
@@ -473,18 +485,26 @@ TEST(ScenarioRun, GraspingAPartAttachedToAnotherCarriesTheWholeSubAssembly) {
         "reach 2.0  -0.010 0.040 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
         "open 0.3\n"
         "reach 0.5  -0.070 0.040 0.080  0.7071067811865476 0 0 0.7071067811865476\n");
-  const auto file = write(dir, "collar.lua", R"(return scenario {
+  return write(dir, name, R"(return scenario {
   name = "collar on a shaft", units = "mm",
   parts = {
     shaft = part { shape = cylinder { diameter = 24, length = 50 }, at = { 0, 150, 0 }, turn = { x = 90 } },
     collar = part { shape = tube { outer = 40, inner = 23.9, length = 10 }, at = { 0, 150, 0 },
                     turn = { x = 90 }, attached_to = "shaft" },
+    base = part { shape = box { size = { 20, 20, 20 } }, at = { 200, 0, 0 }, fixed = true },
   },
+  mates = { )" + mates + R"( },
+  rules = { )" + rules + R"( },
   hand = glove { plan = "collar.plan" },
-  expect = { grasped_as("collar", "power"), max_penetration(0.01) },
+})");
 }
-)");
-  const RunOutcome o = run_scenario(file);
+
+TEST(ScenarioRun, GraspingAPartAttachedToAnotherCarriesTheWholeSubAssembly) {
+  // The hand closes on a collar pressed on a shaft (attached to it) and
+  // carries both 85 mm down; before, the collar was held against its own
+  // shaft and nothing moved until the hand let go of it, overstretched.
+  const test::TempDir dir("dovetail_scenario");
+  const RunOutcome o = run_scenario(collar_on_shaft(dir, "collar.lua", "", ""));
   ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
   std::vector<std::string> grasps;
   for (const engine::Event& e : o.report.events) {
@@ -493,14 +513,15 @@ TEST(ScenarioRun, GraspingAPartAttachedToAnotherCarriesTheWholeSubAssembly) {
     }
   }
   EXPECT_EQ(grasps, (std::vector<std::string>{"collar power", "collar opened"}));
-  ASSERT_EQ(o.final_poses.size(), 2u);
-  for (const auto& pose : o.final_poses) {
+  std::map<std::string, Vec3> at;
+  for (const auto& pose : o.final_poses) at[pose.part] = pose.position;
+  for (const std::string part : {"shaft", "collar"}) {
     // Both went down with the hand (the hand's grip shifts them a little sideways).
-    EXPECT_NEAR(pose.position.y(), 0.065, 1e-4) << pose.part;
-    EXPECT_NEAR(pose.position.x(), 0, 1e-3) << pose.part;
+    EXPECT_NEAR(at[part].y(), 0.065, 1e-4) << part;
+    EXPECT_NEAR(at[part].x(), 0, 1e-3) << part;
   }
   // The collar where it was on the shaft.
-  EXPECT_LT((o.final_poses[0].position - o.final_poses[1].position).norm(), 1e-12);
+  EXPECT_LT((at["shaft"] - at["collar"]).norm(), 1e-12);
 }
 
 TEST(ScenarioRun, TheFinalPictureIsTheSameWithOrWithoutFrames) {
@@ -592,6 +613,63 @@ TEST(ScenarioRun, AMateOfAPartTheHandNeverHeldSaysWhyItCouldNotSnap) {
                                           "hand lets it go (or by a rule's snap)"),
             std::string::npos)
       << o.expectations[0].detail;
+}
+
+TEST(ScenarioRun, AMateInsideTheCarriedSubAssemblyNeitherGuidesNorSnapsIt) {
+  // The collar's mate into its own shaft is always in place, as both move
+  // together: it must not draw the carried pair onto itself, nor take the
+  // release's snap.
+  const test::TempDir dir("dovetail_scenario");
+  const RunOutcome plain = run_scenario(collar_on_shaft(dir, "plain.lua", "", ""));
+  const RunOutcome inner = run_scenario(collar_on_shaft(
+      dir, "inner.lua",
+      "collar_on_shaft = mate { part = \"collar\", point = { 0, 0, 0 }, axis = \"z\", "
+      "into = \"shaft\", at = { 0, 0, 0 }, along = \"z\" }",
+      ""));
+  ASSERT_EQ(plain.status, RunOutcome::Status::kPassed) << plain.error;
+  ASSERT_EQ(inner.status, RunOutcome::Status::kPassed) << inner.error;
+  EXPECT_EQ(inner.report.state_hash, plain.report.state_hash);
+  for (const engine::Event& e : inner.report.events) {
+    EXPECT_NE(e.kind, engine::EventKind::kMate) << e.a << " " << e.b;
+  }
+}
+
+TEST(ScenarioRun, AHeldPartAttachedToAFixedPartIsLetGo) {
+  // While carried, a rule attaches the shaft to the fixed base: the hand lets
+  // the collar go ("attached"), and the pair stays where it was.
+  const test::TempDir dir("dovetail_scenario");
+  const RunOutcome o = run_scenario(collar_on_shaft(
+      dir, "fixed.lua", "", "rule { when = after(1.5), act = { attach(\"shaft\", \"base\") } }"));
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.error;
+  std::vector<std::string> grasps;
+  for (const engine::Event& e : o.report.events) {
+    if (e.kind == engine::EventKind::kGrasp || e.kind == engine::EventKind::kRelease) {
+      grasps.push_back(e.a + " " + e.b);
+    }
+  }
+  EXPECT_EQ(grasps, (std::vector<std::string>{"collar power", "collar attached"}));
+  for (const auto& pose : o.final_poses) {
+    if (pose.part == "shaft") {
+      EXPECT_GT(pose.position.y(), 0.1) << "let go on the way down";
+    }
+  }
+}
+
+TEST(ScenarioLoad, HoldingAPartAttachedToAFixedPartIsAnError) {
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "hold.plan", "start 0 0.2 0 1 0 0 0\nwait 0.5\n");
+  const std::string what = load_error(write(dir, "hold.lua", R"(return scenario {
+  name = "held", units = "mm",
+  parts = {
+    base = part { shape = box { size = { 20, 20, 20 } }, fixed = true },
+    nut = part { shape = box { size = { 5, 5, 5 } }, at = { 0, 12, 0 }, attached_to = "base" },
+  },
+  hand = glove { plan = "hold.plan", holding = "nut" },
+})"));
+  EXPECT_NE(what.find("hold.lua:7: glove: the hand cannot hold 'nut': it is attached to 'base', "
+                      "which is fixed"),
+            std::string::npos)
+      << what;
 }
 
 TEST(ScenarioRun, TextWithNulAndControlBytesIsKeptWholeAndShownEscaped) {
