@@ -651,7 +651,12 @@ class Loader {
     if (fresh) {
       engine::ImportOptions options;
       options.merge = false;
-      it->second = engine::import_file(path, options);
+      try {
+        it->second = engine::import_file(path, options);
+      } catch (...) {
+        imports_.erase(it);  // a file that failed is not an empty one
+        throw;
+      }
       for (const std::string& f : it->second.files) note_file(f);
     }
     const engine::ImportReport& report = it->second;
@@ -729,6 +734,9 @@ class Loader {
   std::vector<std::filesystem::path>* files_read_ = nullptr;
   bool hand_given_ = false;  ///< a replayed trace gives the hand the scenario lacks
   std::map<std::string, engine::ImportReport> imports_;  ///< mesh files read by node
+  /// Mesh files read whole, once however many parts name them (each read is
+  /// a process of its own).
+  std::map<std::string, engine::ImportReport> whole_imports_;
 };
 
 Scenario Loader::load() {
@@ -896,9 +904,17 @@ void Loader::read_parts(int map, const SourceLocation& where) {
           loaded = select_nodes(path, nodes.given ? nodes.names : without.names, nodes.given,
                                 part.where, what);
         } else {
-          engine::ImportReport report = engine::import_file(path, {});
-          for (const std::string& f : report.files) note_file(f);
-          loaded = std::move(report.parts.front().mesh);
+          auto [it, fresh] = whole_imports_.try_emplace(path.string());
+          if (fresh) {
+            try {
+              it->second = engine::import_file(path, {});
+            } catch (...) {
+              whole_imports_.erase(it);
+              throw;
+            }
+          }
+          for (const std::string& f : it->second.files) note_file(f);
+          loaded = it->second.parts.front().mesh;
         }
       } catch (const ScenarioError&) {
         throw;
