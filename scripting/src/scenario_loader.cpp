@@ -1236,8 +1236,9 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
     if (std::find(known.begin(), known.end(), name) == known.end()) {
       // A name of another kind (a part where a mate belongs) is said so.
       std::string other;
-      for (const auto& [list, what] : {std::pair{&parts, "part"}, std::pair{&mates, "mate"},
-                                       std::pair{&steps, "step"}, std::pair{&regions, "region"}}) {
+      for (const auto& [list, what] :
+           {std::pair{&names.parts, "part"}, std::pair{&names.mates, "mate"},
+            std::pair{&names.steps, "step"}, std::pair{&names.regions, "region"}}) {
         if (what != std::string_view(kind) &&
             std::find(list->begin(), list->end(), name) != list->end()) {
           other = " ('" + name + "' is a " + what + "; " + kind + "s: " +
