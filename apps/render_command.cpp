@@ -24,7 +24,7 @@ namespace {
 constexpr const char* kHelp =
     R"(usage: dovetail render INPUT --out PNG [--width W] [--height H] [--camera NAME|auto]
                        [--trace TRACE | --plan PLAN] [--time T] [--hand-size S]
-                       [--hand-length M]
+                       [--hand-length M] [--units mm|cm|m]
 
 Draws a mesh or assembly file off-screen and writes the picture as PNG.
 
@@ -43,6 +43,8 @@ Draws a mesh or assembly file off-screen and writes the picture as PNG.
   --plan PLAN    the same with a simulated-glove plan (docs/interaction.md)
   --hand-size S  adult_m50 (default), adult_f50, adult_m95, adult_f05
   --hand-length M  scale the size to this hand length in metres (0: its own)
+  --units U      with a hand: the unit of INPUT's numbers, mm, cm or m (default:
+                 millimetres when its box is more than 100 across, else metres)
 
 Flat shading with a light at the camera, depth-tested, no anti-aliasing; the
 same input and options give the same PNG bytes. Prints a one-line JSON summary
@@ -96,12 +98,33 @@ engine::RenderScene scene_with_hand(const Args& args, const std::string& input,
   } catch (const interaction::PlanError& e) {
     throw InputError(e.what());
   }
+  engine::AssemblyOptions options;
+  if (const std::optional<std::string> units = args.value("units")) {
+    if (*units == "mm") {
+      options.units = 0.001;
+    } else if (*units == "cm") {
+      options.units = 0.01;
+    } else if (*units == "m") {
+      options.units = 1;
+    } else {
+      throw UsageError("render: --units must be mm, cm or m, not '" + *units + "'");
+    }
+  }
   engine::AssemblyReport assembly;
   engine::Scene parts;
   try {
-    parts = engine::load_assembly(input, {}, &assembly);
+    parts = engine::load_assembly(input, options, &assembly);
   } catch (const collision::MeshError& e) {
     throw InputError(e.what());
+  }
+  if (assembly.units_inferred) {
+    // The hand is drawn in metres: a part read in the wrong unit is 1000
+    // times too small or too large beside it.
+    std::fprintf(stderr,
+                 "dovetail: note: %s: read in %s (its box is %s 100 across); --units says "
+                 "otherwise\n",
+                 input.c_str(), assembly.units == 1 ? "metres" : "millimetres",
+                 assembly.units == 1 ? "at most" : "more than");
   }
   for (const std::string& note : assembly.notes) {
     std::fprintf(stderr, "dovetail: note: %s: %s\n", input.c_str(), note.c_str());
@@ -163,10 +186,10 @@ engine::RenderSettings render_settings(const Args& args) {
 }  // namespace
 
 int render_command(std::span<const std::string> argv) {
-  const Args args(
-      "render", argv,
-      {"out", "width", "height", "camera", "trace", "plan", "time", "hand-size", "hand-length"},
-      {});
+  const Args args("render", argv,
+                  {"out", "width", "height", "camera", "trace", "plan", "time", "hand-size",
+                   "hand-length", "units"},
+                  {});
   if (args.help()) {
     std::fputs(kHelp, stdout);
     return kExitOk;
@@ -185,7 +208,7 @@ int render_command(std::span<const std::string> argv) {
 
   const bool with_hand = trace || plan;
   if (!with_hand) {
-    for (const char* option : {"time", "hand-size", "hand-length"}) {
+    for (const char* option : {"time", "hand-size", "hand-length", "units"}) {
       if (args.value(option)) {
         throw UsageError(std::string("render: --") + option + " needs --trace or --plan");
       }

@@ -138,6 +138,22 @@ dovetail_cli_test(render_hand_unknown_size EXIT 2
                   ARGS render ${cube} --trace ${glove}/trace_three_samples.csv --hand-size giant
                        --out ${out}/x.png
                   STDERR "unknown size 'giant'")
+# The unit of an assembly drawn with a hand: inferred with a note, or given.
+dovetail_cli_test(render_hand_units_inferred EXIT 0
+                  ARGS render ${cube} --trace ${glove}/trace_three_samples.csv --out ${out}/units.png
+                       --width 80 --height 60
+                  STDERR "cube.obj: read in metres \\(its box is at most 100 across\\); --units says otherwise"
+                  REMOVE ${out}/units.png)
+dovetail_cli_test(render_hand_units_given EXIT 0
+                  ARGS render ${cube} --trace ${glove}/trace_three_samples.csv --units mm
+                       --out ${out}/units_mm.png --width 80 --height 60
+                  STDOUT "\"hand\":true" REMOVE ${out}/units_mm.png)
+dovetail_cli_test(render_hand_units_unknown EXIT 2
+                  ARGS render ${cube} --trace ${glove}/trace_three_samples.csv --units inch
+                       --out ${out}/x.png
+                  STDERR "--units must be mm, cm or m, not 'inch'")
+dovetail_cli_test(render_units_without_hand EXIT 2
+                  ARGS render ${cube} --units mm --out ${out}/x.png STDERR "--units needs --trace or --plan")
 dovetail_cli_test(render_time_without_trace EXIT 2
                   ARGS render ${cube} --time 1 --out ${out}/x.png STDERR "--time needs --trace or --plan")
 
