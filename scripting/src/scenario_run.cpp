@@ -265,6 +265,7 @@ class Runner {
   std::vector<std::optional<double>> rule_last_;
   std::vector<std::pair<const Clause*, double>> pending_;  ///< actions for the next frame
   double action_time_ = 0;                                 ///< see time()
+  std::set<std::string> carried_ever_;                     ///< every part the hand has carried
   std::vector<std::size_t> forced_steps_;                  ///< `complete` actions this frame
   std::vector<Event> injected_;                            ///< `snap` mate events this frame
   struct Motion {
@@ -814,21 +815,7 @@ std::string Runner::why_not_snapped(const MateSpec& m) const {
   const Closest& c = closest_[i];
   // A part snaps when the hand lets it go (or by a rule's snap): one the hand
   // never held could not, however close it came.
-  // Held, or carried as part of a held sub-assembly.
-  const engine::Scene& scene = sim_->scene();
-  const auto top = [&](const std::string& name) {
-    PartId p = scene.find(name);
-    while (p.valid() && scene.parent(p).valid() && !scene.has_tag(scene.parent(p), "hand")) {
-      p = scene.parent(p);
-    }
-    return p;
-  };
-  const PartId mate_top = top(m.mate.part);
-  bool held = scenario_.glove && !scenario_.glove->holding.empty() &&
-              top(scenario_.glove->holding) == mate_top;
-  for (const Event& ev : sim_->report().events) {
-    held = held || (ev.kind == EventKind::kGrasp && top(ev.a) == mate_top);
-  }
+  const bool held = carried_ever_.count(m.mate.part) != 0;
   const std::string never_held =
       held ? ""
            : "; the hand never held it, and a part snaps when the hand lets it go (or by a "
@@ -875,6 +862,14 @@ void Runner::end_frame(const engine::FrameResult& result, double previous_time) 
   std::vector<Occurrence> happened = occurrences(result);
   measure_penetration(now);
   watch_mates(now);
+  // The parts the hand carried (the held one and its sub-assembly), for mate_made.
+  if (grasping_ && grasping_->carried()) {
+    const engine::Scene& scene = sim_->scene();
+    const PartId root = scene.find(*grasping_->carried());
+    for (const PartId p : scene.parts()) {
+      if (root.valid() && scene.descends_from(p, root)) carried_ever_.insert(scene.name(p));
+    }
+  }
   // Steps first: their completions are events the rules of this frame see.
   for (const std::size_t i : forced_steps_) complete_step(i, now, happened);
   forced_steps_.clear();
