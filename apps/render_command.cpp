@@ -117,17 +117,12 @@ engine::RenderScene scene_with_hand(const Args& args, const std::string& input,
   } catch (const collision::MeshError& e) {
     throw InputError(e.what());
   }
-  if (assembly.units_inferred) {
+  for (const std::string& note : assembly.notes) {
     // The hand is drawn in metres: a part read in the wrong unit is 1000
     // times too small or too large beside it.
-    std::fprintf(stderr,
-                 "dovetail: note: %s: read in %s (its box is %s 100 across); --units says "
-                 "otherwise\n",
-                 input.c_str(), assembly.units == 1 ? "metres" : "millimetres",
-                 assembly.units == 1 ? "at most" : "more than");
-  }
-  for (const std::string& note : assembly.notes) {
-    std::fprintf(stderr, "dovetail: note: %s: %s\n", input.c_str(), note.c_str());
+    const bool units = note.rfind("units inferred", 0) == 0;
+    std::fprintf(stderr, "dovetail: note: %s: %s%s\n", input.c_str(), note.c_str(),
+                 units ? " (--units mm, cm or m says which)" : "");
   }
   triangles = assembly.triangles;
   files = assembly.files;

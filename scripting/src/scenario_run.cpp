@@ -122,6 +122,10 @@ std::vector<std::string> glove_warnings(const Scenario& scenario, const GloveSpe
       }
     }
   }
+  if (const double start = start_time(source); start < 0) {
+    out.push_back(who + ": the trace starts at t=" + format_time(start) +
+                  " s; what it holds before t=0 is not used (the run starts at 0)");
+  }
   // Device clocks (seconds since 1970) instead of seconds from the start of the run.
   if (const double start = start_time(source); start > 1) {
     out.push_back(who + ": the trace starts at t=" + format_time(start) +
@@ -179,14 +183,21 @@ std::shared_ptr<const interaction::GloveSource> glove_source(
     const bool trace = replay || !glove.trace.empty();
     const std::filesystem::path& file = replay ? *replay : trace ? glove.trace : glove.plan;
     const double start = start_time(*source);
+    // What else is doubtful about a trace (times in milliseconds) is its likelier cause.
+    std::string doubts;
+    if (const auto* samples = dynamic_cast<const interaction::TraceSource*>(source.get())) {
+      for (const std::string& doubt : interaction::trace_doubts(file, samples->samples())) {
+        if (doubt.find("milliseconds") != std::string::npos) doubts = "; " + doubt;
+      }
+    }
     throw ScenarioError((replay ? std::string() : glove.where.str() + ": glove: ") + file.string() +
                         ": the " + (trace ? "trace" : "plan") +
                         " ends at t=" + format_time(source->end_time()) + " s" +
                         (start > 1 ? " (it starts at t=" + format_time(start) +
                                          " s; its times are seconds from the start of the run)"
                                    : std::string()) +
-                        ", later than the " + format_time(kMaxRunSeconds) +
-                        " s a run may last; give the scenario a duration");
+                        ", later than the " + format_time(kMaxRunSeconds) + " s a run may last" +
+                        (doubts.empty() ? "; give the scenario a duration" : doubts));
   }
   return source;
 }
@@ -272,6 +283,7 @@ class Runner {
     std::string part;
     Vec3 from, to;
     double t0, t1;
+    SourceLocation where;  ///< the move's action
   };
   std::vector<Motion> motions_;
   std::vector<std::string> arrived_;  ///< parts whose move ended this frame, in order
@@ -578,7 +590,8 @@ void Runner::apply(const Clause& action, double now) {
     }
     std::erase_if(motions_, [&](const Motion& m) { return m.part == a; });
     const double over = action.args[2].given ? action.args[2].number : 0;
-    motions_.push_back({a, scene.world_pose(p).t, action.args[1].vector, now, now + over});
+    motions_.push_back(
+        {a, scene.world_pose(p).t, action.args[1].vector, now, now + over, action.where});
   } else if (w == "attach") {
     const std::string& to = action.args[1].text;
     if (scene.descends_from(scene.get(to), scene.get(a))) {
@@ -1124,8 +1137,10 @@ void Runner::run() {
                            (options_.trace || !scenario_.glove->trace.empty() ? 0 : 1)
                      : 1;
   }
+  // Frames at t = 0, dt, 2 dt, ... up to the first at or after the end, so
+  // that a rule at the end time (after(duration)) has its frame.
   const auto frames =
-      static_cast<std::uint64_t>(std::floor(end_time / scenario_.time_step + 1e-9)) + 1;
+      static_cast<std::uint64_t>(std::ceil(end_time / scenario_.time_step - 1e-9)) + 1;
   std::optional<engine::ProgressMeter> meter;
   if (options_.progress) meter.emplace(frames);
   const auto loop_start = std::chrono::steady_clock::now();
@@ -1148,6 +1163,15 @@ void Runner::run() {
     if (!failed_by_rule_ && !pending_.empty()) {
       const engine::FrameResult& result = sim_->step();
       end_frame(result, previous);
+    }
+    // Moves still under way when the run ends do not arrive, and are said so.
+    for (const Motion& m : motions_) {
+      out_.messages.push_back({m.t0, "warn",
+                               "move: '" + m.part +
+                                   "' had not arrived when the run ended (it "
+                                   "would at t=" +
+                                   format_time(m.t1) + " s)",
+                               m.where});
     }
     // What rules of that frame left for another is not done, and said so.
     for (const auto& [action, fired] : pending_) {

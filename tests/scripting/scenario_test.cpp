@@ -422,6 +422,39 @@ TEST(ScenarioRun, ARuleFiredInTheLastFrameGetsOneFrameMoreForItsActions) {
   EXPECT_TRUE(said) << m.to_json();
 }
 
+TEST(ScenarioRun, ARunReachesItsDurationWhenItIsNoMultipleOfTheTimeStep) {
+  // 1.234567 s at 90 Hz: frames up to t = 112/90 = 1.2444 s, the first at or
+  // after the end, where after(1.234567) fires. Before, the run stopped at
+  // 111/90 = 1.2333 s and the rule never fired.
+  const test::TempDir dir("dovetail_scenario");
+  const auto file =
+      write(dir, "odd.lua",
+            std::regex_replace(
+                moved_peg("    rule { when = after(1.234567), act = { log \"end\" } },", ""),
+                std::regex("duration = 1,"), "duration = 1.234567,"));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+  EXPECT_EQ(o.report.frames, 113u);
+  EXPECT_EQ(logged_texts(o), (std::vector<std::string>{"end"})) << o.to_json();
+}
+
+TEST(ScenarioRun, AMoveStillUnderWayWhenTheRunEndsIsAWarning) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(
+      dir, "late.lua",
+      moved_peg("    rule { when = after(0.9), act = { move(\"peg\", { 0, 150, 0 }, 0.5) } },",
+                ""));
+  const RunOutcome o = run_scenario(file);
+  bool said = false;
+  for (const Message& m : o.messages) {
+    said = said || (m.level == "warn" && m.where.line == 17 &&
+                    m.text ==
+                        "move: 'peg' had not arrived when the run ended (it would at "
+                        "t=1.411 s)");
+  }
+  EXPECT_TRUE(said) << o.to_json();
+}
+
 TEST(ScenarioRun, AFailIsTheFirstReasonGivenBeforeExpectationsItCutShort) {
   const test::TempDir dir("dovetail_scenario");
   const auto file =
@@ -1051,6 +1084,39 @@ TEST(ScenarioReplay, ATraceCutShortIsAWarning) {
   EXPECT_NE(o.warnings[0].find("cut.csv: its last line has no line end"), std::string::npos)
       << o.warnings[0];
   EXPECT_EQ(o.status, RunOutcome::Status::kFailed) << "warnings_at_most(0) counts it";
+}
+
+TEST(ScenarioReplay, TimesInMillisecondsOrBeforeZeroAreNamed) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto shifted = [&](const std::string& name, double scale, double shift) {
+    rewrite_lines(recorded_peg_trace(dir), dir / name, [&](int row, const std::string& line) {
+      if (row == 0) return line;
+      const std::size_t comma = line.find(',');
+      char t[64];
+      std::snprintf(t, sizeof t, "%.17g", std::stod(line.substr(0, comma)) * scale + shift);
+      return t + line.substr(comma);
+    });
+    return dir / name;
+  };
+  // Times in half-milliseconds: too long without a duration, and the error says why.
+  RunOptions ms;
+  ms.trace = shifted("ms.csv", 2000, 0);
+  const RunOutcome too_long = run_scenario(kScenarios / "01_peg_in_hole.lua", ms);
+  ASSERT_EQ(too_long.status, RunOutcome::Status::kError);
+  EXPECT_NE(too_long.error.find("s a run may last; its samples are 22.22 s apart (the median)"),
+            std::string::npos)
+      << too_long.error;
+  EXPECT_NE(too_long.error.find("are its times in milliseconds?"), std::string::npos)
+      << too_long.error;
+  // Two seconds before 0: those samples are not used, and a warning says so.
+  RunOptions early;
+  early.trace = shifted("early.csv", 1, -2);
+  const RunOutcome o = run_scenario(kScenarios / "01_peg_in_hole.lua", early);
+  ASSERT_FALSE(o.warnings.empty()) << o.error;
+  EXPECT_NE(o.warnings[0].find("early.csv: the trace starts at t=-2.000 s; what it holds before "
+                               "t=0 is not used"),
+            std::string::npos)
+      << o.warnings[0];
 }
 
 TEST(ScenarioReplay, AScenarioWithoutAGloveGetsTheTracesHandWithoutAWarning) {
