@@ -294,6 +294,9 @@ class Runner {
     bool seen = false;
   };
   std::vector<Closest> closest_;
+  /// Per mate (by index): where its part was when the hand last let it go.
+  std::vector<Closest> released_;
+  std::set<std::string> carried_now_;  ///< the parts the hand carried in the last frame
   std::size_t refusals_seen_ = 0;      ///< of grasping_->refused_snaps(), written as warnings
   interaction::OverlapGauge overlap_;  ///< max_penetration's measure
   std::optional<engine::Camera> camera_;
@@ -838,9 +841,18 @@ std::string Runner::why_not_snapped(const MateSpec& m) const {
   std::snprintf(angle, sizeof angle, "%.3g degrees", std::round(c.offset.angle_deg * 1e6) / 1e6);
   char tolerance[64];
   std::snprintf(tolerance, sizeof tolerance, "%.3g degrees", m.mate.angle_tolerance_deg);
-  return ": the closest it came was " + format_length(c.offset.distance_m, out_) +
-         " from its place, its axis " + angle + " off, at t=" + format_time(c.time) +
-         " s (a snap needs the part released within " +
+  std::string at_release;
+  if (i < released_.size() && released_[i].seen) {
+    const Closest& r = released_[i];
+    char off[64];
+    std::snprintf(off, sizeof off, "%.3g degrees", std::round(r.offset.angle_deg * 1e6) / 1e6);
+    at_release = ": when the hand let it go at t=" + format_time(r.time) + " s it was " +
+                 format_length(r.offset.distance_m, out_) + " from its place, its axis " + off +
+                 " off;";
+  }
+  return at_release + (at_release.empty() ? ": the" : " the") + " closest it came was " +
+         format_length(c.offset.distance_m, out_) + " from its place, its axis " + angle +
+         " off, at t=" + format_time(c.time) + " s (a snap needs the part released within " +
          format_length(m.mate.position_tolerance, out_) + " and " + tolerance + ")" + never_held;
 }
 
@@ -875,13 +887,29 @@ void Runner::end_frame(const engine::FrameResult& result, double previous_time) 
   std::vector<Occurrence> happened = occurrences(result);
   measure_penetration(now);
   watch_mates(now);
-  // The parts the hand carried (the held one and its sub-assembly), for mate_made.
+  // Where the mates' parts were when the hand let them go (they were carried
+  // up to the last frame), and the parts the hand carries now (the held one
+  // and its sub-assembly), for mate_made.
+  const engine::Scene& scene = sim_->scene();
+  for (const Event& e : result.events) {
+    if (e.kind != EventKind::kRelease) continue;
+    released_.resize(scenario_.mates.size());
+    for (std::size_t i = 0; i < scenario_.mates.size(); ++i) {
+      const interaction::Mate& m = scenario_.mates[i].mate;
+      if (!carried_now_.count(m.part)) continue;
+      const PartId p = scene.find(m.part), o = scene.find(m.other);
+      if (!p.valid() || !o.valid()) continue;
+      released_[i] = {interaction::mate_offset(m, scene.world_pose(p), scene.world_pose(o)), now,
+                      true};
+    }
+  }
+  carried_now_.clear();
   if (grasping_ && grasping_->carried()) {
-    const engine::Scene& scene = sim_->scene();
     const PartId root = scene.find(*grasping_->carried());
     for (const PartId p : scene.parts()) {
-      if (root.valid() && scene.descends_from(p, root)) carried_ever_.insert(scene.name(p));
+      if (root.valid() && scene.descends_from(p, root)) carried_now_.insert(scene.name(p));
     }
+    carried_ever_.insert(carried_now_.begin(), carried_now_.end());
   }
   // Steps first: their completions are events the rules of this frame see.
   for (const std::size_t i : forced_steps_) complete_step(i, now, happened);

@@ -667,6 +667,32 @@ TEST(ScenarioRun, AMateInsideTheCarriedSubAssemblyNeitherGuidesNorSnapsIt) {
   }
 }
 
+TEST(ScenarioRun, MateMadeSaysWhereThePartWasWhenTheHandLetItGo) {
+  // The shaft's seat is on the base, 200 mm away: released far from it.
+  const test::TempDir dir("dovetail_scenario");
+  std::string text;
+  {
+    std::ifstream in(collar_on_shaft(
+        dir, "far.lua",
+        "far = mate { part = \"shaft\", point = { 0, 0, 0 }, axis = \"z\", into = \"base\", "
+        "at = { 0, 10, 0 }, along = \"-y\" }",
+        ""));
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const auto file = write(dir, "far.lua",
+                          std::regex_replace(text, std::regex("  hand = glove"),
+                                             "  expect = { mate_made \"far\" },\n  hand = glove"));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed) << o.error;
+  ASSERT_EQ(o.expectations.size(), 1u);
+  EXPECT_NE(o.expectations[0].detail.find("'shaft' never snapped into 'base': when the hand let "
+                                          "it go at t="),
+            std::string::npos)
+      << o.expectations[0].detail;
+  EXPECT_NE(o.expectations[0].detail.find(" off; the closest it came was "), std::string::npos)
+      << o.expectations[0].detail;
+}
+
 TEST(ScenarioRun, AHeldPartAttachedToAFixedPartIsLetGo) {
   // While carried, a rule attaches the shaft to the fixed base: the hand lets
   // the collar go ("attached"), and the pair stays where it was.
