@@ -377,8 +377,15 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
     }
   }
   constexpr Real kClosingSlack = 2;    // degrees of glove jitter tolerated while closing
+  constexpr int kOnsetMisses = 2;      // frames in a row without the grasp, tolerated
   constexpr Real kStillClosing = 0.5;  // degrees per frame: the hand is still closing
-  const bool closing = total_flexion >= last_flexion_ - kClosingSlack;
+  // Against the last frame for a grasp starting to build up; against where it
+  // started for one building up (the sum of 15 joints' noise swings by more
+  // than the slack from frame to frame, but does not open the hand).
+  const bool closing =
+      total_flexion >=
+      (candidate_.empty() || found_part != candidate_ ? last_flexion_ : candidate_start_flexion_) -
+          kClosingSlack;
   const bool still_closing = total_flexion > last_flexion_ + kStillClosing;
   if (found && closing && found_part == candidate_) {
     ++candidate_frames_;
@@ -389,10 +396,16 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
     candidate_frames_ = 1;
     candidate_start_flexion_ = last_flexion_;
     candidate_start_digits_ = last_digit_flexion_;
+  } else if (!found && closing && !candidate_.empty() && candidate_misses_ < kOnsetMisses) {
+    // A frame in which glove noise lifts a finger or the palm off the part
+    // interrupts the grasp building up, but does not start it again: a hand
+    // that has stopped closing could never start it again.
+    ++candidate_misses_;
   } else {
     candidate_.clear();
     candidate_frames_ = 0;
   }
+  if (found) candidate_misses_ = 0;
   last_flexion_ = total_flexion;
   last_digit_flexion_ = digit_flexion;
   // The grasp holds for onset_frames; its type is taken once the hand stops closing
@@ -400,7 +413,7 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   // And the hand must have closed while the grasp built up: an open or still hand
   // moved against a part (drawn back along a rod it just let go of) grasps nothing.
   constexpr Real kMinClosing = 1;  // degrees of total flexion
-  if (candidate_frames_ >= settings_.grasp.onset_frames &&
+  if (found && found_part == candidate_ && candidate_frames_ >= settings_.grasp.onset_frames &&
       total_flexion >= candidate_start_flexion_ + kMinClosing &&
       (!still_closing || candidate_frames_ >= 4 * settings_.grasp.onset_frames)) {
     hold(candidate_, candidate_type_);

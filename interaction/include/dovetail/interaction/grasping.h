@@ -248,6 +248,7 @@ class Grasping {
   std::string candidate_;   ///< part whose grasp is building up
   GraspType candidate_type_ = GraspType::kPrecision;
   int candidate_frames_ = 0;
+  int candidate_misses_ = 0;          ///< frames in a row the candidate's grasp was not found
   Real candidate_start_flexion_ = 0;  ///< total glove flexion the frame before the candidate
   /// Each digit's glove flexion the frame before the candidate.
   std::array<Real, kDigitCount> candidate_start_digits_{};
