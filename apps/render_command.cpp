@@ -100,15 +100,9 @@ engine::RenderScene scene_with_hand(const Args& args, const std::string& input,
   }
   engine::AssemblyOptions options;
   if (const std::optional<std::string> units = args.value("units")) {
-    if (*units == "mm") {
-      options.units = 0.001;
-    } else if (*units == "cm") {
-      options.units = 0.01;
-    } else if (*units == "m") {
-      options.units = 1;
-    } else {
-      throw UsageError("render: --units must be mm, cm or m, not '" + *units + "'");
-    }
+    const std::optional<double> metres = engine::metres_per_unit(*units);
+    if (!metres) throw UsageError("render: --units must be mm, cm or m, not '" + *units + "'");
+    options.units = *metres;
   }
   engine::AssemblyReport assembly;
   engine::Scene parts;

@@ -782,15 +782,11 @@ void Loader::read_scenario_fields(int table, const SourceLocation& where) {
   const Arg units = field(table, word, "units", where, "scenario");
   if (units.given) {
     scenario_.units = units.text;
-    if (units.text == "mm") {
-      scenario_.metres_per_unit = 0.001;
-    } else if (units.text == "cm") {
-      scenario_.metres_per_unit = 0.01;
-    } else if (units.text == "m") {
-      scenario_.metres_per_unit = 1;
-    } else {
+    const std::optional<double> metres = engine::metres_per_unit(units.text);
+    if (!metres) {
       fail(where, "scenario: units must be \"mm\", \"cm\" or \"m\", not \"" + units.text + "\"");
     }
+    scenario_.metres_per_unit = *metres;
   }
   if (const Arg a = field(table, word, "seed", where, "scenario"); a.given) {
     scenario_.seed = static_cast<std::uint64_t>(a.number);

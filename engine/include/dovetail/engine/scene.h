@@ -199,6 +199,14 @@ struct AssemblyOptions {
 /// file is in millimetres, when the units are not declared.
 inline constexpr double kMillimetreThreshold = 100.0;
 
+/// Metres per unit of a unit's name, "mm", "cm" or "m"; nullopt for any other.
+inline std::optional<double> metres_per_unit(std::string_view unit) {
+  if (unit == "mm") return 0.001;
+  if (unit == "cm") return 0.01;
+  if (unit == "m") return 1.0;
+  return std::nullopt;
+}
+
 /// What loading an assembly did and noticed.
 struct AssemblyReport {
   double units = 1;             ///< metres per file unit used
