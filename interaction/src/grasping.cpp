@@ -190,6 +190,19 @@ Transform Grasping::pose_in(const engine::Scene& scene, PartId root, PartId part
   return X_RP;
 }
 
+std::optional<std::pair<PartId, PartId>> Grasping::outward_mate(const engine::Scene& scene,
+                                                                const Mate& mate, PartId root) {
+  const PartId p = scene.find(mate.part), o = scene.find(mate.other);
+  if (!p.valid() || !o.valid() || !scene.descends_from(p, root) || scene.descends_from(o, root))
+    return std::nullopt;
+  return std::pair{p, o};
+}
+
+Transform Grasping::root_pose_for(const engine::Scene& scene, PartId root, PartId part,
+                                  const Transform& X_WP) {
+  return part == root ? X_WP : engine::compose(X_WP, pose_in(scene, root, part).inverse());
+}
+
 Transform Grasping::carried_pose(const engine::Scene& scene, PartId part,
                                  const Transform& X_WH) const {
   if (!carried_) return scene.world_pose(part);
@@ -581,13 +594,11 @@ Transform Grasping::guided(const engine::Scene& scene, PartId root, const Transf
   for (std::size_t m = 0; m < mates_.size(); ++m) {
     const Mate& mate = mates_[m];
     if (!mate.guide) continue;
-    // A mate of the carried part or of a part attached to it (the held part among
-    // them) into a part outside the sub-assembly: one inside it moves with it.
-    const PartId p = scene.find(mate.part), o = scene.find(mate.other);
-    if (!p.valid() || !o.valid() || !scene.descends_from(p, root) || scene.descends_from(o, root))
-      continue;
-    const Transform X_RP = pose_in(scene, root, p);
-    const Transform X_WP_target = p == root ? X_WR_target : engine::compose(X_WR_target, X_RP);
+    const auto parts = outward_mate(scene, mate, root);
+    if (!parts) continue;
+    const auto [p, o] = *parts;
+    const Transform X_WP_target =
+        p == root ? X_WR_target : engine::compose(X_WR_target, pose_in(scene, root, p));
     const Transform X_WO = scene.world_pose(o);
     const Vec3 q_W = X_WO.apply(mate.p_OF);
     const Vec3 b_W = (X_WO.R * mate.axis_O).normalized();
@@ -613,7 +624,7 @@ Transform Grasping::guided(const engine::Scene& scene, PartId root, const Transf
     const Vec3 p_new = X.apply(mate.p_PF);
     const Vec3 on_line = q_W + b_W * b_W.dot(p_new - q_W);
     X.t += on_line - p_new;
-    return p == root ? X : engine::compose(X, X_RP.inverse());
+    return root_pose_for(scene, root, p, X);
   }
   return X_WR_target;
 }
@@ -639,14 +650,12 @@ void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
   const PartId root = carried_root(scene, scene.get(part));
   if (!scene.movable(root)) return;
   for (const Mate& mate : mates_) {
-    const PartId p = scene.find(mate.part), o = scene.find(mate.other);
-    if (!p.valid() || !o.valid() || !scene.descends_from(p, root) || scene.descends_from(o, root))
-      continue;
+    const auto parts = outward_mate(scene, mate, root);
+    if (!parts) continue;
+    const auto [p, o] = *parts;
     const Transform X_WP = scene.world_pose(p), X_WO = scene.world_pose(o);
     if (!within_tolerance(mate, X_WP, X_WO)) continue;
-    const Transform X_seated = mate_pose(mate, X_WP, X_WO);
-    const Transform X_WR_seated =
-        p == root ? X_seated : engine::compose(X_seated, pose_in(scene, root, p).inverse());
+    const Transform X_WR_seated = root_pose_for(scene, root, p, mate_pose(mate, X_WP, X_WO));
     if (const Overlap overlap = deepest_overlap(scene, root, X_WR_seated);
         overlap.depth > kSnapOverlap) {
       refused_snaps_.push_back({mate.name, mate.part, overlap.blocker, overlap.overlapping,

@@ -204,6 +204,13 @@ class Grasping {
   /// `part`'s pose in the frame of `root`, which it descends from, from the
   /// chain of local poses (the same bits every frame).
   static Transform pose_in(const engine::Scene& scene, engine::PartId root, engine::PartId part);
+  /// A mate's part and other when its part is in `root`'s sub-assembly and its
+  /// other is outside it (a mate inside it moves with it); nullopt otherwise.
+  static std::optional<std::pair<engine::PartId, engine::PartId>> outward_mate(
+      const engine::Scene& scene, const Mate& mate, engine::PartId root);
+  /// The pose of `root` that puts `part`, which descends from it, at X_WP.
+  static Transform root_pose_for(const engine::Scene& scene, engine::PartId root,
+                                 engine::PartId part, const Transform& X_WP);
   /// Where the hand at X_WH puts `part`: the carried sub-assembly's parts by
   /// the grasp, the others where they are.
   Transform carried_pose(const engine::Scene& scene, engine::PartId part,
