@@ -67,6 +67,13 @@ double start_time(const interaction::GloveSource& source) {
   return trace ? trace->samples().front().t : 0;
 }
 
+/// A length in metres, in the scenario's units ("12.5 mm").
+std::string format_length(double metres, double metres_per_unit, const std::string& units) {
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "%.4g %s", metres / metres_per_unit, units.c_str());
+  return buffer;
+}
+
 /// Warnings about a glove that cannot be what was meant, each starting with
 /// `who`: a hand that goes far from every part (a plan written in
 /// millimetres reads as metres); joints far outside their ranges (another
@@ -79,10 +86,7 @@ std::vector<std::string> glove_warnings(const Scenario& scenario, const GloveSpe
                                         const std::filesystem::path& trace) {
   std::vector<std::string> out;
   const auto length = [&](double metres) {
-    char buffer[48];
-    std::snprintf(buffer, sizeof buffer, "%.4g %s", metres / scenario.metres_per_unit,
-                  scenario.units.c_str());
-    return std::string(buffer);
+    return format_length(metres, scenario.metres_per_unit, scenario.units);
   };
   const auto box_of = [&](const PartSpec& p) {
     Eigen::AlignedBox<double, 3> box;
@@ -122,12 +126,13 @@ std::vector<std::string> glove_warnings(const Scenario& scenario, const GloveSpe
       }
     }
   }
-  if (const double start = start_time(source); start < 0) {
+  const double start = start_time(source);
+  if (start < 0) {
     out.push_back(who + ": the trace starts at t=" + format_time(start) +
                   " s; what it holds before t=0 is not used (the run starts at 0)");
   }
   // Device clocks (seconds since 1970) instead of seconds from the start of the run.
-  if (const double start = start_time(source); start > 1) {
+  if (start > 1) {
     out.push_back(who + ": the trace starts at t=" + format_time(start) +
                   " s; until then the hand stays at its first sample (its times are seconds "
                   "from the start of the run: shift them to start at 0)");
@@ -146,9 +151,7 @@ std::vector<std::string> glove_warnings(const Scenario& scenario, const GloveSpe
 }
 
 std::string format_length(double metres, const RunOutcome& o) {
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "%.4g %s", metres / o.metres_per_unit, o.units.c_str());
-  return buffer;
+  return format_length(metres, o.metres_per_unit, o.units);
 }
 
 std::pair<std::string, std::string> ordered(const std::string& a, const std::string& b) {
@@ -836,19 +839,21 @@ std::string Runner::why_not_snapped(const MateSpec& m) const {
       held ? ""
            : "; the hand never held it, and a part snaps when the hand lets it go (or by a "
              "rule's snap)";
-  char angle[64];
   // Rounded to a millionth of a degree: turns given in degrees leave ~1e-15.
-  std::snprintf(angle, sizeof angle, "%.3g degrees", std::round(c.offset.angle_deg * 1e6) / 1e6);
+  const auto degrees = [](const interaction::MateOffset& offset) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.3g degrees", std::round(offset.angle_deg * 1e6) / 1e6);
+    return std::string(text);
+  };
+  const std::string angle = degrees(c.offset);
   char tolerance[64];
   std::snprintf(tolerance, sizeof tolerance, "%.3g degrees", m.mate.angle_tolerance_deg);
   std::string at_release;
   if (i < released_.size() && released_[i].seen) {
     const Closest& r = released_[i];
-    char off[64];
-    std::snprintf(off, sizeof off, "%.3g degrees", std::round(r.offset.angle_deg * 1e6) / 1e6);
     at_release = ": when the hand let it go at t=" + format_time(r.time) + " s it was " +
-                 format_length(r.offset.distance_m, out_) + " from its place, its axis " + off +
-                 " off;";
+                 format_length(r.offset.distance_m, out_) + " from its place, its axis " +
+                 degrees(r.offset) + " off;";
   }
   return at_release + (at_release.empty() ? ": the" : " the") + " closest it came was " +
          format_length(c.offset.distance_m, out_) + " from its place, its axis " + angle +
