@@ -142,26 +142,26 @@ std::vector<GloveSample> read_trace(std::istream& in, std::string_view name) {
   return samples;
 }
 
+std::optional<std::string> sparse_samples(std::span<const GloveSample> samples) {
+  // Gloves sample 30 to 200 times a second; under 10 is another time unit.
+  if (samples.size() < 3) return std::nullopt;
+  std::vector<Real> gaps;
+  for (std::size_t i = 1; i < samples.size(); ++i) gaps.push_back(samples[i].t - samples[i - 1].t);
+  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+  const Real median = gaps[gaps.size() / 2];
+  constexpr Real kSparse = 0.1;  // seconds
+  if (!(median > kSparse)) return std::nullopt;
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "its samples are %.4g s apart (the median), %.3g samples a second, where gloves "
+                "sample 30 to 200 times a second: are its times in milliseconds?",
+                median, 1 / median);
+  return std::string(text);
+}
+
 std::vector<std::string> trace_doubts(const fs::path& path, std::span<const GloveSample> samples) {
   std::vector<std::string> doubts;
-  // Gloves sample 30 to 200 times a second; under 10 is another time unit.
-  if (samples.size() >= 3) {
-    std::vector<Real> gaps;
-    for (std::size_t i = 1; i < samples.size(); ++i)
-      gaps.push_back(samples[i].t - samples[i - 1].t);
-    std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
-    const Real median = gaps[gaps.size() / 2];
-    constexpr Real kSparse = 0.1;  // seconds
-    if (median > kSparse) {
-      char text[200];
-      std::snprintf(
-          text, sizeof text,
-          "its samples are %.4g s apart (the median), %.3g samples a second, where gloves "
-          "sample 30 to 200 times a second: are its times in milliseconds?",
-          median, 1 / median);
-      doubts.emplace_back(text);
-    }
-  }
+  if (std::optional<std::string> sparse = sparse_samples(samples)) doubts.push_back(*sparse);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (in && in.tellg() > 0) {
     in.seekg(-1, std::ios::end);

@@ -189,8 +189,8 @@ std::shared_ptr<const interaction::GloveSource> glove_source(
     // What else is doubtful about a trace (times in milliseconds) is its likelier cause.
     std::string doubts;
     if (const auto* samples = dynamic_cast<const interaction::TraceSource*>(source.get())) {
-      for (const std::string& doubt : interaction::trace_doubts(file, samples->samples())) {
-        if (doubt.find("milliseconds") != std::string::npos) doubts = "; " + doubt;
+      if (const auto sparse = interaction::sparse_samples(samples->samples())) {
+        doubts = "; " + *sparse;
       }
     }
     throw ScenarioError((replay ? std::string() : glove.where.str() + ": glove: ") + file.string() +

@@ -29,6 +29,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <iosfwd>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -64,6 +65,8 @@ std::vector<GloveSample> read_trace(const std::filesystem::path& path);
 /// cut short while written, whose last value may be cut too). For warnings.
 std::vector<std::string> trace_doubts(const std::filesystem::path& path,
                                       std::span<const GloveSample> samples);
+/// trace_doubts' first: samples more than 0.1 s apart at the median.
+std::optional<std::string> sparse_samples(std::span<const GloveSample> samples);
 
 /// The header row and one row per sample, each ending in '\n'. The samples
 /// are not checked: ones that read_trace refuses (none, non-finite values, a
