@@ -612,8 +612,15 @@ void Runner::apply(const Clause& action, double now) {
     scene.set_parent(scene.get(a), PartId{}, true);
   } else if (w == "snap") {
     const interaction::Mate& m = mate(a)->mate;
-    scene.set_world_pose(scene.get(m.part), interaction::mate_pose(m, scene.world_pose(m.part),
-                                                                   scene.world_pose(m.other)));
+    const Transform X_WP = scene.world_pose(m.part), X_WO = scene.world_pose(m.other);
+    // A part in place already (seated by the hand or an earlier snap) stays,
+    // and `mated` does not fire twice for one fit.
+    constexpr double kInPlace_m = 1e-9, kInPlace_deg = 1e-6;
+    if (const interaction::MateOffset offset = interaction::mate_offset(m, X_WP, X_WO);
+        offset.distance_m <= kInPlace_m && offset.angle_deg <= kInPlace_deg) {
+      return;
+    }
+    scene.set_world_pose(scene.get(m.part), interaction::mate_pose(m, X_WP, X_WO));
     injected_.push_back({EventKind::kMate, sim_->frame(), now, m.part, m.other});
   } else if (w == "complete") {
     for (std::size_t i = 0; i < scenario_.steps.size(); ++i) {

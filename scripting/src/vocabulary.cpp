@@ -315,7 +315,8 @@ std::vector<Word> make_vocabulary() {
   w.push_back({"snap",
                WordKind::kAction,
                {{"mate", kMate, kRequired, "the mate"}},
-               "Puts the mate's part in place at once, wherever it is, and fires `mated`.",
+               "Puts the mate's part in place at once, wherever it is, and fires `mated`; a part "
+               "in place already stays, and fires nothing.",
                "snap \"peg_in_hole\""});
   w.push_back({"log",
                WordKind::kAction,

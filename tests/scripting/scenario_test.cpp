@@ -312,6 +312,21 @@ TEST(ScenarioRun, RulesStepsAndExpectationsOfAMovedPeg) {
   EXPECT_EQ(o.messages[0].where.line, 18);
 }
 
+TEST(ScenarioRun, ASnapOfAPartInPlaceAlreadyFiresNoSecondMated) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file =
+      write(dir, "twice.lua",
+            moved_peg("    rule { when = after(0.2), act = { snap \"peg_in_hole\" } },\n"
+                      "    rule { when = after(0.3), act = { snap \"peg_in_hole\" } },\n"
+                      "    rule { when = mated \"peg_in_hole\", act = { log \"seated\" } },",
+                      "    mate_made \"peg_in_hole\","));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary();
+  const auto seated = std::count_if(o.messages.begin(), o.messages.end(),
+                                    [](const auto& m) { return m.text == "seated"; });
+  EXPECT_EQ(seated, 1);
+}
+
 TEST(ScenarioRun, AStepOutOfOrderFailsNamingTheStepsAndTimes) {
   const test::TempDir dir("dovetail_scenario");
   const auto file =
