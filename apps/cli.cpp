@@ -42,14 +42,18 @@ Args::Args(std::string command, std::span<const std::string> argv,
       help_ = true;
       continue;
     }
-    // One-letter options the command declares may be written -j as well as --j.
+    // One-letter options the command declares may be written -j as well as
+    // --j, and one that takes a value with the value joined on: -j2, as make's.
     const bool short_option =
         arg.size() == 2 && arg[1] != '-' &&
         (value_options.count(arg.substr(1)) != 0 || flags.count(arg.substr(1)) != 0);
-    if (arg.rfind("--", 0) != 0 && !short_option) {
+    const bool short_joined = arg.size() > 2 && arg[1] != '-' &&
+                              value_options.count(arg.substr(1, 1)) != 0 && arg[2] != '=';
+    if (arg.rfind("--", 0) != 0 && !short_option && !short_joined) {
       throw UsageError(command_ + ": unknown option '" + arg + "'" + see_help(command_));
     }
-    std::string name = arg.substr(short_option ? 1 : 2);
+    std::string name =
+        short_joined ? arg.substr(1, 1) + "=" + arg.substr(2) : arg.substr(short_option ? 1 : 2);
     // The option as a message names it: -j for one letter, --name otherwise.
     const auto spelled = [](const std::string& n) { return (n.size() == 1 ? "-" : "--") + n; };
     std::optional<std::string> inline_value;

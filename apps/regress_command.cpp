@@ -23,6 +23,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -151,6 +152,41 @@ void remove_old_outputs(const Job& job, const std::filesystem::path& out) {
   std::error_code ec;
   std::filesystem::remove(out / (job.stem + ".json"), ec);
   std::filesystem::remove(out / job.stem / "final.png", ec);
+}
+
+/// Removes what an earlier regress left in `out` of scenarios no longer in
+/// the folder (deleted or renamed since), so that OUT, kept as a CI
+/// artifact, holds only the outputs of the scenarios there; returns their
+/// names. OUT may hold other files: only a Dovetail report beside its log
+/// counts, and of its frames folder only the final frame.
+std::vector<std::string> remove_stale_outputs(const std::filesystem::path& out,
+                                              const std::vector<std::filesystem::path>& files) {
+  std::set<std::string> stems;
+  for (const std::filesystem::path& f : files) stems.insert(f.stem().string());
+  std::vector<std::string> removed;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(out, ec)) {
+    const std::filesystem::path& report = entry.path();
+    const std::string stem = report.stem().string();
+    if (report.extension() != ".json" || stems.count(stem) != 0 ||
+        !std::filesystem::is_regular_file(out / (stem + ".log"), ec)) {
+      continue;
+    }
+    std::string head(256, '\0');
+    std::ifstream in(report, std::ios::binary);
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    if (head.find("\"format\": \"dovetail-scenario-report\"") == std::string::npos) continue;
+    removed.push_back(stem);
+  }
+  std::sort(removed.begin(), removed.end());
+  for (const std::string& stem : removed) {
+    std::filesystem::remove(out / (stem + ".json"), ec);
+    std::filesystem::remove(out / (stem + ".log"), ec);
+    std::filesystem::remove(out / stem / "final.png", ec);
+    std::filesystem::remove(out / stem, ec);  // only if nothing else is in it
+  }
+  return removed;
 }
 
 /// Starts the run of `job` with its standard error in OUT/STEM.log; false,
@@ -706,6 +742,16 @@ int regress_command(std::span<const std::string> argv) {
   }
   for (const std::optional<std::string>& summary : {junit, html}) {
     if (summary && inside(out, *summary)) check_writable(*summary);
+  }
+  if (const std::vector<std::string> stale = remove_stale_outputs(out, scenario_files(folder));
+      !stale.empty()) {
+    std::string names;
+    for (const std::string& stem : stale) names += (names.empty() ? "" : ", ") + stem;
+    std::fprintf(stderr,
+                 "dovetail: note: regress: removed from %s the outputs of %zu scenario%s no "
+                 "longer in %s: %s\n",
+                 out.string().c_str(), stale.size(), stale.size() == 1 ? "" : "s",
+                 folder.string().c_str(), names.c_str());
   }
 
   const auto begin = std::chrono::steady_clock::now();

@@ -154,6 +154,9 @@ std::string format_length(double metres, const RunOutcome& o) {
   return format_length(metres, o.metres_per_unit, o.units);
 }
 
+/// The same pose, to the bit.
+bool same(const Transform& x, const Transform& y) { return x.R == y.R && x.t == y.t; }
+
 std::pair<std::string, std::string> ordered(const std::string& a, const std::string& b) {
   return a < b ? std::pair(a, b) : std::pair(b, a);
 }
@@ -282,6 +285,8 @@ class Runner {
   std::set<std::string> carried_ever_;                     ///< every part the hand has carried
   std::vector<std::size_t> forced_steps_;                  ///< `complete` actions this frame
   std::vector<Event> injected_;                            ///< `snap` mate events this frame
+  /// Per mate: the poses of its part and other part when it last fired `mated`.
+  std::map<std::string, std::pair<Transform, Transform>> seated_;
   struct Motion {
     std::string part;
     Vec3 from, to;
@@ -613,11 +618,11 @@ void Runner::apply(const Clause& action, double now) {
   } else if (w == "snap") {
     const interaction::Mate& m = mate(a)->mate;
     const Transform X_WP = scene.world_pose(m.part), X_WO = scene.world_pose(m.other);
-    // A part in place already (seated by the hand or an earlier snap) stays,
-    // and `mated` does not fire twice for one fit.
-    constexpr double kInPlace_m = 1e-9, kInPlace_deg = 1e-6;
-    if (const interaction::MateOffset offset = interaction::mate_offset(m, X_WP, X_WO);
-        offset.distance_m <= kInPlace_m && offset.angle_deg <= kInPlace_deg) {
+    // A fit made already, neither part moved since, stays as it is: `mated`
+    // fires once for it.
+    if (const auto seated = seated_.find(m.name); seated != seated_.end() &&
+                                                  same(seated->second.first, X_WP) &&
+                                                  same(seated->second.second, X_WO)) {
       return;
     }
     scene.set_world_pose(scene.get(m.part), interaction::mate_pose(m, X_WP, X_WO));
@@ -665,6 +670,7 @@ bool Runner::holds(const Clause& state) const {
 }
 
 std::vector<Occurrence> Runner::occurrences(const engine::FrameResult& result) {
+  const engine::Scene& scene = sim_->scene();
   std::vector<Occurrence> out;
   // Moves ended at the start of this frame: the parts are where they were sent.
   for (std::string& part : arrived_) out.push_back({Happening::kArrive, std::move(part), ""});
@@ -709,8 +715,10 @@ std::vector<Occurrence> Runner::occurrences(const engine::FrameResult& result) {
         break;
       case EventKind::kMate:
         for (const MateSpec& m : scenario_.mates) {
-          if (m.mate.part == e.a && m.mate.other == e.b)
+          if (m.mate.part == e.a && m.mate.other == e.b) {
             out.push_back({Happening::kMated, m.mate.name, ""});
+            seated_[m.mate.name] = {scene.world_pose(e.a), scene.world_pose(e.b)};
+          }
         }
         break;
       case EventKind::kRegionEnter:

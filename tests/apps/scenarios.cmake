@@ -270,6 +270,9 @@ add_test(NAME cli.regress_interrupted
          COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/regress_interrupt.sh $<TARGET_FILE:dovetail>
                  ${out}/regress_interrupted)
 set_tests_properties(cli.regress_interrupted PROPERTIES TIMEOUT 300)
+add_test(NAME cli.regress_stale_outputs
+         COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/regress_stale.sh $<TARGET_FILE:dovetail>
+                 ${scenarios} ${out}/regress_stale)
 
 dovetail_cli_test(regress_bad_jobs EXIT 2 ARGS regress ${scenarios} -j 0 STDERR "regress: -j must be an integer from 1 to 256")
 file(MAKE_DIRECTORY ${out}/regress_empty_folder)
@@ -337,3 +340,10 @@ dovetail_cli_test(capture_bad_files_and_a_good_one EXIT 1
                   ARGS capture ${out}/no_such.capture ${data} ${data}/captures/touching-hulls.capture
                   STDERR "no_such.capture: cannot be opened&&/data: is a folder"
                   STDOUT "touching-hulls.capture: iteration-cap not reproduced")
+# A one-letter option's value may be joined on, as make's -j2.
+dovetail_cli_test(regress_short_option_joined EXIT 2 ARGS regress ${scenarios} -j0
+                  STDERR "regress: -j must be an integer from 1 to 256")
+dovetail_cli_test(regress_short_option_joined_twice EXIT 2 ARGS regress ${scenarios} -j2 -j 3
+                  STDERR "regress: option '-j' given twice")
+dovetail_cli_test(regress_short_option_unknown EXIT 2 ARGS regress ${scenarios} -x2
+                  STDERR "regress: unknown option '-x2'")
