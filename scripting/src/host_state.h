@@ -26,6 +26,15 @@ namespace dovetail::scripting {
 /// VM instructions between two calls of the count hook.
 inline constexpr int kHookInterval = 1000;
 
+/// Library work the count hook does not see, counted in instructions so
+/// that it meets the same budget, the same way on every machine: one per
+/// kBytesPerInstruction bytes the script's memory grows by (a `..` or a
+/// string.rep copies its result in one instruction), one per
+/// kComparesPerInstruction characters a string search may compare, one per
+/// element a table function moves or visits.
+inline constexpr std::uint64_t kBytesPerInstruction = 64;
+inline constexpr std::uint64_t kComparesPerInstruction = 4;
+
 struct HostState {
   SandboxLimits limits;
   std::uint64_t seed = 0;
@@ -79,7 +88,16 @@ struct HostState {
   lua_CFunction string_match = nullptr;
   lua_CFunction string_gmatch = nullptr;
   lua_CFunction string_gsub = nullptr;
+  lua_CFunction string_byte = nullptr;
+  lua_CFunction utf8_len = nullptr;
+  lua_CFunction utf8_codepoint = nullptr;
+  lua_CFunction utf8_offset = nullptr;
+  lua_CFunction base_tonumber = nullptr;
   lua_CFunction table_move = nullptr;
+  lua_CFunction table_insert = nullptr;
+  lua_CFunction table_remove = nullptr;
+  lua_CFunction table_concat = nullptr;
+  lua_CFunction table_unpack = nullptr;
   lua_CFunction coroutine_close = nullptr;
 
   bool active() const { return depth > 0; }
@@ -107,6 +125,12 @@ void note_memory_error(HostState& host, lua_State* L = nullptr);
 /// exhausted limit, placed where the count hook last saw the script, else at
 /// the Lua caller of the C function running in `L` (when given).
 bool limit_exhausted(HostState& host, lua_State* L = nullptr);
+
+/// Counts `units` instructions of work a library function (the C function
+/// running in `L`) does, before it does it, and raises the budget's error,
+/// placed at its Lua caller and naming `what` ("string.find: ..."), when
+/// that passes the call's budget. Outside a host call it counts nothing.
+void charge(lua_State* L, std::uint64_t units, const char* what);
 
 /// Raises the wall-clock limit, placed at the Lua caller of the C function
 /// running in `L`, when a host call has passed its deadline (or another

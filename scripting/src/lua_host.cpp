@@ -35,6 +35,8 @@ bool has_line(const char* where) {
   return digits > 0 && n > 0 && where[n - 1] == ':';
 }
 
+void count_hook(lua_State* L, lua_Debug* ar);
+
 // The allocator of the state: counts every byte and, while a host call runs,
 // refuses growth beyond the cap (Lua then collects garbage and retries once,
 // and raises a memory error if that does not help).
@@ -75,7 +77,23 @@ void* allocate(void* data, void* block, std::size_t old_size, std::size_t new_si
     return nullptr;
   }
   host.bytes = host.bytes - held + new_size;
-  if (grows) host.refusal_pending = false;
+  if (grows) {
+    host.refusal_pending = false;
+    // Copying into new memory is work no instruction shows; the count
+    // hook raises the budget's error at its next look.
+    if (host.active()) {
+      const std::uint64_t work = (new_size - held) / kBytesPerInstruction;
+      host.instructions_in_call += work;
+      host.instructions_total += work;
+      // Past the budget: the hook looks at the next instruction rather than
+      // up to kHookInterval copies later (lua_sethook may be called from
+      // anywhere, the allocator too).
+      if (host.instructions_in_call > host.limits.instructions_per_call) {
+        lua_State* const at = host.running != nullptr ? host.running : host.L;
+        if (at != nullptr) lua_sethook(at, count_hook, LUA_MASKCOUNT, 1);
+      }
+    }
+  }
   return moved;
 }
 
@@ -91,7 +109,11 @@ void exhaust_time(HostState& host, const char* where) {
 // hook from the thread that creates them, so they are counted too.
 void count_hook(lua_State* L, lua_Debug* ar) {
   HostState& host = host_of(L);
-  host.instructions_total += kHookInterval;
+  // The allocator may have made the hook look sooner; it looks every
+  // kHookInterval instructions again from here.
+  const int interval = lua_gethookcount(L);
+  if (interval != kHookInterval) lua_sethook(L, count_hook, LUA_MASKCOUNT, kHookInterval);
+  host.instructions_total += static_cast<std::uint64_t>(interval);
   if (!host.active()) return;
   if (lua_getinfo(L, "Sl", ar) != 0) {
     if (ar->currentline > 0) {
@@ -101,7 +123,7 @@ void count_hook(lua_State* L, lua_Debug* ar) {
     }
   }
   if (!limit_exhausted(host)) {
-    host.instructions_in_call += kHookInterval;
+    host.instructions_in_call += static_cast<std::uint64_t>(interval);
     if (host.instructions_in_call > host.limits.instructions_per_call) {
       set_exhausted(host, ScriptError::Kind::kBudget, host.where,
                     "instruction budget of %llu exceeded",
@@ -332,6 +354,25 @@ bool limit_exhausted(HostState& host, lua_State* L) {
                   "memory limit of %zu bytes exceeded", host.limits.memory_bytes);
   }
   return host.exhausted.has_value();
+}
+
+void charge(lua_State* L, std::uint64_t units, const char* what) {
+  HostState& host = host_of(L);
+  if (!host.active()) return;
+  const std::uint64_t budget = host.limits.instructions_per_call;
+  host.instructions_total += units;
+  // Saturated one past the budget: `units` may be a bound near 2^64.
+  host.instructions_in_call = units > budget || host.instructions_in_call > budget - units
+                                  ? budget + 1
+                                  : host.instructions_in_call + units;
+  if (!limit_exhausted(host, L) && host.instructions_in_call > budget) {
+    char here[sizeof(host.where)];
+    write_where(L, 1, here, sizeof(here));
+    set_exhausted(host, ScriptError::Kind::kBudget, here,
+                  "instruction budget of %llu exceeded (%s)",
+                  static_cast<unsigned long long>(budget), what);
+  }
+  if (host.exhausted) raise_exhausted(L);
 }
 
 void check_deadline(lua_State* L) {

@@ -7,8 +7,10 @@
 // noexcept helper that catches and reports failure instead.
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 
@@ -189,6 +191,12 @@ void push_sorted_iterator(lua_State* L, int index) {
     lua_pop(L, 1);
   }
   if (count > std::numeric_limits<int>::max()) luaL_error(L, "pairs: table too large");
+  // Sorting the keys: about count * log2(count) comparisons, each call.
+  const auto n = static_cast<std::uint64_t>(count);
+  char what[96];
+  std::snprintf(what, sizeof(what), "pairs: sorting the %llu keys of a table",
+                static_cast<unsigned long long>(n));
+  charge(L, n * (1 + static_cast<std::uint64_t>(std::bit_width(n))), what);
   lua_createtable(L, static_cast<int>(count), 0);  // keys in traversal order
   const int in_traversal_order = lua_gettop(L);
   auto* keys = static_cast<SortKey*>(
@@ -443,6 +451,28 @@ PatternCost pattern_cost(const char* pattern, std::size_t length) {
   return counted;
 }
 
+/// Counts a search's comparisons, (n + 1) starts of up to m characters each
+/// for a subject of n characters and a pattern (or plain text) of m: a
+/// search with no repetition is bounded by them, and however long its
+/// text, it meets the instruction budget before it runs.
+void charge_search(lua_State* L, const char* name) {
+  std::size_t n = 0;
+  std::size_t m = 0;
+  luaL_checklstring(L, 1, &n);
+  luaL_checklstring(L, 2, &m);
+  const auto compares =
+      static_cast<double>(n + 1) * static_cast<double>(std::max<std::size_t>(m, 1));
+  char what[160];
+  std::snprintf(what, sizeof(what),
+                "string.%s: a search of %zu characters for a pattern of %zu may compare %.3g "
+                "characters",
+                name, n, m, compares);
+  charge(L,
+         compares >= 1e19 ? std::numeric_limits<std::uint64_t>::max()
+                          : static_cast<std::uint64_t>(compares) / kComparesPerInstruction,
+         what);
+}
+
 /// Raises the refusal when `pattern` (argument 2) on the subject (argument 1)
 /// could search for very long.
 void check_pattern(lua_State* L, const char* name) {
@@ -473,10 +503,12 @@ int timed_search(lua_State* L, lua_CFunction search) {
 }
 int sandbox_string_find(lua_State* L) {
   if (!lua_toboolean(L, 4)) check_pattern(L, "find");  // a plain search has no pattern
+  charge_search(L, "find");
   return timed_search(L, host_of(L).string_find);
 }
 int sandbox_string_match(lua_State* L) {
   check_pattern(L, "match");
+  charge_search(L, "match");
   return timed_search(L, host_of(L).string_match);
 }
 // One step of a gmatch iterator: the library's (upvalue 1), then the
@@ -490,6 +522,7 @@ int gmatch_step(lua_State* L) {
 }
 int sandbox_string_gmatch(lua_State* L) {
   check_pattern(L, "gmatch");
+  charge_search(L, "gmatch");  // for all its steps together
   const int results = host_of(L).string_gmatch(L);
   if (results != 1 || !lua_isfunction(L, -1)) return results;
   lua_pushcclosure(L, gmatch_step, 1);
@@ -497,7 +530,41 @@ int sandbox_string_gmatch(lua_State* L) {
 }
 int sandbox_string_gsub(lua_State* L) {
   check_pattern(L, "gsub");
+  charge_search(L, "gsub");
   return timed_search(L, host_of(L).string_gsub);
+}
+
+// ---- functions that read a whole string: one instruction per
+// kComparesPerInstruction characters
+
+/// Charges `name` for reading all of the string at argument 1.
+void charge_string(lua_State* L, const char* name) {
+  if (lua_type(L, 1) != LUA_TSTRING) return;  // a number reads short; the library reports the rest
+  std::size_t n = 0;
+  lua_tolstring(L, 1, &n);
+  char what[96];
+  std::snprintf(what, sizeof(what), "%s on a string of %zu characters", name, n);
+  charge(L, n / kComparesPerInstruction, what);
+}
+int sandbox_string_byte(lua_State* L) {
+  if (lua_gettop(L) >= 3) charge_string(L, "string.byte");  // a range of values
+  return host_of(L).string_byte(L);
+}
+int sandbox_utf8_len(lua_State* L) {
+  charge_string(L, "utf8.len");
+  return host_of(L).utf8_len(L);
+}
+int sandbox_utf8_codepoint(lua_State* L) {
+  if (lua_gettop(L) >= 3) charge_string(L, "utf8.codepoint");
+  return host_of(L).utf8_codepoint(L);
+}
+int sandbox_utf8_offset(lua_State* L) {
+  charge_string(L, "utf8.offset");
+  return host_of(L).utf8_offset(L);
+}
+int sandbox_tonumber(lua_State* L) {
+  charge_string(L, "tonumber");
+  return host_of(L).base_tonumber(L);
 }
 
 // Names objects by serial number in '%s' and refuses '%p': both would
@@ -528,27 +595,56 @@ int sandbox_string_format(lua_State* L) {
   return host_of(L).string_format(L);
 }
 
-// ---- table.move: each element moved counts as one instruction
+// ---- table functions: each element moved or visited counts as one instruction
 
 int sandbox_table_move(lua_State* L) {
   const lua_Integer first = luaL_checkinteger(L, 2);
   const lua_Integer last = luaL_checkinteger(L, 3);
-  HostState& host = host_of(L);
-  if (last >= first && host.active()) {
+  if (last >= first) {
     const lua_Unsigned span = static_cast<lua_Unsigned>(last) - static_cast<lua_Unsigned>(first);
-    const std::uint64_t budget = host.limits.instructions_per_call;
-    const std::uint64_t used = host.instructions_in_call;
-    if (span >= budget || used > budget - span - 1) {
-      char where[LUA_IDSIZE + 24];
-      write_where(L, 1, where, sizeof(where));
-      set_exhausted(host, ScriptError::Kind::kBudget, where, "instruction budget of %llu exceeded",
-                    static_cast<unsigned long long>(budget));
-      return raise_exhausted(L);
-    }
-    host.instructions_in_call += span + 1;
-    host.instructions_total += span + 1;
+    char what[80];
+    std::snprintf(what, sizeof(what), "table.move: %llu elements",
+                  static_cast<unsigned long long>(span) + 1);
+    charge(L, span == std::numeric_limits<lua_Unsigned>::max() ? span : span + 1, what);
   }
-  return host.table_move(L);
+  return host_of(L).table_move(L);
+}
+
+/// Charges `name` on the table at argument 1 for every element of it: what
+/// insert and remove at a position shift, concat joins and unpack pushes is
+/// at most that.
+void charge_table(lua_State* L, const char* name) {
+  if (lua_type(L, 1) != LUA_TTABLE) return;  // the library reports it
+  const lua_Unsigned length = lua_rawlen(L, 1);
+  char what[80];
+  std::snprintf(what, sizeof(what), "table.%s on a table of %llu elements", name,
+                static_cast<unsigned long long>(length));
+  charge(L, length, what);
+}
+int sandbox_table_insert(lua_State* L) {
+  if (lua_gettop(L) >= 3) charge_table(L, "insert");  // at a position: shifts the rest
+  return host_of(L).table_insert(L);
+}
+int sandbox_table_remove(lua_State* L) {
+  if (lua_gettop(L) >= 2) charge_table(L, "remove");
+  return host_of(L).table_remove(L);
+}
+int sandbox_table_concat(lua_State* L) {
+  charge_table(L, "concat");
+  return host_of(L).table_concat(L);
+}
+int sandbox_table_unpack(lua_State* L) {
+  // Explicit bounds may reach past the table: the values pushed count.
+  if (lua_gettop(L) >= 3 && lua_isinteger(L, 2) && lua_isinteger(L, 3)) {
+    const lua_Integer first = lua_tointeger(L, 2), last = lua_tointeger(L, 3);
+    if (last >= first) {
+      const lua_Unsigned span = static_cast<lua_Unsigned>(last) - static_cast<lua_Unsigned>(first);
+      charge(L, span, "table.unpack");
+    }
+  } else {
+    charge_table(L, "unpack");
+  }
+  return host_of(L).table_unpack(L);
 }
 
 // ---- math.random and math.randomseed: the host's generator
@@ -831,7 +927,16 @@ int open_sandbox(lua_State* L) {
   host.string_match = library_function(L, string, "match");
   host.string_gmatch = library_function(L, string, "gmatch");
   host.string_gsub = library_function(L, string, "gsub");
+  host.string_byte = library_function(L, string, "byte");
+  host.utf8_len = library_function(L, utf8, "len");
+  host.utf8_codepoint = library_function(L, utf8, "codepoint");
+  host.utf8_offset = library_function(L, utf8, "offset");
+  host.base_tonumber = library_function(L, base, "tonumber");
   host.table_move = library_function(L, table, "move");
+  host.table_insert = library_function(L, table, "insert");
+  host.table_remove = library_function(L, table, "remove");
+  host.table_concat = library_function(L, table, "concat");
+  host.table_unpack = library_function(L, table, "unpack");
   host.coroutine_close = library_function(L, coroutine, "close");
 
   lua_newtable(L);  // tostring's serial numbers, weak so objects still die
@@ -843,8 +948,8 @@ int open_sandbox(lua_State* L) {
 
   lua_createtable(L, 0, 32);
   const int env = lua_gettop(L);
-  for (const char* name : {"assert", "error", "ipairs", "select", "tonumber", "type", "rawequal",
-                           "rawget", "rawlen", "getmetatable", "_VERSION"}) {
+  for (const char* name : {"assert", "error", "ipairs", "select", "type", "rawequal", "rawget",
+                           "rawlen", "getmetatable", "_VERSION"}) {
     lua_getfield(L, base, name);
     lua_setfield(L, env, name);
   }
@@ -856,6 +961,7 @@ int open_sandbox(lua_State* L) {
                                    {"load", sandbox_load},
                                    {"setmetatable", sandbox_setmetatable},
                                    {"rawset", sandbox_rawset},
+                                   {"tonumber", sandbox_tonumber},
                                    {nullptr, nullptr}};
   luaL_setfuncs(L, kBase, 0);
   lua_pushvalue(L, env);
@@ -865,13 +971,11 @@ int open_sandbox(lua_State* L) {
   // copy itself: the string metatable is protected, so scripts cannot reach
   // it to change it.
   push_copy(L, string, "dump");
-  static const luaL_Reg kString[] = {{"rep", sandbox_string_rep},
-                                     {"format", sandbox_string_format},
-                                     {"find", sandbox_string_find},
-                                     {"match", sandbox_string_match},
-                                     {"gmatch", sandbox_string_gmatch},
-                                     {"gsub", sandbox_string_gsub},
-                                     {nullptr, nullptr}};
+  static const luaL_Reg kString[] = {
+      {"rep", sandbox_string_rep},       {"format", sandbox_string_format},
+      {"find", sandbox_string_find},     {"match", sandbox_string_match},
+      {"gmatch", sandbox_string_gmatch}, {"gsub", sandbox_string_gsub},
+      {"byte", sandbox_string_byte},     {nullptr, nullptr}};
   luaL_setfuncs(L, kString, 0);
   lua_pushliteral(L, "");
   lua_getmetatable(L, -1);
@@ -884,7 +988,7 @@ int open_sandbox(lua_State* L) {
   lua_setfield(L, env, "string");
   lua_pop(L, 1);
 
-  // table: the stable sort, the counted move.
+  // table: the stable sort; move, insert, remove, concat and unpack counted.
   push_copy(L, table);
   if (luaL_loadbufferx(L, kSortSource, std::strlen(kSortSource), "=[table.sort]", "t") != LUA_OK) {
     return lua_error(L);
@@ -895,8 +999,11 @@ int open_sandbox(lua_State* L) {
   lua_getfield(L, base, "error");
   lua_call(L, 2, 1);
   lua_setfield(L, -2, "sort");
-  lua_pushcfunction(L, sandbox_table_move);
-  lua_setfield(L, -2, "move");
+  static const luaL_Reg kTable[] = {
+      {"move", sandbox_table_move},     {"insert", sandbox_table_insert},
+      {"remove", sandbox_table_remove}, {"concat", sandbox_table_concat},
+      {"unpack", sandbox_table_unpack}, {nullptr, nullptr}};
+  luaL_setfuncs(L, kTable, 0);
   push_read_only(L, -1, "table");
   lua_setfield(L, env, "table");
   lua_pop(L, 1);
@@ -910,6 +1017,11 @@ int open_sandbox(lua_State* L) {
   lua_pop(L, 1);
 
   push_copy(L, utf8);
+  static const luaL_Reg kUtf8[] = {{"len", sandbox_utf8_len},
+                                   {"codepoint", sandbox_utf8_codepoint},
+                                   {"offset", sandbox_utf8_offset},
+                                   {nullptr, nullptr}};
+  luaL_setfuncs(L, kUtf8, 0);
   push_read_only(L, -1, "utf8");
   lua_setfield(L, env, "utf8");
   lua_pop(L, 1);

@@ -233,6 +233,70 @@ TEST(LuaHostBudget, InfiniteLoopEndsWithBudgetError) {
   expect_works(host);
 }
 
+// Library work the count hook does not see meets the budget too, the same
+// way on every machine: with no wall-clock guard to speak of (1000 s), each
+// of these stops on the budget, at its own line, naming what spent it.
+TEST(LuaHostBudget, LibraryWorkCountsAgainstTheBudget) {
+  SandboxLimits limits = small_limits();
+  limits.wall_seconds_per_call = 1000;
+  struct Case {
+    const char* script;
+    const char* names;
+  };
+  const Case cases[] = {
+      // One search comparing 10^10 characters: refused before it runs.
+      {"local s = ('a'):rep(1 << 20)\nreturn s:find(('a'):rep(10000) .. 'b', 1, true)",
+       "script.lua:2: instruction budget of 1000000 exceeded (string.find: a search of 1048576 "
+       "characters for a pattern of 10001 may compare 1.05e+10 characters)"},
+      {"local s = ('a'):rep(1 << 20)\nreturn s:gsub(('a'):rep(10000) .. 'b', '')",
+       "(string.gsub: a search of 1048576"},
+      // Sorting 100,000 keys for every pairs: a few calls spend the budget.
+      {"local t = {}\nfor i = 1, 100000 do t['k' .. i] = i end\n"
+       "for _ = 1, 100 do for k in pairs(t) do break end end",
+       "script.lua:3: instruction budget of 1000000 exceeded (pairs: sorting the 100000 keys"},
+      // Each insert at the front shifts the whole table.
+      {"local t = {}\nfor i = 1, 100000 do t[i] = i end\n"
+       "for i = 1, 1000 do table.insert(t, 1, i) end",
+       "script.lua:3: instruction budget of 1000000 exceeded (table.insert on a table of"},
+      {"local t = {}\nfor i = 1, 100000 do t[i] = i end\n"
+       "for i = 1, 1000 do table.remove(t, 1) end",
+       "(table.remove on a table of"},
+      {"local t = {}\nfor i = 1, 100000 do t[i] = 'x' end\n"
+       "for i = 1, 1000 do local s = table.concat(t) end",
+       "(table.concat on a table of 100000 elements)"},
+      {"local t = {}\nfor i = 1, 100000 do t[i] = i end\n"
+       "for i = 1, 1000 do local a = select('#', table.unpack(t)) end",
+       "(table.unpack on a table of 100000 elements)"},
+      {"local s = ('7'):rep(1 << 20)\nfor i = 1, 1000 do local x = tonumber(s) end",
+       "(tonumber on a string of 1048576 characters)"},
+      {"local s = ('x'):rep(1 << 20)\nfor i = 1, 1000 do local n = utf8.len(s) end",
+       "(utf8.len on a string of 1048576 characters)"},
+  };
+  for (const Case& c : cases) {
+    LuaHost host(limits, 1);
+    const ScriptError error = run_error(host, c.script);
+    EXPECT_EQ(error.kind(), Kind::kBudget) << c.script << " -> " << error.what();
+    EXPECT_NE(error.message().find(c.names), std::string::npos) << error.message();
+  }
+}
+
+// Copying a long string (a `..` is one instruction) counts by the bytes
+// copied: a loop that copies a megabyte a turn stops on the budget.
+TEST(LuaHostBudget, CopyingIntoNewMemoryCountsAgainstTheBudget) {
+  SandboxLimits limits = small_limits();
+  limits.wall_seconds_per_call = 1000;
+  LuaHost host(limits, 1);
+  const ScriptError error =
+      run_error(host, "local s = ('x'):rep(1 << 20)\nfor i = 1, 1e9 do local t = s .. i end");
+  EXPECT_EQ(error.kind(), Kind::kBudget) << error.what();
+  EXPECT_EQ(error.message().rfind("script.lua:2: instruction budget of 1000000 exceeded", 0), 0u)
+      << error.message();
+  // About 1000000 / (2^20 / 64) = 61 turns, not the 1000000 / 4 that
+  // counting the loop's instructions alone would allow.
+  EXPECT_LT(host.instructions_used(), 2'000'000u);
+  expect_works(host);
+}
+
 TEST(LuaHostBudget, HookIsInheritedByCoroutines) {
   LuaHost host(small_limits(), 1);
   const char* scripts[] = {
