@@ -171,6 +171,7 @@ void Grasping::hold(const std::string& part, GraspType type) {
     grasping_digit_[d] = type == GraspType::kPower || d <= (type == GraspType::kTripod ? 2U : 1U);
   }
   opened_since_ = -1;
+  grasped_at_ = simulation_->time();
 }
 
 PartId Grasping::carried_root(const engine::Scene& scene, PartId part) {
@@ -343,8 +344,38 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   auto emit = [&](EventKind kind, const std::string& a, const std::string& b) {
     pending_.push_back({kind, frame, t, a, b});
   };
+  // The total flexion low-passed (a time constant of kSmoothing_s divides
+  // the glove's white noise by about three at 90 Hz), and how much it rose
+  // over the last kClosingWindow_s.
+  constexpr Real kSmoothing_s = 0.04;
+  constexpr Real kClosingWindow_s = 0.25;
+  if (!smoothed_started_) {
+    smoothed_flexion_ = last_smoothed_ = total_flexion;
+    smoothed_started_ = true;
+  } else {
+    last_smoothed_ = smoothed_flexion_;
+    const Real alpha = 1 - std::exp(-std::max<Real>(t - last_time_, 0) / kSmoothing_s);
+    smoothed_flexion_ += alpha * (total_flexion - smoothed_flexion_);
+  }
+  last_time_ = t;
+  while (!smoothed_window_.empty() &&
+         smoothed_window_.front().first < t - kClosingWindow_s - 1e-9) {
+    smoothed_window_.pop_front();
+  }
+  smoothed_window_.emplace_back(t, smoothed_flexion_);
+  Real window_low = smoothed_flexion_;
+  for (const auto& [time, value] : smoothed_window_) window_low = std::min(window_low, value);
+  const Real closed_lately = smoothed_flexion_ - window_low;
 
   if (held_) {
+    // The flexion at the grasp settles on the closed hand's, below the
+    // noise of the sample it was taken from.
+    constexpr Real kSettle_s = 0.1;
+    if (t - grasped_at_ <= kSettle_s + 1e-9) {
+      for (std::size_t d = 0; d < kDigitCount; ++d) {
+        flexion_at_grasp_[d] = std::min(flexion_at_grasp_[d], digit_flexion[d]);
+      }
+    }
     // Release: a grasping digit opened past its flexion at the grasp, long enough.
     // Or opened by release_opening_, less, after closing release_open_deg past
     // the grasp: squeezing, then opening, is a gesture glove jitter does not make.
@@ -395,20 +426,23 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   // Against the last frame for a grasp starting to build up; against where it
   // started for one building up (the sum of 15 joints' noise swings by more
   // than the slack from frame to frame, but does not open the hand).
-  const bool closing =
-      total_flexion >=
-      (candidate_.empty() || found_part != candidate_ ? last_flexion_ : candidate_start_flexion_) -
-          kClosingSlack;
+  const bool closing = smoothed_flexion_ >= (candidate_.empty() || found_part != candidate_
+                                                 ? last_smoothed_
+                                                 : candidate_start_smoothed_) -
+                                                kClosingSlack;
   const bool still_closing = total_flexion > last_flexion_ + kStillClosing;
   if (found && closing && found_part == candidate_) {
     ++candidate_frames_;
     candidate_type_ = *found;  // more fingers may arrive while the hand closes
+    candidate_closing_ = std::max(candidate_closing_, closed_lately);
   } else if (found && closing) {
     candidate_ = found_part;
     candidate_type_ = *found;
     candidate_frames_ = 1;
     candidate_start_flexion_ = last_flexion_;
+    candidate_start_smoothed_ = last_smoothed_;
     candidate_start_digits_ = last_digit_flexion_;
+    candidate_closing_ = closed_lately;
   } else if (!found && closing && !candidate_.empty() && candidate_misses_ < kOnsetMisses) {
     // A frame in which glove noise lifts a finger or the palm off the part
     // interrupts the grasp building up, but does not start it again: a hand
@@ -423,11 +457,15 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   last_digit_flexion_ = digit_flexion;
   // The grasp holds for onset_frames; its type is taken once the hand stops closing
   // (or after four times as long), so that the last fingers to arrive count.
-  // And the hand must have closed while the grasp built up: an open or still hand
-  // moved against a part (drawn back along a rod it just let go of) grasps nothing.
-  constexpr Real kMinClosing = 1;  // degrees of total flexion
+  // And the hand must have closed lately while the grasp built up: an open or
+  // still hand moved against a part (drawn back along a rod it just let go
+  // of, or slid along a bar with the glove's noise on every joint) grasps
+  // nothing. A closing hand sweeps tens of degrees of total flexion in a
+  // quarter second; the smoothed noise of a still one rises by more than
+  // kMinClosing about once in 10^4 frames at 1.5 degrees a joint.
+  constexpr Real kMinClosing = 10;  // degrees of total flexion, smoothed, within kClosingWindow_s
   if (found && found_part == candidate_ && candidate_frames_ >= settings_.grasp.onset_frames &&
-      total_flexion >= candidate_start_flexion_ + kMinClosing &&
+      candidate_closing_ >= kMinClosing &&
       (!still_closing || candidate_frames_ >= 4 * settings_.grasp.onset_frames)) {
     hold(candidate_, candidate_type_);
     // The digits that grasp are those touching the part now (a grasp fires only in a

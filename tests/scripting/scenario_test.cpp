@@ -682,6 +682,72 @@ TEST(ScenarioRun, AMateInsideTheCarriedSubAssemblyNeitherGuidesNorSnapsIt) {
   }
 }
 
+TEST(ScenarioRun, AStillClosedHandWithGloveNoiseGraspsNothing) {
+  // The hand closes on a bar where no grasp is found, then slides along it,
+  // closed and still, with 0.5 degrees of noise on every joint. The noise of
+  // 15 joints swings their sum by about 2 degrees a frame, which the onset
+  // once took for closing: seeds 1 to 4 grasped the bar and dragged it.
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "slide.plan",
+        "start -0.030 0.1108 0.080  1 0 0 0\n"
+        "reach 1.0  -0.030 0.0108 0.080  1 0 0 0\n"
+        "close 0.5 power\n"
+        "wait 0.2\n"
+        "reach 2.0  0.065 0.0108 0.080  1 0 0 0\n");
+  for (int seed = 1; seed <= 6; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const auto file = write(dir, "still.lua",
+                            R"(return scenario {
+  name = "still", units = "mm",
+  parts = { bar = part { shape = cylinder { diameter = 40, length = 120 }, at = { 60, 0.8, 0 },
+                         turn = { y = -90 } } },
+  hand = glove { plan = "slide.plan", noise = { position = 0, angle = 0, joints = 0.5, seed = )" +
+                                std::to_string(seed) + R"( } },
+}
+)");
+    const RunOutcome o = run_scenario(file);
+    ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary();
+    for (const engine::Event& e : o.report.events) {
+      EXPECT_NE(e.kind, engine::EventKind::kGrasp) << "at t=" << e.time;
+    }
+  }
+}
+
+TEST(ScenarioRun, AHeldPartIsKeptWhenTheFirstSampleReadHigh) {
+  // `holding` takes the flexion at the grasp from the trace's first sample.
+  // Here the thumb's reads 7 degrees above the closed hand's, and from 0.3 s
+  // the hand relaxes by 1.5 degrees: 8.5 below that one sample, which once
+  // let the part go. The flexion at the grasp now settles on the hand's own.
+  const test::TempDir dir("dovetail_scenario");
+  std::string trace =
+      "t,x,y,z,qw,qx,qy,qz,thumb_roll,thumb_mcp,thumb_ip,thumb_abd,index_mcp,index_pip,index_dip,"
+      "middle_mcp,middle_pip,middle_dip,ring_mcp,ring_pip,ring_dip,pinky_mcp,pinky_pip,pinky_dip,"
+      "index_middle_abd,middle_ring_abd,ring_pinky_abd,palm_arch,wrist_pitch,wrist_yaw\n";
+  for (int i = 0; i <= 90; ++i) {
+    const double t = i / 90.0;
+    const double thumb_mcp = i == 0 ? 37 : t >= 0.3 ? 28.5 : 30;
+    char row[512];
+    std::snprintf(row, sizeof(row),
+                  "%.17g,0,0.15,0.09,1,0,0,0,50,%g,30,30,60,70,40,60,70,40,60,70,40,60,70,40,0,0,"
+                  "0,11,0,0\n",
+                  t, thumb_mcp);
+    trace += row;
+  }
+  write(dir, "held.csv", trace);
+  const auto file = write(dir, "held.lua", R"(return scenario {
+  name = "held", units = "mm",
+  parts = { peg = part { shape = cylinder { diameter = 20, length = 60 }, at = { 0, 100, 0 },
+                         turn = { x = 90 } } },
+  hand = glove { trace = "held.csv", holding = "peg" },
+}
+)");
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary();
+  for (const engine::Event& e : o.report.events) {
+    EXPECT_NE(e.kind, engine::EventKind::kRelease) << e.b << " at t=" << e.time;
+  }
+}
+
 TEST(ScenarioRun, AGraspBuildsUpThroughGloveNoise) {
   // A shaft with a collar, grasped by the shaft, carried into a hole, under
   // the glove's noise model (1 mm, 0.15 degrees, 0.5 degrees a joint): the

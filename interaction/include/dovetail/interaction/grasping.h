@@ -15,6 +15,7 @@
 /// deterministic: the same trace gives the same bits at any thread count.
 
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <optional>
@@ -261,6 +262,20 @@ class Grasping {
   std::array<Real, kDigitCount> candidate_start_digits_{};
   Real last_flexion_ = 0;
   std::array<Real, kDigitCount> last_digit_flexion_{};
+  /// When the part was grasped: for a moment after, each digit's flexion at
+  /// the grasp follows the glove down, so that a grasp taken from one noisy
+  /// sample (`holding`'s first) does not sit above the closed hand.
+  Real grasped_at_ = 0;
+  /// The total glove flexion low-passed, and its values over the last
+  /// moments (time, value): how much the hand closed lately, which the
+  /// noise of 15 joints does not fake, decides a grasp's onset.
+  Real smoothed_flexion_ = 0;
+  Real last_time_ = 0;
+  bool smoothed_started_ = false;
+  std::deque<std::pair<Real, Real>> smoothed_window_;
+  Real candidate_start_smoothed_ = 0;  ///< smoothed_flexion_ the frame before the candidate
+  Real last_smoothed_ = 0;
+  Real candidate_closing_ = 0;  ///< the most the hand closed lately while the candidate built up
   std::optional<std::size_t> guiding_;  ///< the mate drawing the held part onto its axis
   /// What slides on what, sorted: (the held part or a part attached to it, the part it
   /// has a contact with), as the last slide_begin events said.
