@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <numbers>
 #include <optional>
 #include <vector>
 
@@ -159,9 +160,34 @@ std::optional<std::string> sparse_samples(std::span<const GloveSample> samples) 
   return std::string(text);
 }
 
+std::optional<std::string> radian_angles(std::span<const GloveSample> samples) {
+  // A hand that moves at all bends some joint by tens of degrees; angles
+  // in radians stay within pi. Under 0.2 everywhere is a still, flat hand.
+  const GloveSample* widest = nullptr;
+  std::size_t joint = 0;
+  for (const GloveSample& g : samples) {
+    for (std::size_t j = 0; j < kJointCount; ++j) {
+      if (!widest || std::abs(g.joints[j]) > std::abs(widest->joints[joint]))
+        widest = &g, joint = j;
+    }
+  }
+  if (!widest) return std::nullopt;
+  const Real largest = std::abs(widest->joints[joint]);
+  if (largest < 0.2 || largest > std::numbers::pi + 0.01) return std::nullopt;
+  char text[300];
+  std::snprintf(text, sizeof text,
+                "no joint angle is beyond +-%.3g over the whole take (the largest, %s, is %.4g "
+                "at t=%.6g s), where a closing hand bends its joints by tens of degrees: are the "
+                "angles in radians? Dovetail reads degrees",
+                std::numbers::pi, std::string(joint_name(static_cast<Joint>(joint))).c_str(),
+                widest->joints[joint], widest->t);
+  return std::string(text);
+}
+
 std::vector<std::string> trace_doubts(const fs::path& path, std::span<const GloveSample> samples) {
   std::vector<std::string> doubts;
   if (std::optional<std::string> sparse = sparse_samples(samples)) doubts.push_back(*sparse);
+  if (std::optional<std::string> radians = radian_angles(samples)) doubts.push_back(*radians);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (in && in.tellg() > 0) {
     in.seekg(-1, std::ios::end);

@@ -23,6 +23,11 @@ dovetail_cli_test(glove_check_times_in_milliseconds EXIT 0
                   ARGS glove check ${glove}/trace_times_in_milliseconds.csv
                   STDOUT "\"samples\":3"
                   STDERR "trace_times_in_milliseconds.csv: its samples are 11.11 s apart \\(the median\\), 0.09 samples a second[^\n]*are its times in milliseconds\\?")
+# Joint angles in radians read as degrees: a hand that hardly moves.
+dovetail_cli_test(glove_check_joint_angles_in_radians EXIT 0
+                  ARGS glove check ${glove}/trace_joint_angles_in_radians.csv
+                  STDOUT "\"samples\":4"
+                  STDERR "trace_joint_angles_in_radians.csv: no joint angle is beyond \\+-3.14 over the whole take \\(the largest, index_mcp, is 1.2 at t=0.0333333 s\\)[^\n]*are the angles in radians\\? Dovetail reads degrees")
 dovetail_cli_test(glove_check_no_final_line_end EXIT 0
                   ARGS glove check ${glove}/trace_no_final_line_end.csv
                   STDOUT "\"samples\":3"

@@ -61,12 +61,16 @@ std::vector<GloveSample> read_trace(const std::filesystem::path& path);
 
 /// What makes a trace that reads cleanly doubtful, one sentence each, without
 /// the file's name: samples far sparser than any glove's (times written in
-/// milliseconds read as seconds), and a last line without a line end (a file
-/// cut short while written, whose last value may be cut too). For warnings.
+/// milliseconds read as seconds), joint angles in radians, and a last line
+/// without a line end (a file cut short while written, whose last value may
+/// be cut too). For warnings.
 std::vector<std::string> trace_doubts(const std::filesystem::path& path,
                                       std::span<const GloveSample> samples);
 /// trace_doubts' first: samples more than 0.1 s apart at the median.
 std::optional<std::string> sparse_samples(std::span<const GloveSample> samples);
+/// trace_doubts' second: every joint angle within +-pi, some beyond 0.2
+/// (radians, where degrees are read).
+std::optional<std::string> radian_angles(std::span<const GloveSample> samples);
 
 /// The header row and one row per sample, each ending in '\n'. The samples
 /// are not checked: ones that read_trace refuses (none, non-finite values, a
