@@ -59,6 +59,37 @@ TEST(Containment, IsClosed) {
   EXPECT_TRUE(is_closed(make_mesh(std::move(v), std::move(t), "split box")));
 }
 
+TEST(Containment, SurfaceEdgesCountWhatKeepsAMeshOpen) {
+  const Mesh box = make_box(Vec3(1, 1, 1));
+  EXPECT_TRUE(surface_edges(box).closed());
+  EXPECT_TRUE(surface_edges(make_torus(2, 0.5, 16, 8)).closed());
+
+  // One triangle removed: its three edges are each left on one triangle.
+  Mesh open = box;
+  open.triangles.pop_back();
+  EXPECT_EQ(surface_edges(open).open, 3u);
+  EXPECT_EQ(surface_edges(open).misoriented, 0u);
+
+  // One triangle flipped: its three edges run the same way as its
+  // neighbours'; nothing is missing.
+  Mesh flipped = box;
+  std::swap(flipped.triangles[3][1], flipped.triangles[3][2]);
+  EXPECT_EQ(surface_edges(flipped).open, 0u);
+  EXPECT_EQ(surface_edges(flipped).misoriented, 3u);
+
+  // Both at once, on two different triangles.
+  Mesh both = flipped;
+  both.triangles.erase(both.triangles.begin() + 8);
+  const SurfaceEdges counts = surface_edges(both);
+  EXPECT_GT(counts.open, 0u);
+  EXPECT_GT(counts.misoriented, 0u);
+
+  // The same verdict as is_closed on every mesh of the tests above.
+  for (const Mesh& mesh : {box, open, flipped, both, make_wavy_sheet(1, 0.1, 3, 5)}) {
+    EXPECT_EQ(surface_edges(mesh).closed(), is_closed(mesh));
+  }
+}
+
 /// Two boxes in one mesh, as a CAD export writes an assembly of bodies: the
 /// second box's vertices moved by `offset`; no welding but by position.
 Mesh two_boxes(const Vec3& half_a, const Vec3& half_b, const Vec3& offset) {

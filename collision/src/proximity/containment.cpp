@@ -237,6 +237,43 @@ bool is_closed(const Mesh& mesh) {
   return true;
 }
 
+SurfaceEdges surface_edges(const Mesh& mesh) {
+  // Each edge by its lower vertex first, with +1 for a use in that direction
+  // and -1 for the other: a closed surface uses every edge as often each way.
+  std::vector<std::tuple<std::uint32_t, std::uint32_t, int>> uses;
+  uses.reserve(3 * mesh.triangles.size());
+  for (const Edge& e : directed_edges(mesh)) {
+    // An edge of a triangle with two welded corners has no direction to cancel.
+    if (e.from == e.to) continue;
+    if (e.from < e.to) {
+      uses.emplace_back(e.from, e.to, 1);
+    } else {
+      uses.emplace_back(e.to, e.from, -1);
+    }
+  }
+  std::sort(uses.begin(), uses.end());
+  SurfaceEdges counts;
+  for (std::size_t k = 0; k < uses.size();) {
+    std::size_t n = 0;
+    int balance = 0;
+    std::size_t j = k;
+    for (; j < uses.size() && std::get<0>(uses[j]) == std::get<0>(uses[k]) &&
+           std::get<1>(uses[j]) == std::get<1>(uses[k]);
+         ++j) {
+      ++n;
+      balance += std::get<2>(uses[j]);
+    }
+    // An odd count cannot balance, so it is a hole whatever the winding.
+    if (n % 2 == 1) {
+      ++counts.open;
+    } else if (balance != 0) {
+      ++counts.misoriented;
+    }
+    k = j;
+  }
+  return counts;
+}
+
 PointLocation locate_point(const Mesh& mesh, const Vec3& p_M) {
   return locate_in(mesh, mesh.vertices, p_M).location;
 }

@@ -26,6 +26,24 @@ namespace dovetail::collision {
 /// split vertices are judged by their geometry.
 bool is_closed(const Mesh& mesh);
 
+/// How a mesh's triangles meet along their edges, counted per edge (its two
+/// vertices, welded by position as in is_closed). A mesh with at least one
+/// triangle is closed exactly when both counts are 0.
+struct SurfaceEdges {
+  /// Edges on an odd number of triangles (usually one): the rim of a hole or
+  /// of a missing face, so the surface has no inside there.
+  std::size_t open = 0;
+  /// Edges on an even number of triangles, but not as many running each
+  /// way: neighbours wound opposite ways, so their normals disagree on which
+  /// side is inside.
+  std::size_t misoriented = 0;
+  bool closed() const { return open == 0 && misoriented == 0; }
+};
+
+/// What keeps `mesh` from being closed (is_closed), edge by edge, so that a
+/// warning can say how much of a part's surface is wrong.
+SurfaceEdges surface_edges(const Mesh& mesh);
+
 /// Where a point lies against a closed mesh.
 enum class PointLocation {
   kOutside,
