@@ -1,6 +1,9 @@
 #include "folder_io_system.h"
 
+#include <assimp/MemoryIOWrapper.h>
+
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <system_error>
 #include <utility>
@@ -45,7 +48,15 @@ Assimp::IOStream* FolderIOSystem::Open(const char* file, const char* mode) {
   if (mode == nullptr || std::strpbrk(mode, "wa+") != nullptr) return nullptr;
   const fs::path p = resolve(file, true);
   if (p.empty()) return nullptr;
-  Assimp::IOStream* stream = files_.Open(p.string().c_str(), mode);
+  Assimp::IOStream* stream = nullptr;
+  if (!substituted_.empty() && p == substituted_) {
+    // The stream owns its copy, so the importer may open the file twice.
+    auto* bytes = new std::uint8_t[std::max<std::size_t>(substitute_text_.size(), 1)];
+    std::memcpy(bytes, substitute_text_.data(), substitute_text_.size());
+    stream = new Assimp::MemoryIOStream(bytes, substitute_text_.size(), true);
+  } else {
+    stream = files_.Open(p.string().c_str(), mode);
+  }
   if (stream != nullptr && std::find(opened_.begin(), opened_.end(), p.string()) == opened_.end()) {
     opened_.push_back(p.string());
   }
@@ -53,5 +64,10 @@ Assimp::IOStream* FolderIOSystem::Open(const char* file, const char* mode) {
 }
 
 void FolderIOSystem::Close(Assimp::IOStream* stream) { files_.Close(stream); }
+
+void FolderIOSystem::substitute(const fs::path& file, std::string text) {
+  substituted_ = file.lexically_normal();
+  substitute_text_ = std::move(text);
+}
 
 }  // namespace dovetail::engine::detail

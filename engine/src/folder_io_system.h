@@ -28,6 +28,11 @@ class FolderIOSystem : public Assimp::IOSystem {
   Assimp::IOStream* Open(const char* file, const char* mode = "rb") override;
   void Close(Assimp::IOStream* stream) override;
 
+  /// Serves `text` in place of the file `file` (an absolute path inside the
+  /// folder), which is still reported as opened: for an input read with a
+  /// correction the importer needs (obj_with_unique_objects).
+  void substitute(const std::filesystem::path& file, std::string text);
+
   /// Paths the importer tried to open and was refused, in order, without repeats.
   const std::vector<std::string>& refused() const { return refused_; }
   /// Files the importer opened (normalised absolute paths), in order, without repeats.
@@ -41,6 +46,8 @@ class FolderIOSystem : public Assimp::IOSystem {
 
   std::filesystem::path root_;
   Assimp::DefaultIOSystem files_;
+  std::filesystem::path substituted_;
+  std::string substitute_text_;
   mutable std::vector<std::string> refused_;
   std::vector<std::string> opened_;
 };

@@ -23,6 +23,7 @@
 #include "declared_sizes.h"
 #include "folder_io_system.h"
 #include "import_process.h"
+#include "obj_lines.h"
 
 namespace dovetail::engine {
 
@@ -494,6 +495,13 @@ void check_format(const fs::path& path) {
 
 namespace {
 
+bool is_obj(const fs::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension == ".obj";
+}
+
 /// assimp's part of an import: the file read, checked and turned into parts.
 ImportReport read_with_assimp(const fs::path& path, const ImportOptions& options) {
   // The folder resolved as the file system does: "link/../x" is x beside
@@ -508,6 +516,13 @@ ImportReport read_with_assimp(const fs::path& path, const ImportOptions& options
   // The importer owns and deletes the IO system; `io` stays valid while it lives.
   auto* io = new detail::FolderIOSystem(absolute.parent_path());
   importer.SetIOHandler(io);
+  std::vector<std::string> renamed;
+  if (is_obj(path)) {
+    if (std::optional<detail::UniqueObjects> unique = detail::obj_with_unique_objects(absolute)) {
+      io->substitute(absolute, std::move(unique->text));
+      renamed = std::move(unique->notes);
+    }
+  }
   importer.SetPropertyBool(AI_CONFIG_PP_FD_REMOVE, true);
   // Zero-area triangles are found exactly by make_mesh; assimp's area test uses
   // an absolute threshold that would drop real triangles of small parts.
@@ -548,7 +563,7 @@ ImportReport read_with_assimp(const fs::path& path, const ImportOptions& options
   if (scene->mNumMeshes == 0 && raw_meshes > 0 && repeated > 0) {
     fail(path, "contains no usable triangles: every face repeats a vertex");
   }
-  std::vector<std::string> notes;
+  std::vector<std::string> notes = std::move(renamed);
   if (!io->refused().empty()) notes.push_back(refused_message(*io));
   if (repeated > 0) {
     notes.push_back(

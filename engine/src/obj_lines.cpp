@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <fstream>
 #include <optional>
+#include <set>
+#include <sstream>
 #include <string_view>
 #include <system_error>
 #include <utility>
@@ -154,6 +156,92 @@ std::optional<std::string> check_obj_lines(const std::filesystem::path& path,
                              (vertices == 1 ? " vertex" : " vertices"));
   }
   return std::nullopt;
+}
+
+std::optional<UniqueObjects> obj_with_unique_objects(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream read;
+  read << in.rdbuf();
+  if (in.bad() || !read) return std::nullopt;
+  const std::string text = read.str();
+
+  // Lines as [start, end) without the line break, which stays where it was.
+  std::vector<std::pair<std::size_t, std::size_t>> lines;
+  for (std::size_t start = 0; start < text.size();) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    lines.emplace_back(start, end);
+    start = end + 1;
+  }
+  // The name an `o` line gives (the word after the keyword, as assimp reads
+  // it) and where it lies in the text; the name a `g` line gives (the rest of
+  // the line, trailing blanks trimmed).
+  struct ObjectLine {
+    std::size_t at;
+    std::string name;
+    std::size_t line;
+  };
+  std::vector<ObjectLine> objects;
+  std::set<std::string> taken;
+  std::vector<std::pair<std::size_t, bool>> order;  // (index into objects or groups, is `o`)
+  std::vector<std::string> groups;
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    const auto [start, end] = lines[k];
+    const std::string_view line(text.data() + start, end - start);
+    std::size_t at = 0;
+    const std::string_view keyword = next_word(line, at);
+    if (keyword == "o") {
+      const std::string_view name = next_word(line, at);
+      if (name.empty()) continue;
+      objects.push_back(
+          {start + static_cast<std::size_t>(name.data() - line.data()), std::string(name), k + 1});
+      taken.insert(std::string(name));
+      order.emplace_back(objects.size() - 1, true);
+    } else if (keyword == "g") {
+      while (at < line.size() && space(line[at])) ++at;
+      std::size_t last = line.size();
+      while (last > at && space(line[last - 1])) --last;
+      if (last == at) continue;
+      groups.emplace_back(line.substr(at, last - at));
+      taken.insert(groups.back());
+      order.emplace_back(groups.size() - 1, false);
+    }
+  }
+
+  // Which `o` lines repeat a name seen before them, in file order.
+  std::set<std::string> seen;
+  std::vector<std::pair<std::size_t, std::string>> renames;  // (object, new name)
+  for (const auto& [index, is_object] : order) {
+    if (!is_object) {
+      seen.insert(groups[index]);
+      continue;
+    }
+    const std::string& name = objects[index].name;
+    if (seen.insert(name).second) continue;
+    std::string fresh;
+    for (std::size_t k = 2;; ++k) {
+      fresh = name + "_" + std::to_string(k);
+      if (taken.count(fresh) == 0) break;
+    }
+    taken.insert(fresh);
+    renames.emplace_back(index, fresh);
+  }
+  if (renames.empty()) return std::nullopt;
+
+  UniqueObjects out;
+  std::size_t copied = 0;
+  for (const auto& [index, fresh] : renames) {
+    const ObjectLine& object = objects[index];
+    out.text.append(text, copied, object.at - copied);
+    out.text += fresh;
+    copied = object.at + object.name.size();
+    // As string_view: std::quoted would be found for a std::string.
+    out.notes.push_back(at_line(object.line, "the object " + quoted(std::string_view(object.name)) +
+                                                 " repeats an earlier name; it is read as " +
+                                                 quoted(std::string_view(fresh))));
+  }
+  out.text.append(text, copied, std::string::npos);
+  return out;
 }
 
 }  // namespace dovetail::engine::detail

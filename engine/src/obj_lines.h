@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "dovetail/collision/mesh.h"
 
@@ -31,5 +32,24 @@ namespace dovetail::engine::detail {
 /// to the importer.
 std::optional<std::string> check_obj_lines(const std::filesystem::path& path,
                                            const collision::MeshLimits& limits);
+
+/// An OBJ file's text with repeated object names made unique, and a note per
+/// renamed object.
+struct UniqueObjects {
+  std::string text;
+  std::vector<std::string> notes;
+};
+
+/// The OBJ file `path` with each object line `o NAME` whose NAME an earlier
+/// `o` or `g` line used renamed to NAME_2, NAME_3, ... (the first such name
+/// no `o` or `g` line of the file uses); nullopt when no name repeats, the
+/// usual case, or the file cannot be read (the importer then says why).
+///
+/// Why: assimp's OBJ reader gives a repeated object name the earlier object
+/// of that name and keeps adding faces to the mesh it was filling, so two
+/// washers, or a washer and the pin read after it, became one part under one
+/// name. Renamed, each object is a node of its own, as in every other format.
+/// Only the name changes; every other byte, and so every line number, stays.
+std::optional<UniqueObjects> obj_with_unique_objects(const std::filesystem::path& path);
 
 }  // namespace dovetail::engine::detail

@@ -744,6 +744,42 @@ TEST(MeshImport, PartsAreNamedUniquelyPerInstance) {
   EXPECT_EQ(merged.triangle_count(), 4u);
 }
 
+TEST(MeshImport, ObjObjectsWithOneNameStayApart) {
+  // Three triangles at z = 0, 1, 2: a bracket, then two objects both named
+  // washer, the second of them a pin exported under the washer's name.
+  TempDir dir;
+  const std::string file =
+      "o bracket\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+      "o washer\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n"
+      "o washer\nv 0 0 2\nv 1 0 2\nv 0 1 2\nf 7 8 9\n"
+      "o bracket\nv 0 0 3\nv 1 0 3\nv 0 1 3\nf 10 11 12\n"
+      "o washer_2\nv 0 0 4\nv 1 0 4\nv 0 1 4\nf 13 14 15\n";
+  write_file(dir / "asm.obj", file);
+  ImportOptions per_part;
+  per_part.merge = false;
+  const ImportReport report = import_file(dir / "asm.obj", per_part);
+  ASSERT_EQ(report.parts.size(), 5u);
+  // Each object is a part of its own, holding its own triangle, in file
+  // order; a name the file itself uses (washer_2) is not given twice.
+  const std::vector<std::string> names{"bracket", "washer", "washer_3", "bracket_2", "washer_2"};
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    EXPECT_EQ(report.parts[k].name, names[k]);
+    ASSERT_EQ(report.parts[k].mesh.triangle_count(), 1u) << names[k];
+    EXPECT_EQ(report.parts[k].mesh.vertices[0].z(), static_cast<double>(k)) << names[k];
+  }
+  // Said, with the line of each renamed object.
+  std::string notes;
+  for (const std::string& note : report.notes) notes += note + "\n";
+  EXPECT_NE(notes.find("line 11: the object 'washer' repeats an earlier name; it is read as "
+                       "'washer_3'"),
+            std::string::npos)
+      << notes;
+  EXPECT_NE(notes.find("line 16:"), std::string::npos) << notes;
+  // The file itself is left as it was, and the merged import reads it all.
+  EXPECT_EQ(read_file(dir / "asm.obj"), file);
+  EXPECT_EQ(import_mesh(dir / "asm.obj").triangle_count(), 5u);
+}
+
 TEST(MeshImport, DegenerateTrianglesAreCounted) {
   TempDir dir;
   write_file(dir / "flat.obj",
