@@ -1,10 +1,13 @@
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "cli.h"
 #include "commands.h"
+#include "dovetail/collision/containment.h"
+#include "dovetail/interaction/overlap.h"
 
 namespace dovetail::cli {
 
@@ -15,14 +18,17 @@ constexpr const char* kHelp =
 
 Reads a mesh file (OBJ, STL, PLY, glTF or GLB) as `query` does and reports what
 was found: vertices, triangles, validation findings (degenerate triangles
-removed, unused vertices, skipped point/line primitives, notes), the file's cameras
+removed, unused vertices, skipped point/line primitives, notes), whether the
+surface is closed and consistently wound (open and wrongly wound edges, with a
+warning: penetration depth and inside tests need such a surface), the file's cameras
 (by name, for `render --camera`), bounds, and
 for every method the hierarchy built over it: nodes, leaves, depth, bytes,
 bytes per triangle and build time.
 
   --json       one JSON object on one line instead of the text report
   --method M   only this method (boxtree, dop6, dop14, dop18, dop26, aabb, obb, brute)
-  --parts      also list the parts (one per mesh instance of every node)
+  --parts      also list the parts (one per mesh instance of every node), each
+               with its open and wrongly wound edges
 )";
 
 std::string json_vec(const collision::Vec3& v) {
@@ -39,6 +45,7 @@ struct PartRow {
   std::string name;
   std::size_t vertices = 0;
   std::size_t triangles = 0;
+  collision::SurfaceEdges edges{};
 };
 
 }  // namespace
@@ -51,6 +58,7 @@ struct Inspection {
   LoadedMesh loaded;
   collision::Bounds bounds{};
   double diagonal = 0;
+  collision::SurfaceEdges edges{};
   std::vector<PartRow> parts{};
   std::vector<MethodRow> rows{};
 };
@@ -62,7 +70,8 @@ std::vector<PartRow> part_rows(const std::string& path) {
   per_part.merge = false;
   try {
     for (const engine::ImportedPart& part : engine::import_file(path, per_part).parts) {
-      parts.push_back({part.name, part.mesh.vertex_count(), part.mesh.triangle_count()});
+      parts.push_back({part.name, part.mesh.vertex_count(), part.mesh.triangle_count(),
+                       collision::surface_edges(part.mesh)});
     }
   } catch (const collision::MeshError& e) {
     throw InputError(e.what());
@@ -119,14 +128,18 @@ void print_json(const Inspection& x, bool with_parts) {
       .add_raw("cameras", json_array(cameras))
       .add_raw("bounds_min", json_vec(x.bounds.min))
       .add_raw("bounds_max", json_vec(x.bounds.max))
-      .add("diagonal", x.diagonal);
+      .add("diagonal", x.diagonal)
+      .add("open_edges", std::uint64_t{x.edges.open})
+      .add("wrongly_wound_edges", std::uint64_t{x.edges.misoriented});
   if (with_parts) {
     std::vector<std::string> part_items;
     for (const PartRow& part : x.parts) {
       JsonLine item;
       item.add("name", part.name)
           .add("vertices", std::uint64_t{part.vertices})
-          .add("triangles", std::uint64_t{part.triangles});
+          .add("triangles", std::uint64_t{part.triangles})
+          .add("open_edges", std::uint64_t{part.edges.open})
+          .add("wrongly_wound_edges", std::uint64_t{part.edges.misoriented});
       part_items.push_back(item.str());
     }
     json.add_raw("parts", json_array(part_items));
@@ -152,6 +165,12 @@ void print_text(const Inspection& x, bool with_parts) {
   std::printf("bounds max          %.9g %.9g %.9g\n", x.bounds.max.x(), x.bounds.max.y(),
               x.bounds.max.z());
   std::printf("diagonal            %.9g\n", x.diagonal);
+  std::printf("open edges          %zu\n", x.edges.open);
+  std::printf("wrongly wound edges %zu\n", x.edges.misoriented);
+  if (const std::optional<std::string> flaw = interaction::surface_flaw(*x.loaded.mesh)) {
+    std::printf("warning             not a closed surface: %s; %s\n", flaw->c_str(),
+                interaction::kSurfaceFlawEffect);
+  }
   for (const std::string& note : x.loaded.report.notes) {
     std::printf("note                %s\n", note.c_str());
   }
@@ -159,9 +178,11 @@ void print_text(const Inspection& x, bool with_parts) {
     std::printf("camera              %s\n", camera.first.c_str());
   }
   if (with_parts) {
-    std::printf("\n%-32s %10s %10s\n", "part", "vertices", "triangles");
+    std::printf("\n%-32s %10s %10s %10s %14s\n", "part", "vertices", "triangles", "open edges",
+                "wrongly wound");
     for (const PartRow& part : x.parts) {
-      std::printf("%-32s %10zu %10zu\n", part.name.c_str(), part.vertices, part.triangles);
+      std::printf("%-32s %10zu %10zu %10zu %14zu\n", part.name.c_str(), part.vertices,
+                  part.triangles, part.edges.open, part.edges.misoriented);
     }
   }
   std::printf("\n%-8s %10s %10s %6s %12s %10s %10s\n", "method", "nodes", "leaves", "depth",
@@ -192,6 +213,7 @@ int inspect_command(std::span<const std::string> argv) {
   Inspection x{.path = args.positional()[0], .loaded = load_mesh(args.positional()[0])};
   x.bounds = collision::mesh_bounds(*x.loaded.mesh);
   x.diagonal = (x.bounds.max - x.bounds.min).norm();
+  x.edges = collision::surface_edges(*x.loaded.mesh);
   if (args.flag("parts")) x.parts = part_rows(x.path);
   x.rows = method_rows(methods, x.loaded.mesh);
   if (args.flag("json")) {

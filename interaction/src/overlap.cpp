@@ -1,12 +1,29 @@
 #include "dovetail/interaction/overlap.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <stdexcept>
 
 #include "dovetail/collision/contacts.h"
 #include "dovetail/collision/containment.h"
 
 namespace dovetail::interaction {
+
+std::optional<std::string> surface_flaw(const collision::Mesh& mesh) {
+  const collision::SurfaceEdges edges = collision::surface_edges(mesh);
+  if (edges.closed()) return std::nullopt;
+  const auto count = [](std::size_t n, const char* what) {
+    return std::to_string(n) + " " + what + (n == 1 ? " edge" : " edges");
+  };
+  std::string text;
+  if (edges.open > 0) text = count(edges.open, "open") + " (a hole or a missing face)";
+  if (edges.misoriented > 0) {
+    if (!text.empty()) text += " and ";
+    text +=
+        count(edges.misoriented, "wrongly wound") + " (neighbouring faces facing opposite ways)";
+  }
+  return text;
+}
 
 Real OverlapGauge::depth(const std::shared_ptr<const collision::Mesh>& a, const Transform& X_WA,
                          const std::shared_ptr<const collision::Mesh>& b, const Transform& X_WB) {

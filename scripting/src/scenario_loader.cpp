@@ -21,6 +21,7 @@
 #include "dovetail/collision/primitives.h"
 #include "dovetail/engine/mesh_import.h"
 #include "dovetail/engine/pose_list.h"
+#include "dovetail/interaction/overlap.h"
 #include "dovetail/scripting/lua_host.h"
 #include "dovetail/scripting/scenario.h"
 
@@ -187,6 +188,7 @@ class Loader {
 
   Scenario load();
   void warn_about_mesh_sizes();
+  void warn_about_open_surfaces();
 
  private:
   /// A mistake in the file, where it is.
@@ -1332,6 +1334,20 @@ void Loader::warn_about_mesh_sizes() {
   }
 }
 
+/// A part from a mesh file whose surface is open or inconsistently wound:
+/// its overlaps are measured wrong or not at all (interaction::surface_flaw),
+/// and nothing else would say so. Generated shapes are closed by construction.
+void Loader::warn_about_open_surfaces() {
+  for (const PartSpec& p : scenario_.parts) {
+    if (p.file.empty() || !p.mesh) continue;
+    if (const std::optional<std::string> flaw = interaction::surface_flaw(*p.mesh)) {
+      scenario_.warnings.push_back(p.where.str() + ": part '" + p.name + "' (" + p.file +
+                                   ") is not a closed surface: " + *flaw + "; " +
+                                   interaction::kSurfaceFlawEffect);
+    }
+  }
+}
+
 void Loader::resolve() {
   Names names;
   for (const PartSpec& p : scenario_.parts) names.parts.push_back(p.name);
@@ -1391,6 +1407,7 @@ void Loader::resolve() {
     }
   }
   warn_about_mesh_sizes();
+  warn_about_open_surfaces();
   if (scenario_.glove && !scenario_.glove->holding.empty()) {
     check_part(scenario_.glove->holding, scenario_.glove->where, "glove: holding");
     if (fixed(scenario_.glove->holding)) {

@@ -622,6 +622,47 @@ TEST(ScenarioLoad, AMeshFileInOtherUnitsThanTheScenarioIsAWarning) {
   EXPECT_NE(s.warnings[0].find("is the file in other units?"), std::string::npos) << s.warnings[0];
 }
 
+TEST(ScenarioLoad, AnOpenOrWronglyWoundMeshIsAWarningThatCounts) {
+  // A 20 mm box without its top (two triangles, four open edges), and one
+  // with a face's two triangles wound inwards (four wrongly wound edges).
+  const test::TempDir dir("dovetail_scenario");
+  const std::string corners =
+      "v 0 0 0\nv 20 0 0\nv 20 20 0\nv 0 20 0\nv 0 0 20\nv 20 0 20\nv 20 20 20\nv 0 20 20\n";
+  const std::string sides =
+      "f 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+  write(dir, "open.obj", corners + "f 1 3 2\nf 1 4 3\n" + sides);
+  write(dir, "flipped.obj", corners + "f 1 3 2\nf 1 4 3\nf 5 7 6\nf 5 8 7\n" + sides);
+  write(dir, "closed.obj", corners + "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\n" + sides);
+  const auto file = write(dir, "open.lua", R"(return scenario {
+  name = "open", units = "mm",
+  parts = {
+    box = part { mesh = "open.obj", fixed = true },
+    lid = part { mesh = "flipped.obj", at = { 0, 0, 40 } },
+    peg = part { mesh = "closed.obj", at = { 0, 0, 80 } },
+  },
+  expect = { warnings_at_most(0) },
+  duration = 0.1,
+})");
+  const Scenario s = check_scenario(file);
+  ASSERT_EQ(s.warnings.size(), 2u);
+  EXPECT_NE(s.warnings[0].find("open.lua:4: part 'box' (open.obj) is not a closed surface: 4 "
+                               "open edges (a hole or a missing face); penetration depth "
+                               "(max_penetration, a snap's overlap check) and inside tests need "
+                               "a closed, consistently wound surface"),
+            std::string::npos)
+      << s.warnings[0];
+  EXPECT_NE(s.warnings[1].find("open.lua:5: part 'lid' (flipped.obj) is not a closed surface: 4 "
+                               "wrongly wound edges"),
+            std::string::npos)
+      << s.warnings[1];
+  const RunOutcome o = run_scenario(file);
+  EXPECT_EQ(o.warnings, s.warnings);
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed) << o.failure_summary() << o.error;
+  ASSERT_EQ(o.expectations.size(), 1u);
+  EXPECT_NE(o.expectations[0].detail.find("2 warnings"), std::string::npos)
+      << o.expectations[0].detail;
+}
+
 TEST(ScenarioLoad, CheckWarnsOfAPlanInOtherUnitsAsTheRunDoes) {
   // A plan in millimetres: the hand goes some 100 m from the parts.
   const test::TempDir dir("dovetail_scenario");

@@ -14,6 +14,8 @@
 
 #include <map>
 #include <memory>
+#include <optional>
+#include <string>
 
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/mesh.h"
@@ -24,6 +26,26 @@ namespace dovetail::interaction {
 
 using collision::Real;
 using collision::Transform;
+
+/// What the gauge needs of a part's surface, for warnings: what the surface
+/// lacks ("48 open edges (a hole or a missing face)", "4 wrongly wound edges",
+/// or both), or nullopt when it is closed and consistently wound
+/// (collision::surface_edges).
+///
+/// Why it matters: an open or inconsistently wound surface has no inside, so
+/// a part can sit deep in it unmeasured (the depth reads 0), and the depth of
+/// an overlap that is found is measured against faces that may not bound the
+/// part (a hole far from the contact can make it read tens of millimetres
+/// too deep). The depth is not refused for such a part, since a scenario
+/// whose parts never overlap still runs as it should; the warning says
+/// which numbers not to trust.
+std::optional<std::string> surface_flaw(const collision::Mesh& mesh);
+
+/// What an open or wrongly wound surface affects, to follow surface_flaw in
+/// a warning.
+inline constexpr const char* kSurfaceFlawEffect =
+    "penetration depth (max_penetration, a snap's overlap check) and inside tests need a "
+    "closed, consistently wound surface, so overlaps with this part may read 0 or too deep";
 
 /// Keeps each mesh's OBB tree and, for a convex part, its hull, built on
 /// first use. The meshes must outlive the gauge's use of them.
