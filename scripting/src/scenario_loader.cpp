@@ -736,6 +736,8 @@ class Loader {
   std::vector<std::filesystem::path>* files_read_ = nullptr;
   bool hand_given_ = false;  ///< a replayed trace gives the hand the scenario lacks
   std::map<std::string, engine::ImportReport> imports_;  ///< mesh files read by node
+  /// Parts declared `open_surface = true`: no warning about their surface.
+  std::set<std::string> open_surfaces_;
   /// Mesh files read whole, once however many parts name them (each read is
   /// a process of its own).
   std::map<std::string, engine::ImportReport> whole_imports_;
@@ -932,6 +934,9 @@ void Loader::read_parts(int map, const SourceLocation& where) {
               .toRotationMatrix();
     }
     part.fixed = field(t, word, "fixed", part.where, what).number != 0;
+    if (field(t, word, "open_surface", part.where, what).number != 0) {
+      open_surfaces_.insert(part.name);
+    }
     part.attached_to = field(t, word, "attached_to", part.where, what).text;
     if (const Arg c = field(t, word, "color", part.where, what); c.given) part.color = c.color;
     part.tags = field(t, word, "tags", part.where, what).names;
@@ -1339,7 +1344,7 @@ void Loader::warn_about_mesh_sizes() {
 /// and nothing else would say so. Generated shapes are closed by construction.
 void Loader::warn_about_open_surfaces() {
   for (const PartSpec& p : scenario_.parts) {
-    if (p.file.empty() || !p.mesh) continue;
+    if (p.file.empty() || !p.mesh || open_surfaces_.count(p.name) != 0) continue;
     if (const std::optional<std::string> flaw = interaction::surface_flaw(*p.mesh)) {
       scenario_.warnings.push_back(p.where.str() + ": part '" + p.name + "' (" + p.file +
                                    ") is not a closed surface: " + *flaw + "; " +

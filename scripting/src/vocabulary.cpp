@@ -54,6 +54,10 @@ std::vector<Word> make_vocabulary() {
         {"at", kVector, kOptional, "position of the part's origin (default {0, 0, 0})"},
         {"turn", kTurn, kOptional, "orientation: degrees about x, then y, then z"},
         {"fixed", kFlag, kOptional, "true: the part never moves (default false)"},
+        {"open_surface", kFlag, kOptional,
+         "true: the mesh is known not to be a closed, consistently wound surface (a model "
+         "shown beside the assembly), so loading does not warn of it; overlaps with it are "
+         "still measured unreliably (default false)"},
         {"attached_to", kPart, kOptional,
          "another part it is attached to from the start, where it is placed (as `attach`)"},
         {"color", kColor, kOptional,

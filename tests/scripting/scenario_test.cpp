@@ -661,6 +661,18 @@ TEST(ScenarioLoad, AnOpenOrWronglyWoundMeshIsAWarningThatCounts) {
   ASSERT_EQ(o.expectations.size(), 1u);
   EXPECT_NE(o.expectations[0].detail.find("2 warnings"), std::string::npos)
       << o.expectations[0].detail;
+
+  // A part declared open_surface = true is known to be open: no warning of it.
+  const auto declared = write(dir, "declared.lua", R"(return scenario {
+  name = "open", units = "mm",
+  parts = {
+    box = part { mesh = "open.obj", fixed = true, open_surface = true },
+    lid = part { mesh = "flipped.obj", at = { 0, 0, 40 } },
+  },
+})");
+  const Scenario d = check_scenario(declared);
+  ASSERT_EQ(d.warnings.size(), 1u);
+  EXPECT_NE(d.warnings[0].find("part 'lid'"), std::string::npos) << d.warnings[0];
 }
 
 TEST(ScenarioLoad, CheckWarnsOfAPlanInOtherUnitsAsTheRunDoes) {
