@@ -21,6 +21,7 @@
 #include "dovetail/collision/primitives.h"
 #include "dovetail/engine/mesh_import.h"
 #include "dovetail/engine/pose_list.h"
+#include "dovetail/interaction/hand_model.h"
 #include "dovetail/interaction/overlap.h"
 #include "dovetail/scripting/lua_host.h"
 #include "dovetail/scripting/scenario.h"
@@ -188,6 +189,7 @@ class Loader {
 
   Scenario load();
   void warn_about_mesh_sizes();
+  void warn_about_parts_beside_the_hand();
   void warn_about_open_surfaces();
 
  private:
@@ -212,6 +214,41 @@ class Loader {
   /// names every such mistake, by line.
   void note(const SourceLocation& where, const std::string& message) {
     noted_.push_back({where, message});
+  }
+
+  /// The line of `key = ...` in the declaration that starts at `where`: the
+  /// first line at or after it that assigns the key, outside comments; where
+  /// itself when there is none (a table built by a loop, say). Lua keeps no
+  /// line for a table's fields, so a mistake in one would otherwise be named
+  /// at the line its declaration opens.
+  SourceLocation field_line(const SourceLocation& where, std::string_view key) {
+    if (where.line <= 0 || key.empty()) return where;
+    auto [it, fresh] = source_lines_.try_emplace(where.file);
+    if (fresh) {
+      std::ifstream in(where.file, std::ios::binary);
+      for (std::string line; std::getline(in, line);) it->second.push_back(line);
+    }
+    const std::vector<std::string>& lines = it->second;
+    const auto is_name = [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_';
+    };
+    constexpr std::size_t kReach = 400;  // lines a declaration may span
+    for (std::size_t i = static_cast<std::size_t>(where.line) - 1;
+         i < lines.size() && i < static_cast<std::size_t>(where.line) - 1 + kReach; ++i) {
+      const std::string_view line = std::string_view(lines[i]).substr(0, lines[i].find("--"));
+      for (std::size_t at = line.find(key); at != std::string_view::npos;
+           at = line.find(key, at + 1)) {
+        if (at > 0 && (is_name(line[at - 1]) || line[at - 1] == '.')) continue;
+        std::size_t next = at + key.size();
+        if (next < line.size() && is_name(line[next])) continue;
+        while (next < line.size() && (line[next] == ' ' || line[next] == '\t')) ++next;
+        if (next < line.size() && line[next] == '=' &&
+            (next + 1 >= line.size() || line[next + 1] != '=')) {
+          return {where.file, static_cast<int>(i) + 1};
+        }
+      }
+    }
+    return where;
   }
 
   void throw_noted() const {
@@ -616,7 +653,8 @@ class Loader {
     for (const Param& p : word.params) known.emplace_back(p.name);
     for (const std::string& key : keys) {
       if (std::find(known.begin(), known.end(), key) == known.end()) {
-        note(where, what + ": unknown field '" + key + "'" + did_you_mean(key, known));
+        note(field_line(where, key),
+             what + ": unknown field '" + key + "'" + did_you_mean(key, known));
       }
     }
     for (const lua_Integer p : positions) {
@@ -636,7 +674,7 @@ class Loader {
     Arg arg;
     raw_getfield(index, std::string(name));
     if (lua_type(L_, -1) != LUA_TNIL) {
-      arg = arg_at(lua_gettop(L_), p, where, what);
+      arg = arg_at(lua_gettop(L_), p, field_line(where, name), what);
     } else if (!p.optional) {
       lua_pop(L_, 1);
       fail(where, what + ": missing field '" + std::string(name) + "'");
@@ -735,6 +773,8 @@ class Loader {
   std::vector<Problem> noted_;  ///< see note()
   std::vector<std::filesystem::path>* files_read_ = nullptr;
   bool hand_given_ = false;  ///< a replayed trace gives the hand the scenario lacks
+  /// The lines of the files read, for field_line.
+  std::map<std::string, std::vector<std::string>> source_lines_;
   std::map<std::string, engine::ImportReport> imports_;  ///< mesh files read by node
   /// Parts declared `open_surface = true`: no warning about their surface.
   std::set<std::string> open_surfaces_;
@@ -1263,7 +1303,7 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
     switch (clause.word->params[i].type) {
       case ArgType::kPartOrHand:
         if (arg.text == "hand") {
-          if (!scenario_.glove)
+          if (!scenario_.glove && !hand_given_)
             note(clause.where, std::string(clause.word->name) + ": the scenario has no hand");
           break;
         }
@@ -1339,6 +1379,51 @@ void Loader::warn_about_mesh_sizes() {
   }
 }
 
+/// Parts from mesh files that agree with each other but not with the hand:
+/// a median of under 1/200 or over 200 times the hand's length, where a
+/// hand grasps parts of millimetres to a metre. A whole product exported in
+/// metres into a scenario in millimetres (or the other way round) is such a
+/// set; warn_about_mesh_sizes, which compares parts with each other, misses it.
+void Loader::warn_about_parts_beside_the_hand() {
+  if (!scenario_.glove) return;
+  std::vector<double> sizes;
+  for (const PartSpec& p : scenario_.parts) {
+    if (p.file.empty() || !p.mesh) continue;
+    Eigen::AlignedBox<double, 3> box;
+    for (const Vec3& v : p.mesh->vertices) box.extend(v);
+    sizes.push_back(box.diagonal().norm());  // metres (the vertices are scaled)
+  }
+  if (sizes.empty()) return;
+  std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
+  const double median = sizes[sizes.size() / 2];
+  double hand = scenario_.glove->hand_length;
+  for (const interaction::HandSize& size : interaction::hand_sizes()) {
+    if (hand == 0 && size.name == interaction::HandDef{}.size) hand = size.hand_length;
+  }
+  constexpr double kRatio = 200;
+  if (!(median > 0) || (median >= hand / kRatio && median <= hand * kRatio)) return;
+  const double per_unit = scenario_.metres_per_unit;
+  const auto brief = [](double x) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.3g", x);
+    return std::string(buffer);
+  };
+  const auto whole = [](double x) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.0f", x);
+    return std::string(buffer);
+  };
+  const std::string& units = scenario_.units;
+  const double ratio = hand / median;
+  scenario_.warnings.push_back(
+      scenario_.glove->where.str() + ": the parts from mesh files are a median of " +
+      brief(median / per_unit) + " " + units + " across, " +
+      (ratio > 1 ? "1/" + whole(ratio) + " of" : whole(1 / ratio) + " times") + " the hand (" +
+      brief(hand / per_unit) + " " + units +
+      "): are the files in other units? A mesh file's numbers are read in the scenario's (" +
+      units + ")");
+}
+
 /// A part from a mesh file whose surface is open or inconsistently wound:
 /// its overlaps are measured wrong or not at all (interaction::surface_flaw),
 /// and nothing else would say so. Generated shapes are closed by construction.
@@ -1373,8 +1458,8 @@ void Loader::resolve() {
     }
   };
   for (const MateSpec& m : scenario_.mates) {
-    check_part(m.mate.part, m.where, "mate '" + m.mate.name + "'");
-    check_part(m.mate.other, m.where, "mate '" + m.mate.name + "'");
+    check_part(m.mate.part, field_line(m.where, "part"), "mate '" + m.mate.name + "'");
+    check_part(m.mate.other, field_line(m.where, "into"), "mate '" + m.mate.name + "'");
     if (fixed(m.mate.part))
       note(m.where, "mate '" + m.mate.name + "': its part '" + m.mate.part + "' is fixed");
   }
@@ -1392,7 +1477,7 @@ void Loader::resolve() {
   for (const PartSpec& p : scenario_.parts) {
     if (p.attached_to.empty()) continue;
     const std::string what = "part '" + p.name + "': attached_to";
-    check_part(p.attached_to, p.where, what);
+    check_part(p.attached_to, field_line(p.where, "attached_to"), what);
     if (p.attached_to == p.name) {
       note(p.where, what + ": a part cannot be attached to itself");
       continue;
@@ -1412,6 +1497,7 @@ void Loader::resolve() {
     }
   }
   warn_about_mesh_sizes();
+  warn_about_parts_beside_the_hand();
   warn_about_open_surfaces();
   if (scenario_.glove && !scenario_.glove->holding.empty()) {
     check_part(scenario_.glove->holding, scenario_.glove->where, "glove: holding");

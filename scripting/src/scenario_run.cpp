@@ -313,6 +313,9 @@ class Runner {
       measured_;
   SourceLocation current_where_{};
   bool failed_by_rule_ = false;
+  /// In the frame after the last, which only finishes the last frame's
+  /// actions: timers (after, every) are past the run's end and do not fire.
+  bool past_end_ = false;
 };
 
 // ---- Lua side of the low-level API. These functions hold no C++ object with a
@@ -765,6 +768,7 @@ bool Runner::matches(const Clause& when, const Occurrence& o) const {
 }
 
 bool Runner::timer_fires(const Clause& when, double now, double previous) const {
+  if (past_end_) return false;  // the frame that finishes the last one's actions
   const std::string_view w = when.word->name;
   const double t = when.args[0].number;
   if (w == "after") return now >= t && previous < t;
@@ -1189,6 +1193,19 @@ void Runner::run() {
   // that a rule at the end time (after(duration)) has its frame.
   const auto frames =
       static_cast<std::uint64_t>(std::ceil(end_time / scenario_.time_step - 1e-9)) + 1;
+  // A time past the last frame never comes: after(t) there can never fire.
+  const double last_time = static_cast<double>(frames - 1) * scenario_.time_step;
+  const auto never_after = [&](const Clause& c, const std::string& context) {
+    if (c.word->name == "after" && c.args[0].number > last_time + 1e-9) {
+      out_.warnings.push_back(c.where.str() + ": " + context + c.text +
+                              " can never happen: the run ends at t=" + format_time(last_time) +
+                              " s");
+    }
+  };
+  for (const StepSpec& step : scenario_.steps) {
+    if (step.done) never_after(*step.done, "step '" + step.name + "': ");
+  }
+  for (const RuleSpec& rule : scenario_.rules) never_after(rule.when, "rule: ");
   std::optional<engine::ProgressMeter> meter;
   if (options_.progress) meter.emplace(frames);
   const auto loop_start = std::chrono::steady_clock::now();
@@ -1209,6 +1226,7 @@ void Runner::run() {
     // the next: one frame more, a whole one (its contacts found, its events
     // and steps counted, the state hashed), so that no action is lost.
     if (!failed_by_rule_ && !pending_.empty()) {
+      past_end_ = true;
       const engine::FrameResult& result = sim_->step();
       end_frame(result, previous);
     }

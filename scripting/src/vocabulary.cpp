@@ -226,7 +226,8 @@ std::vector<Word> make_vocabulary() {
       {"every",
        WordKind::kEvent,
        {{"seconds", kSeconds, kRequired, "the period, > 0"}},
-       "In the first frame at or after each multiple of the period, t = p, 2p, ... (not at 0). "
+       "In the first frame at or after each multiple of the period, t = p, 2p, ... (not at 0): "
+       "once a frame for a period shorter than the time step. "
        "A rule fires at most once per its cooldown (default 0.1 s): for a shorter period give "
        "the rule cooldown = 0.",
        "every(1)"});

@@ -116,16 +116,67 @@ TEST(ScenarioLoad, AttachingAFixedPartOrAPartToItselfIsAnError) {
       << itself;
 }
 
-TEST(ScenarioLoad, TheScenarioTablesOwnFieldsAreNamedAtItsReturnLine) {
+TEST(ScenarioLoad, TheScenarioTablesOwnFieldsAreNamedAtTheirLines) {
   // `return scenario { ... }` is a tail call, which keeps no line: the
-  // loader names the line of the file's `return scenario`.
+  // loader finds the line of the file's `return scenario`, and below it the
+  // field's own.
   const test::TempDir dir("dovetail_scenario");
   const std::string what = load_error(
       write(dir, "own.lua",
             "-- return scenario in a comment\n" + moved_peg("", "", "  durration = 1,\n")));
-  EXPECT_NE(what.find("own.lua:2: scenario: unknown field 'durration' (did you mean 'duration'?)"),
+  EXPECT_NE(what.find("own.lua:23: scenario: unknown field 'durration' (did you mean 'duration'?)"),
             std::string::npos)
       << what;
+}
+
+TEST(ScenarioLoad, AMistakeInAFieldIsNamedAtTheFieldsLine) {
+  // Lua keeps no line for a table's fields: the loader finds the line that
+  // assigns the field, below the line its declaration opens.
+  const test::TempDir dir("dovetail_scenario");
+  const std::string pin = R"(return scenario {
+  name = "lines", units = "mm",
+  parts = {
+    block = part {
+      shape = box { size = { 40, 40, 40 } },  -- at = { 1 } in a comment is no field
+      fixed = true,
+    },
+    pin = part {
+      shape = cylinder { diameter = 10, length = 60 },
+      at = { 0, 60 },
+    },
+  },
+}
+)";
+  EXPECT_NE(load_error(write(dir, "at.lua", pin))
+                .find("at.lua:10: part 'pin' 'at' must be three numbers"),
+            std::string::npos)
+      << load_error(write(dir, "at.lua", pin));
+  const std::string mate = R"(return scenario {
+  name = "lines", units = "mm",
+  parts = {
+    block = part { shape = box { size = { 40, 40, 40 } }, fixed = true },
+    pin = part { shape = cylinder { diameter = 10, length = 60 }, at = { 0, 60, 0 } },
+  },
+  mates = {
+    pin_home = mate {
+      part = "pin",
+      point = { 0, 0, 44 },
+      axis = "z",
+      into = "blok",
+      at = { 0, 0, 33 },
+      along = "z",
+      tolerence = 1,
+    },
+  },
+}
+)";
+  const std::string what = load_error(write(dir, "mate.lua", mate));
+  const std::size_t into = what.find("mate.lua:12: mate 'pin_home': ");
+  const std::size_t tolerance =
+      what.find("mate.lua:15: mate 'pin_home': unknown field 'tolerence'");
+  EXPECT_NE(into, std::string::npos) << what;
+  EXPECT_NE(tolerance, std::string::npos) << what;
+  EXPECT_LT(into, tolerance) << "in the order of the file: " << what;
 }
 
 TEST(ScenarioLoad, AMateAngleOutsideItsRangeIsNamed) {
@@ -327,6 +378,28 @@ TEST(ScenarioRun, ASnapOfAPartInPlaceAlreadyFiresNoSecondMated) {
   EXPECT_EQ(seated, 1);
 }
 
+TEST(ScenarioRun, AnAfterPastTheRunsEndIsAWarning) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(dir, "late.lua", R"(return scenario {
+  name = "late", units = "mm", duration = 0.3,
+  parts = { a = part { shape = box { size = { 10, 10, 10 } } } },
+  rules = {
+    rule { when = after(0.3), act = { log "at the end" } },
+    rule { when = after(1e9), act = { log "never" } },
+  },
+})");
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+  ASSERT_EQ(o.warnings.size(), 1u);
+  EXPECT_NE(
+      o.warnings[0].find("late.lua:6: rule: after(1000000000) can never happen: the run ends at "
+                         "t=0.300 s"),
+      std::string::npos)
+      << o.warnings[0];
+  ASSERT_EQ(o.messages.size(), 1u);
+  EXPECT_EQ(o.messages[0].text, "at the end");
+}
+
 TEST(ScenarioRun, AStepOutOfOrderFailsNamingTheStepsAndTimes) {
   const test::TempDir dir("dovetail_scenario");
   const auto file =
@@ -421,20 +494,34 @@ TEST(ScenarioRun, ARuleFiredInTheLastFrameGetsOneFrameMoreForItsActions) {
   ASSERT_EQ(e.status, RunOutcome::Status::kError) << e.failure_summary();
   EXPECT_NE(e.error.find("boom"), std::string::npos) << e.error;
 
-  // A rule firing every frame leaves a move for a 93rd frame: not done, said.
+  // A rule on an event of the 92nd frame (the snap's) leaves a move for a
+  // 93rd: not done, said.
+  const auto chained =
+      write(dir, "chained.lua",
+            moved_peg("    rule { when = after(1), act = { snap \"peg_in_hole\" } },\n"
+                      "    rule { when = mated \"peg_in_hole\", act = { move(\"peg\", { 0, 200, 0 "
+                      "}) } },",
+                      ""));
+  const auto not_done = [](const RunOutcome& run) {
+    int count = 0;
+    for (const Message& msg : run.messages) {
+      count += msg.level == "warn" &&
+               msg.text == "move: not done: its rule fired in the run's last frame";
+    }
+    return count;
+  };
+  const RunOutcome m = run_scenario(chained);
+  EXPECT_EQ(not_done(m), 1) << m.to_json();
+
+  // Timers are past the run's end in the 92nd frame: a rule firing every
+  // frame leaves nothing undone there.
   const auto every =
       write(dir, "every.lua",
-            moved_peg("    rule { when = after(1), act = { move(\"lid\", { 100, 5, 0 }) } },\n"
-                      "    rule { when = every(1 / 90), cooldown = 0, act = { move(\"peg\", { 0, "
+            moved_peg("    rule { when = every(1 / 90), cooldown = 0, act = { move(\"peg\", { 0, "
                       "200, 0 }) } },",
                       ""));
-  const RunOutcome m = run_scenario(every);
-  bool said = false;
-  for (const Message& msg : m.messages) {
-    said = said || (msg.level == "warn" &&
-                    msg.text == "move: not done: its rule fired in the run's last frame");
-  }
-  EXPECT_TRUE(said) << m.to_json();
+  const RunOutcome r = run_scenario(every);
+  EXPECT_EQ(not_done(r), 0) << r.to_json();
 }
 
 TEST(ScenarioRun, ARunReachesItsDurationWhenItIsNoMultipleOfTheTimeStep) {
@@ -620,6 +707,40 @@ TEST(ScenarioLoad, AMeshFileInOtherUnitsThanTheScenarioIsAWarning) {
             std::string::npos)
       << s.warnings[0];
   EXPECT_NE(s.warnings[0].find("is the file in other units?"), std::string::npos) << s.warnings[0];
+}
+
+TEST(ScenarioLoad, PartsFromMeshFilesFarFromTheHandsSizeAreAWarning) {
+  // A whole product exported in metres (a 60 mm and an 80 mm box) read in a
+  // scenario in millimetres: the parts agree with each other, but are
+  // 0.1 mm across beside a 190 mm hand. In metres, the same files pass.
+  const test::TempDir dir("dovetail_scenario");
+  const auto box = [](double a) {
+    std::string text;
+    for (int i = 0; i < 8; ++i) {
+      text += "v " + std::to_string(i & 1 ? a : 0) + " " + std::to_string(i & 2 ? a : 0) + " " +
+              std::to_string(i & 4 ? a : 0) + "\n";
+    }
+    return text +
+           "f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\nf 3 7 4\nf 4 7 8\n"
+           "f 1 5 3\nf 3 5 7\nf 2 4 6\nf 4 8 6\n";
+  };
+  write(dir, "small.obj", box(0.06));
+  write(dir, "large.obj", box(0.08));
+  write(dir, "hand.plan", "start 0 0.2 0  1 0 0 0\nwait 0.1\n");
+  const auto scenario = [&](const char* units) {
+    return write(dir, std::string(units) + ".lua",
+                 "return scenario {\n  name = \"units\", units = \"" + std::string(units) +
+                     "\",\n  parts = { a = part { mesh = \"small.obj\" }, b = part { mesh = "
+                     "\"large.obj\" } },\n  hand = glove { plan = \"hand.plan\" },\n}\n");
+  };
+  const Scenario mm = check_scenario(scenario("mm"));
+  ASSERT_EQ(mm.warnings.size(), 1u);
+  EXPECT_NE(mm.warnings[0].find("mm.lua:4: the parts from mesh files are a median of 0.139 mm "
+                                "across, 1/1371 of the hand (190 mm): are the files in other "
+                                "units?"),
+            std::string::npos)
+      << mm.warnings[0];
+  EXPECT_TRUE(check_scenario(scenario("m")).warnings.empty());
 }
 
 TEST(ScenarioLoad, AnOpenOrWronglyWoundMeshIsAWarningThatCounts) {
@@ -1339,6 +1460,26 @@ TEST(ScenarioReplay, AScenarioWithoutAGloveGetsTheTracesHandWithoutAWarning) {
   for (const std::string& w : o.warnings) EXPECT_EQ(w.find("has no hand"), std::string::npos) << w;
   EXPECT_FALSE(run_scenario(dir / "scenarios" / "noglove.lua").warnings.empty())
       << "run without the trace: the rule on released() can never happen";
+}
+
+TEST(ScenarioReplay, AScenarioWithoutAGloveMayNameTheHandWhenReplayed) {
+  // touches("hand", ...) needs a hand: run alone, the scenario has none (an
+  // error at its line); replayed, the trace's hand is there.
+  const test::TempDir dir("dovetail_scenario");
+  RunOptions replay;
+  replay.trace = recorded_peg_trace(dir);
+  std::filesystem::create_directories(dir / "scenarios");
+  const std::string text = std::regex_replace(
+      std::regex_replace(peg_in_hole_text(), std::regex("  hand = glove [^\n]*\n"), ""),
+      std::regex("  rules = \\{\n"),
+      "  rules = {\n    rule { when = touches(\"hand\", \"peg\"), act = { log \"touched\" } },\n");
+  std::ofstream(dir / "scenarios" / "hand.lua") << text;
+  const RunOutcome o = run_scenario(dir / "scenarios" / "hand.lua", replay);
+  ASSERT_NE(o.status, RunOutcome::Status::kError) << o.error;
+  const RunOutcome alone = run_scenario(dir / "scenarios" / "hand.lua");
+  ASSERT_EQ(alone.status, RunOutcome::Status::kError);
+  EXPECT_NE(alone.error.find("touches: the scenario has no hand"), std::string::npos)
+      << alone.error;
 }
 
 TEST(ShippedScenarios, PegInHolePassesAndGivesTheSameReportAtAnyThreadCountAndOnReplay) {
