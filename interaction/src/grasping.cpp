@@ -42,6 +42,19 @@ DigitJoints digit_joints(std::size_t digit) {
           {static_cast<Segment>(s), static_cast<Segment>(s + 1), static_cast<Segment>(s + 2)}};
 }
 
+/// A digit's joints from the palm outward, those at one knuckle together:
+/// the thumb's carpometacarpal joint turns by roll and abduction.
+std::vector<std::vector<std::size_t>> joint_stages(std::size_t digit) {
+  if (digit == 0) {
+    return {
+        {static_cast<std::size_t>(Joint::kThumbRoll), static_cast<std::size_t>(Joint::kThumbAbd)},
+        {static_cast<std::size_t>(Joint::kThumbMcp)},
+        {static_cast<std::size_t>(Joint::kThumbIp)}};
+  }
+  const std::size_t j = static_cast<std::size_t>(Joint::kIndexMcp) + 3 * (digit - 1);
+  return {{j}, {j + 1}, {j + 2}};
+}
+
 Real flexion(const JointAngles& q, const DigitJoints& d) {
   Real sum = 0;
   for (std::size_t j : d.flexion) sum += q[j];
@@ -254,17 +267,35 @@ void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
     const DigitJoints d = digit_joints(digit);
     if (flexion(target, d) <= flexion(previous, d)) continue;  // opening: nothing to stop
     if (!digit_collides(angles, d)) continue;
-    // Closing into a part: from the last free posture toward the glove's, to the first contact.
+    // Closing into a part: from the last free posture toward the glove's, to
+    // the first contact. Then, as a finger curls round a handle once its
+    // base is stopped, the joints beyond the first close on together toward
+    // the glove's angles, to their own first contact, and so on outward: a
+    // digit stopped whole at its first contact leaves its tip in the air.
     JointAngles q = angles;
     for (std::size_t j : d.joints) q[j] = previous[j];
     if (digit_collides(q, d)) continue;  // already in contact where it was: the glove's angles
-    Real free = 0, hit = 1;
-    for (int i = 0; i < settings_.grasp.finger_bisection_steps; ++i) {
-      const Real mid = (free + hit) / 2;
-      for (std::size_t j : d.joints) q[j] = previous[j] + mid * (target[j] - previous[j]);
-      (digit_collides(q, d) ? hit : free) = mid;
+    const std::vector<std::vector<std::size_t>> stages = joint_stages(digit);
+    for (std::size_t stage = 0; stage < stages.size(); ++stage) {
+      std::vector<std::size_t> moving;
+      for (std::size_t k = stage; k < stages.size(); ++k) {
+        moving.insert(moving.end(), stages[k].begin(), stages[k].end());
+      }
+      const JointAngles from = q;
+      const auto at = [&](Real f) {
+        for (std::size_t j : moving) q[j] = from[j] + f * (target[j] - from[j]);
+      };
+      at(1);
+      if (!digit_collides(q, d)) break;  // the rest reach the glove's angles
+      Real free = 0, hit = 1;
+      for (int i = 0; i < settings_.grasp.finger_bisection_steps; ++i) {
+        const Real mid = (free + hit) / 2;
+        at(mid);
+        (digit_collides(q, d) ? hit : free) = mid;
+      }
+      at(free);
     }
-    for (std::size_t j : d.joints) angles[j] = previous[j] + free * (target[j] - previous[j]);
+    for (std::size_t j : d.joints) angles[j] = q[j];
   }
 }
 
@@ -282,31 +313,47 @@ std::vector<GraspContact> Grasping::touches(const engine::Scene& scene, PartId p
     const auto segment = static_cast<Segment>(i);
     const Transform X_WS = engine::compose(hand_->X_WH(), pose.X_HS[i]);
     const auto& proxy = model.proxy(segment);
-    if (!overlap(collision::transformed_bounds(models_->mesh_bounds(proxy), X_WS), part_box,
-                 settings_.grasp.contact_gap)) {
+    const Real gap = segment == Segment::kPalm
+                         ? std::max(settings_.grasp.palm_gap, settings_.grasp.contact_gap)
+                         : settings_.grasp.contact_gap;
+    if (!overlap(collision::transformed_bounds(models_->mesh_bounds(proxy), X_WS), part_box, gap)) {
       continue;
     }
     ++stats_.contact_queries;
-    const collision::ToleranceResult r =
-        collision::within_tolerance(part_model, models_->distance_model(proxy),
-                                    engine::compose(X_PW, X_WS), settings_.grasp.contact_gap);
+    const collision::ToleranceResult r = collision::within_tolerance(
+        part_model, models_->distance_model(proxy), engine::compose(X_PW, X_WS), gap);
     if (!r.within) continue;
     const auto& tri = mesh->triangles[r.triangle_a];
     const Vec3 n_P = (mesh->vertices[tri[1]] - mesh->vertices[tri[0]])
                          .cross(mesh->vertices[tri[2]] - mesh->vertices[tri[0]])
                          .normalized();
     out.push_back({segment, X_WP.apply(r.p_A), X_WP.R * n_P});
+    if (segment != Segment::kPalm) continue;
+    // The palm meets a handle along a line, where its one nearest point may
+    // lie under another finger than the one that wraps round: each strip
+    // of it (one a finger's ray) touches where it does.
+    for (const auto& strip : model.palm_strips()) {
+      ++stats_.contact_queries;
+      const collision::ToleranceResult s = collision::within_tolerance(
+          part_model, models_->distance_model(strip), engine::compose(X_PW, X_WS), gap);
+      if (!s.within) continue;
+      const auto& t = mesh->triangles[s.triangle_a];
+      const Vec3 n_S = (mesh->vertices[t[1]] - mesh->vertices[t[0]])
+                           .cross(mesh->vertices[t[2]] - mesh->vertices[t[0]])
+                           .normalized();
+      out.push_back({segment, X_WP.apply(s.p_A), X_WP.R * n_S});
+    }
   }
   return out;
 }
 
 std::optional<GraspType> classify_grasp(std::span<const GraspContact> touches, Real friction) {
   const Real cos_cone = std::cos(std::atan(friction));
-  const GraspContact* palm = nullptr;
+  std::vector<const GraspContact*> palm;  // the palm may touch in several places
   const GraspContact* tip[kDigitCount] = {};
   std::vector<const GraspContact*> fingers;  // touching segments of the digits
   for (const GraspContact& t : touches) {
-    if (t.segment == Segment::kPalm) palm = &t;
+    if (t.segment == Segment::kPalm) palm.push_back(&t);
     const std::optional<std::size_t> digit = digit_of(t.segment);
     if (!digit) continue;
     fingers.push_back(&t);
@@ -316,9 +363,11 @@ std::optional<GraspType> classify_grasp(std::span<const GraspContact> touches, R
   auto opposes = [&](const GraspContact* a, const GraspContact* b) {
     return a && b && oppose(a->p_W, a->n_W, b->p_W, b->n_W, cos_cone);
   };
-  if (palm && fingers.size() >= 2) {
-    for (const GraspContact* f : fingers) {
-      if (opposes(palm, f)) return GraspType::kPower;
+  if (!palm.empty() && fingers.size() >= 2) {
+    for (const GraspContact* p : palm) {
+      for (const GraspContact* f : fingers) {
+        if (opposes(p, f)) return GraspType::kPower;
+      }
     }
   }
   // 3-point pinch: the index and middle tips act as one virtual finger (Feix et al.)

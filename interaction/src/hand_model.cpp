@@ -71,7 +71,9 @@ void orient_outward(const std::vector<Vec3>& vertices,
   }
 }
 
-collision::Mesh palm_mesh(const HandModel& hand) {
+/// The palm, or the part of it between fractions `from` and `to` of its
+/// width from the thumb's side.
+collision::Mesh palm_mesh(const HandModel& hand, Real from = 0, Real to = 1) {
   const Real hl = hand.hand_length();
   const Vec3 index = hand.knuckle(Digit::kIndex, 0);
   const Vec3 pinky = hand.knuckle(Digit::kPinky, 0);
@@ -79,13 +81,15 @@ collision::Mesh palm_mesh(const HandModel& hand) {
   const Real x_pinky_side = pinky.x() + hand.radius(Segment::kPinkyProximal);
   const Real y_palmar = -P::kPalmPalmar * hl;
   const Real y_dorsal = P::kPalmDorsal * hl;
+  const auto x_at = [&](Real f) { return x_thumb_side + f * (x_pinky_side - x_thumb_side); };
+  const auto z_at = [&](Real f) { return index.z() + f * (pinky.z() - index.z()); };
   // A prism over the trapezoid wrist - index knuckle - little knuckle.
   std::vector<Vec3> v;
   for (const Real y : {y_palmar, y_dorsal}) {
-    v.emplace_back(x_thumb_side, y, 0);
-    v.emplace_back(x_pinky_side, y, 0);
-    v.emplace_back(x_pinky_side, y, pinky.z());
-    v.emplace_back(x_thumb_side, y, index.z());
+    v.emplace_back(x_at(from), y, 0);
+    v.emplace_back(x_at(to), y, 0);
+    v.emplace_back(x_at(to), y, z_at(to));
+    v.emplace_back(x_at(from), y, z_at(from));
   }
   std::vector<collision::TriangleIndices> t = {
       {0, 1, 2}, {0, 2, 3}, {4, 6, 5}, {4, 7, 6},  // palmar, dorsal
@@ -261,6 +265,11 @@ HandModel::HandModel(const HandDef& def) {
     proxy_[i] = std::make_shared<const collision::Mesh>(capsule_mesh(length_[i], radius_[i]));
   }
   proxy_[0] = std::make_shared<const collision::Mesh>(palm_mesh(*this));
+  for (std::size_t i = 0; i < palm_strips_.size(); ++i) {
+    const auto n = static_cast<Real>(palm_strips_.size());
+    palm_strips_[i] = std::make_shared<const collision::Mesh>(
+        palm_mesh(*this, static_cast<Real>(i) / n, static_cast<Real>(i + 1) / n));
+  }
 }
 
 Vec3 HandModel::knuckle(Digit digit, Real arch_deg) const {

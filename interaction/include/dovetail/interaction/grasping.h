@@ -48,7 +48,8 @@ struct GraspContact {
 
 /// The grasp that contacts on one part form, or nullopt (the rules of
 /// docs/interaction.md, "Contact analysis"): power (palm and two finger
-/// segments, one opposing the palm), tripod (thumb, index and middle tips, the
+/// segments, one opposing the palm, or one of the palm's contacts: the palm
+/// may touch in several places), tripod (thumb, index and middle tips, the
 /// thumb opposing index and middle as one virtual finger), precision (the thumb
 /// tip opposing the index or middle tip), in that order. Two contacts oppose
 /// when the line between them lies inside both friction cones, half-angle
@@ -58,8 +59,12 @@ std::optional<GraspType> classify_grasp(std::span<const GraspContact> contacts, 
 /// When a grasp begins and ends (defaults: notes/grasping.md).
 struct GraspSettings {
   Real contact_gap = 0.0002;  ///< a segment within this of a part touches it (GraspIt!'s 0.2 mm)
-  Real friction = 0.5;        ///< mu: contacts oppose inside cones of half-angle atan(mu)
-  int onset_frames = 3;       ///< the grasp must hold this many frames while the hand closes
+  /// The palm within this of a part touches it: its pads give by millimetres
+  /// under a grip (the proxy is rigid), and the fingers wrapping round a
+  /// handle draw it in.
+  Real palm_gap = 0.002;
+  Real friction = 0.5;   ///< mu: contacts oppose inside cones of half-angle atan(mu)
+  int onset_frames = 3;  ///< the grasp must hold this many frames while the hand closes
   /// A grasping digit opened this far past its flexion at the grasp releases
   /// (or half of what it closed while the grasp built up, when that is less,
   /// once it has closed this far past its flexion at the grasp).

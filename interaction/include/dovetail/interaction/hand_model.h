@@ -173,6 +173,13 @@ class HandModel {
     return proxy_[static_cast<std::size_t>(segment)];
   }
 
+  /// The palm cut across its width into four strips, one under each
+  /// finger's ray, in the palm's frame: where along a handle the palm
+  /// touches it, for the power grasp's opposition.
+  const std::array<std::shared_ptr<const collision::Mesh>, 4>& palm_strips() const {
+    return palm_strips_;
+  }
+
   /// Segment poses in H for joint angles that are already within limits
   /// (clamp_to_limits); the wrist angles are ignored.
   HandPose forward_kinematics(const JointAngles& angles) const;
@@ -188,6 +195,7 @@ class HandModel {
   Real hand_length_ = 0;
   std::array<Real, kSegmentCount> length_{};
   std::array<Real, kSegmentCount> radius_{};
+  std::array<std::shared_ptr<const collision::Mesh>, 4> palm_strips_{};
   std::array<std::shared_ptr<const collision::Mesh>, kSegmentCount> proxy_{};
 };
 
