@@ -218,6 +218,25 @@ int check(std::span<const std::string> argv) {
   for (const std::string& doubt : interaction::trace_doubts(path, samples)) {
     std::fprintf(stderr, "warning: %s: %s\n", path.c_str(), doubt.c_str());
   }
+  // What a run would say of the trace in any scene: a start on a device
+  // clock, and a tracker far from any bench (positions in millimetres).
+  if (const double start = samples.front().t; start > 1) {
+    std::fprintf(stderr,
+                 "warning: %s: it starts at t=%.6g s; a run replays from t = 0 and the hand "
+                 "stays at its first sample until then (shift its times to start at 0)\n",
+                 path.c_str(), start);
+  }
+  constexpr double kFar = 20;  // metres: no workspace a tracker covers
+  for (const interaction::GloveSample& g : samples) {
+    if (g.p_WH.norm() > kFar) {
+      std::fprintf(stderr,
+                   "warning: %s: the tracker is %.6g m from the origin at t=%.6g s, where a "
+                   "tracked workspace is a few metres: are its positions in millimetres? A "
+                   "trace is in metres\n",
+                   path.c_str(), g.p_WH.norm(), g.t);
+      break;
+    }
+  }
   print_summary("check", samples, "");
   return kExitOk;
 }

@@ -196,14 +196,24 @@ std::shared_ptr<const interaction::GloveSource> glove_source(
         doubts = "; " + *sparse;
       }
     }
-    throw ScenarioError((replay ? std::string() : glove.where.str() + ": glove: ") + file.string() +
-                        ": the " + (trace ? "trace" : "plan") +
-                        " ends at t=" + format_time(source->end_time()) + " s" +
-                        (start > 1 ? " (it starts at t=" + format_time(start) +
-                                         " s; its times are seconds from the start of the run)"
-                                   : std::string()) +
-                        ", later than the " + format_time(kMaxRunSeconds) + " s a run may last" +
-                        (doubts.empty() ? "; give the scenario a duration" : doubts));
+    // A trace on a device clock fits once its times are shifted; a longer
+    // take can only be cut short.
+    std::string advice = doubts;
+    if (advice.empty() && start > 1 && source->end_time() - start <= kMaxRunSeconds) {
+      char exact[40];  // the start to the digit, which the shift needs
+      std::snprintf(exact, sizeof exact, "%.15g", start);
+      advice = "; shift its times to start at 0 (subtract " + std::string(exact) + " s from each)";
+    } else if (advice.empty()) {
+      advice = "; a scenario's duration (at most " + format_time(kMaxRunSeconds) +
+               " s) replays its first part only";
+    }
+    throw ScenarioError(
+        (replay ? std::string() : glove.where.str() + ": glove: ") + file.string() + ": the " +
+        (trace ? "trace" : "plan") + " ends at t=" + format_time(source->end_time()) + " s" +
+        (start > 1 ? " (it starts at t=" + format_time(start) +
+                         " s; its times are seconds from the start of the run)"
+                   : std::string()) +
+        ", later than the " + format_time(kMaxRunSeconds) + " s a run may last" + advice);
   }
   return source;
 }

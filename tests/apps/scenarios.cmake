@@ -95,7 +95,7 @@ file(WRITE ${out}/check_plan/long_plan.lua
      "return scenario { name = \"long plan\", parts = { b = part { shape = box { size = { 1, 1, 1 } } } },\n"
      "  hand = glove { plan = \"long.plan\" } }\n")
 dovetail_cli_test(check_plan_too_long EXIT 1 ARGS check ${out}/check_plan/long_plan.lua
-                  STDERR "long_plan.lua:2: glove: .*long.plan: the plan ends at t=1e\\+12 s, later than the 3600.000 s a run may last; give the scenario a duration")
+                  STDERR "long_plan.lua:2: glove: .*long.plan: the plan ends at t=1e\\+12 s, later than the 3600.000 s a run may last; a scenario's duration \\(at most 3600.000 s\\) replays its first part only")
 dovetail_cli_test(run_plan_too_long EXIT 1 ARGS run ${out}/check_plan/long_plan.lua --report ${out}/check_plan/long.json
                   STDERR "the plan ends at t=1e\\+12 s"
                   FILE ${out}/check_plan/long.json MATCHES "\"outcome\": \"error\"&&later than the 3600.000 s")

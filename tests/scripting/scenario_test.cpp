@@ -1396,7 +1396,8 @@ TEST(ScenarioReplay, ATraceOnADeviceClockIsNamedAsSuch) {
   ASSERT_EQ(too_long.status, RunOutcome::Status::kError);
   EXPECT_NE(too_long.error.find("epoch.csv: the trace ends at t=1.73275e+09 s (it starts at "
                                 "t=1.73275e+09 s; its times are seconds from the start of the "
-                                "run), later than the"),
+                                "run), later than the 3600.000 s a run may last; shift its times "
+                                "to start at 0 (subtract 1732752000.25 s from each)"),
             std::string::npos)
       << too_long.error;
   std::filesystem::create_directories(dir / "scenarios");
