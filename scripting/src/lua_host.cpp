@@ -8,13 +8,16 @@
 // into a Lua error afterwards. Host methods that throw ScriptError do so only
 // after the protected Lua call has returned.
 
+#include <algorithm>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 #include <system_error>
+#include <utility>
 
 #include "host_state.h"
 #include "sandbox_env.h"
@@ -229,6 +232,42 @@ void restore_sources(const HostState& host, std::string& text) {
 
 // Pops the error object on top of the stack and makes the ScriptError: the
 // exhausted limit's kind and message when one is set, else `kind`.
+// Names the sandbox leaves out on purpose, and why: said after Lua's
+// "attempt to call a nil value (global 'next')", which reads like a typo.
+constexpr std::pair<std::string_view, std::string_view> kLeftOut[] = {
+    {"next",
+     "next is left out of the sandbox: the order it visits keys in differs from run to run; "
+     "pairs visits them in sorted order"},
+    {"os",
+     "os is left out of the sandbox: the clock and the system would make runs differ; dt.time() "
+     "is the simulated time"},
+    {"io",
+     "io is left out of the sandbox: scripts read and write no files; dt.log writes to the "
+     "report"},
+    {"require", "require is left out of the sandbox: a scenario is one file, its helpers in it"},
+    {"dofile", "dofile is left out of the sandbox: a scenario is one file, its helpers in it"},
+    {"loadfile", "loadfile is left out of the sandbox: a scenario is one file, its helpers in it"},
+    {"package", "package is left out of the sandbox: a scenario is one file, its helpers in it"},
+    {"debug", "debug is left out of the sandbox: it reaches past the sandbox's limits"},
+    {"collectgarbage",
+     "collectgarbage is left out of the sandbox: memory is collected as the script runs"},
+};
+
+/// `text` with the reason a global is left out added to its first line,
+/// when that line is Lua's error at a use of one.
+std::string with_left_out_reason(std::string text) {
+  const std::size_t end = std::min(text.find('\n'), text.size());
+  for (const auto& [name, reason] : kLeftOut) {
+    const std::string global = "a nil value (global '" + std::string(name) + "')";
+    const std::size_t at = text.find(global);
+    if (at != std::string::npos && at + global.size() <= end) {
+      text.insert(end, " (" + std::string(reason) + ")");
+      break;
+    }
+  }
+  return text;
+}
+
 ScriptError take_error(HostState& host, ScriptError::Kind kind) {
   lua_State* L = host.L;
   std::string text;
@@ -248,6 +287,7 @@ ScriptError take_error(HostState& host, ScriptError::Kind kind) {
     kind = *host.exhausted;
   }
   restore_sources(host, text);
+  if (kind == ScriptError::Kind::kRuntime) text = with_left_out_reason(std::move(text));
   return ScriptError(kind, text);
 }
 

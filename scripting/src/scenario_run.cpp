@@ -1266,6 +1266,12 @@ void Runner::run() {
     for (const ExpectationOutcome& e : out_.expectations) {
       if (!e.passed) out_.status = RunOutcome::Status::kFailed;
     }
+  } catch (const ScriptError& e) {
+    // A script's error during the run: when, in simulated time, on its first line.
+    out_.status = RunOutcome::Status::kError;
+    out_.error = e.what();
+    out_.error.insert(std::min(out_.error.find('\n'), out_.error.size()),
+                      " (at t=" + format_time(sim_->time()) + " s)");
   } catch (const std::exception& e) {
     out_.status = RunOutcome::Status::kError;
     out_.error = e.what();

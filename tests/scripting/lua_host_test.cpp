@@ -297,6 +297,21 @@ TEST(LuaHostBudget, CopyingIntoNewMemoryCountsAgainstTheBudget) {
   expect_works(host);
 }
 
+TEST(LuaHostSandbox, ANameLeftOutSaysWhy) {
+  LuaHost host(small_limits(), 1);
+  const ScriptError next = run_error(host, "local k = next({ a = 1 })");
+  EXPECT_EQ(next.message(),
+            "script.lua:1: attempt to call a nil value (global 'next') (next is left out of the "
+            "sandbox: the order it visits keys in differs from run to run; pairs visits them in "
+            "sorted order)");
+  const ScriptError os = run_error(host, "return os.time()");
+  EXPECT_NE(os.message().find("(global 'os') (os is left out of the sandbox"), std::string::npos)
+      << os.message();
+  // A name that is no left-out one reads as Lua has it.
+  EXPECT_EQ(run_error(host, "nxt()").message(),
+            "script.lua:1: attempt to call a nil value (global 'nxt')");
+}
+
 TEST(LuaHostBudget, HookIsInheritedByCoroutines) {
   LuaHost host(small_limits(), 1);
   const char* scripts[] = {

@@ -492,7 +492,7 @@ TEST(ScenarioRun, ARuleFiredInTheLastFrameGetsOneFrameMoreForItsActions) {
                                      ""));
   const RunOutcome e = run_scenario(fails);
   ASSERT_EQ(e.status, RunOutcome::Status::kError) << e.failure_summary();
-  EXPECT_NE(e.error.find("boom"), std::string::npos) << e.error;
+  EXPECT_NE(e.error.find("boom (at t=1.011 s)\n"), std::string::npos) << e.error;
 
   // A rule on an event of the 92nd frame (the snap's) leaves a move for a
   // 93rd: not done, said.
