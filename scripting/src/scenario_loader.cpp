@@ -120,6 +120,10 @@ SourceLocation parse_where(const std::string& text, const std::string& fallback_
   return where;
 }
 
+/// The largest coordinate a scenario may give, in metres: the collision
+/// layer's limit for a mesh (collision::MeshLimits), as a pose list's.
+constexpr double kCoordinateLimit_m = 1e30;
+
 std::string format_number(double x) {
   if (std::isnan(x)) return "nan (not a number, as 0/0 gives)";
   char buffer[32];
@@ -395,6 +399,12 @@ class Loader {
       v[i] = lua_tonumber(L_, -1);
       lua_pop(L_, 1);
       if (!std::isfinite(v[i])) fail(where, what + " must be finite");
+      // As a pose list's: beyond it, products of coordinates overflow.
+      if (std::abs(v[i]) * scenario_.metres_per_unit > kCoordinateLimit_m) {
+        fail(where, what + ": " + format_number(v[i]) + " is beyond the coordinate limit of " +
+                        format_number(kCoordinateLimit_m / scenario_.metres_per_unit) + " " +
+                        scenario_.units);
+      }
     }
     if (lua_rawlen(L_, index) != 3) fail(where, what + " must be exactly three numbers");
     return v;

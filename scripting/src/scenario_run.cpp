@@ -367,6 +367,11 @@ int api_set_translation(lua_State* L) {
     return luaL_error(L, "set_translation: coordinates must be finite");
   }
   Runner* runner = runner_of(L);
+  constexpr double kCoordinateLimit_m = 1e30;  // the scenario's and the pose lists'
+  if (std::max({std::abs(x), std::abs(y), std::abs(z)}) * runner->metres_per_unit() >
+      kCoordinateLimit_m) {
+    return luaL_error(L, "set_translation: a coordinate is beyond the limit of 1e30 m");
+  }
   Transform X;
   char error[256];
   if (!runner->part_pose(name, X, error, sizeof error)) return luaL_error(L, "%s", error);
@@ -611,6 +616,16 @@ void Runner::apply(const Clause& action, double now) {
     if (!scene.movable(p)) {
       out_.messages.push_back({now, "warn", "move: '" + a + "' is fixed and stays", action.where});
       return;
+    }
+    // A later move replaces an earlier one; two in one frame are two rules
+    // at odds, and the one written last wins.
+    for (const Motion& m : motions_) {
+      if (m.part == a && m.t0 == now) {
+        out_.messages.push_back({now, "warn",
+                                 "move: '" + a + "' was sent somewhere else in this frame too (" +
+                                     m.where.str() + "); this move, written later, wins",
+                                 action.where});
+      }
     }
     std::erase_if(motions_, [&](const Motion& m) { return m.part == a; });
     const double over = action.args[2].given ? action.args[2].number : 0;

@@ -299,7 +299,8 @@ std::vector<Word> make_vocabulary() {
                 {"over", kSeconds, kOptional, "seconds to get there (default 0: at once)"}},
                "Moves the part in a straight line, keeping its orientation. It goes where it is "
                "sent: nothing stops it on the way (max_penetration and no_contact see what it "
-               "passes through). Act when it gets there with arrives.",
+               "passes through). Act when it gets there with arrives. A move replaces the part's "
+               "move under way; of two in one frame the one written later wins, with a warning.",
                "move(\"cover\", { 0, 200, 0 }, 0.5)"});
   w.push_back({"attach",
                WordKind::kAction,
