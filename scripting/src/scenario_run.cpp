@@ -25,6 +25,7 @@
 #include "dovetail/interaction/hand.h"
 #include "dovetail/interaction/hand_model.h"
 #include "dovetail/interaction/overlap.h"
+#include "dovetail/scripting/vocabulary.h"
 
 namespace dovetail::scripting {
 
@@ -455,6 +456,34 @@ int api_log(lua_State* L) {
   return 0;
 }
 
+/// __index of the method table and of `dt` (upvalue 1: what it is, "a part"
+/// or "dt"): a name neither has is an error with the nearest name, where Lua
+/// would only say "attempt to call a nil value".
+int api_unknown(lua_State* L) {
+  const char* what = lua_tostring(L, lua_upvalueindex(1));
+  if (lua_type(L, 2) != LUA_TSTRING) return luaL_error(L, "%s has no such field", what);
+  const std::string name = lua_tostring(L, 2);
+  std::vector<std::string> known;
+  lua_pushnil(L);
+  while (lua_next(L, 1) != 0) {
+    if (lua_type(L, -2) == LUA_TSTRING) known.emplace_back(lua_tostring(L, -2));
+    lua_pop(L, 1);
+  }
+  std::sort(known.begin(), known.end());
+  return luaL_error(L, "%s has no '%s'%s", what, name.c_str(), did_you_mean(name, known).c_str());
+}
+
+/// Makes the table on top of the stack raise api_unknown for names it lacks.
+void refuse_unknown_names(lua_State* L, const char* what) {
+  lua_createtable(L, 0, 2);
+  lua_pushstring(L, what);
+  lua_pushcclosure(L, api_unknown, 1);
+  lua_setfield(L, -2, "__index");
+  lua_pushboolean(L, 0);
+  lua_setfield(L, -2, "__metatable");
+  lua_setmetatable(L, -2);
+}
+
 /// Registers the runner and pushes the `dt` table of custom actions.
 void push_api(lua_State* L) {
   lua_getfield(L, LUA_REGISTRYINDEX, "dovetail.dt");
@@ -469,6 +498,7 @@ void push_api(lua_State* L) {
                               {"set_matrix", api_set_matrix},
                               {nullptr, nullptr}};
   luaL_setfuncs(L, methods, 0);
+  refuse_unknown_names(L, "a part");
   lua_setfield(L, -2, "__index");
   lua_pushboolean(L, 0);
   lua_setfield(L, -2, "__metatable");
@@ -477,6 +507,7 @@ void push_api(lua_State* L) {
   const luaL_Reg functions[] = {
       {"part", api_part}, {"time", api_time}, {"log", api_log}, {nullptr, nullptr}};
   luaL_setfuncs(L, functions, 0);
+  refuse_unknown_names(L, "dt");
   lua_pushvalue(L, -1);
   lua_setfield(L, LUA_REGISTRYINDEX, "dovetail.dt");
 }

@@ -179,6 +179,31 @@ TEST(ScenarioLoad, AMistakeInAFieldIsNamedAtTheFieldsLine) {
   EXPECT_LT(into, tolerance) << "in the order of the file: " << what;
 }
 
+TEST(ScenarioRun, AMisspeltNameOfTheCustomActionsApiGetsTheNearestOne) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto run = [&](const std::string& name, const std::string& call) {
+    return run_scenario(write(dir, name, R"(return scenario {
+  name = "api", units = "mm", duration = 0.2,
+  parts = { a = part { shape = box { size = { 10, 10, 10 } } } },
+  rules = { rule { when = after(0.1), act = { custom(function(dt)
+    )" + call + R"( end) } } },
+})"));
+  };
+  const RunOutcome method = run("method.lua", "dt.part(\"a\"):set_translaton(1, 2, 3)");
+  ASSERT_EQ(method.status, RunOutcome::Status::kError);
+  EXPECT_NE(method.error.find("method.lua:5: a part has no 'set_translaton' (did you mean "
+                              "'set_translation'?)"),
+            std::string::npos)
+      << method.error;
+  const RunOutcome function = run("function.lua", "dt.Part(\"a\")");
+  ASSERT_EQ(function.status, RunOutcome::Status::kError);
+  EXPECT_NE(function.error.find("function.lua:5: dt has no 'Part' (did you mean 'part'?)"),
+            std::string::npos)
+      << function.error;
+  EXPECT_EQ(run("right.lua", "dt.part(\"a\"):set_translation(1, 2, 3)").status,
+            RunOutcome::Status::kPassed);
+}
+
 TEST(ScenarioLoad, CoordinatesBeyondTheLimitAreErrors) {
   // 1e300 squared overflows: refused as a pose list refuses it, at load and
   // in a custom action.
