@@ -206,6 +206,12 @@ class Loader {
   /// A problem after which reading cannot go on: reported at once, with
   /// those noted before it.
   [[noreturn]] void fail(const SourceLocation& where, const std::string& message) const {
+    if (reading_optional_field_) {
+      // An optional field's mistake: noted, the field left unread (its
+      // default stands in, and nothing else depends on it), reading goes on.
+      noted_.push_back({where, message});
+      throw OptionalFieldProblem{};
+    }
     std::vector<Problem> all = noted_;
     all.push_back({where, message});
     // A NUL in a name would end the message there: control bytes as \xNN.
@@ -682,8 +688,26 @@ class Loader {
             const std::string& what) {
     const Param& p = param(word, name);
     Arg arg;
+    const int top = lua_gettop(L_);
     raw_getfield(index, std::string(name));
-    if (lua_type(L_, -1) != LUA_TNIL) {
+    if (lua_type(L_, -1) != LUA_TNIL && p.optional && !reading_optional_field_) {
+      // A mistake here is noted and reading goes on, so that one check
+      // names the mistakes of every field.
+      struct Reading {
+        bool& flag;
+        explicit Reading(bool& f) : flag(f) { flag = true; }
+        ~Reading() { flag = false; }
+        Reading(const Reading&) = delete;
+        Reading& operator=(const Reading&) = delete;
+      };
+      try {
+        const Reading reading(reading_optional_field_);
+        arg = arg_at(lua_gettop(L_), p, field_line(where, name), what);
+      } catch (const OptionalFieldProblem&) {
+        arg = Arg{};
+        lua_settop(L_, top + 1);
+      }
+    } else if (lua_type(L_, -1) != LUA_TNIL) {
       arg = arg_at(lua_gettop(L_), p, field_line(where, name), what);
     } else if (!p.optional) {
       lua_pop(L_, 1);
@@ -780,7 +804,10 @@ class Loader {
 
   std::filesystem::path folder_;
   Scenario scenario_;
-  std::vector<Problem> noted_;  ///< see note()
+  mutable std::vector<Problem> noted_;  ///< see note(), and fail() in an optional field
+  /// Set while an optional field's value is read (field()): see fail().
+  mutable bool reading_optional_field_ = false;
+  struct OptionalFieldProblem {};
   std::vector<std::filesystem::path>* files_read_ = nullptr;
   bool hand_given_ = false;  ///< a replayed trace gives the hand the scenario lacks
   /// The lines of the files read, for field_line.

@@ -204,6 +204,33 @@ TEST(ScenarioRun, AMisspeltNameOfTheCustomActionsApiGetsTheNearestOne) {
             RunOutcome::Status::kPassed);
 }
 
+TEST(ScenarioLoad, MistakesInOptionalFieldsAreNamedAllAtOnce) {
+  // Once, each of these ended the check on its own: fixing them took four
+  // checks. An optional field's mistake now leaves the field unread and
+  // reading goes on.
+  const test::TempDir dir("dovetail_scenario");
+  const std::string what = load_error(write(dir, "many.lua", R"(return scenario {
+  name = "many", units = "mm",
+  parts = {
+    b = part { shape = box { size = { 10, 10, 10 } }, turn = { X = 90 } },
+    a = part { shape = box { size = { 10, 10, 10 } }, at = { x = 50, y = 0, z = 0 } },
+    c = part { shape = box { size = { 10, 10, 10 } }, at = { 0, 0, 80, 7 },
+               tags = { 1, 2 } },
+  },
+})"));
+  const std::vector<std::string> expected = {
+      "many.lua:4: part 'b' 'turn': unknown axis 'X'",
+      "many.lua:5: part 'a' 'at' must be three numbers { x, y, z }",
+      "many.lua:6: part 'c' 'at' must be exactly three numbers",
+      "many.lua:7: part 'c' 'tags' must be a list of names"};
+  std::size_t from = 0;
+  for (const std::string& line : expected) {
+    const std::size_t at = what.find(line, from);
+    EXPECT_NE(at, std::string::npos) << line << " in the order of the file, in:\n" << what;
+    if (at != std::string::npos) from = at;
+  }
+}
+
 TEST(ScenarioLoad, CoordinatesBeyondTheLimitAreErrors) {
   // 1e300 squared overflows: refused as a pose list refuses it, at load and
   // in a custom action.
