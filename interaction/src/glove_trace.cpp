@@ -130,8 +130,13 @@ std::vector<GloveSample> read_trace(std::istream& in, std::string_view name) {
   while (const std::optional<std::string_view> line = reader.next_content()) {
     GloveSample sample = parse_row(reader, *line, column_of_field, fields);
     if (!samples.empty() && !(sample.t > samples.back().t)) {
+      // A device that sends a sample twice repeats its time: said so, since a
+      // replay cannot choose between the two.
       reader.fail("time does not increase: t = " + format_number(sample.t) + " after t = " +
-                  format_number(samples.back().t) + " on line " + std::to_string(previous_line));
+                  format_number(samples.back().t) + " on line " + std::to_string(previous_line) +
+                  (sample.t == samples.back().t
+                       ? " (a sample repeated, as devices send some twice: keep one of the two)"
+                       : ""));
     }
     previous_line = reader.line();
     samples.push_back(sample);
