@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string_view>
 #include <system_error>
@@ -400,7 +401,10 @@ void charge(lua_State* L, std::uint64_t units, const char* what) {
   HostState& host = host_of(L);
   if (!host.active()) return;
   const std::uint64_t budget = host.limits.instructions_per_call;
-  host.instructions_total += units;
+  host.instructions_total =
+      units > std::numeric_limits<std::uint64_t>::max() - host.instructions_total
+          ? std::numeric_limits<std::uint64_t>::max()
+          : host.instructions_total + units;
   // Saturated one past the budget: `units` may be a bound near 2^64.
   host.instructions_in_call = units > budget || host.instructions_in_call > budget - units
                                   ? budget + 1

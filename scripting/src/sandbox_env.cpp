@@ -451,26 +451,69 @@ PatternCost pattern_cost(const char* pattern, std::size_t length) {
   return counted;
 }
 
-/// Counts a search's comparisons, (n + 1) starts of up to m characters each
-/// for a subject of n characters and a pattern (or plain text) of m: a
-/// search with no repetition is bounded by them, and however long its
-/// text, it meets the instruction budget before it runs.
-void charge_search(lua_State* L, const char* name) {
+/// What a search (string.find, match, gmatch, gsub) may look at: the
+/// characters from its start (argument 3 where it has one, as Lua reads it)
+/// to the end of the subject, and the pattern's length; anchored (`^`) it
+/// tries one start only.
+struct SearchSpan {
+  std::size_t span = 0;     ///< characters from the start to the end
+  std::size_t pattern = 0;  ///< m
+  bool anchored = false;
+  bool repeats = false;  ///< a repetition: one start may run to the end
+  /// The comparisons it may make: each start tries up to m characters, and
+  /// a repetition may scan to the end once more. (Backtracking beyond that
+  /// is bounded, and refused, by check_pattern.)
+  double worst() const {
+    const double m = static_cast<double>(std::max<std::size_t>(pattern, 1));
+    const double starts = anchored ? 1 : static_cast<double>(span) + 1;
+    return starts * m + (repeats ? static_cast<double>(span) : 0);
+  }
+};
+
+SearchSpan search_span(lua_State* L, bool has_start, bool plain) {
   std::size_t n = 0;
-  std::size_t m = 0;
+  SearchSpan s;
   luaL_checklstring(L, 1, &n);
-  luaL_checklstring(L, 2, &m);
-  const auto compares =
-      static_cast<double>(n + 1) * static_cast<double>(std::max<std::size_t>(m, 1));
+  const char* pattern = luaL_checklstring(L, 2, &s.pattern);
+  lua_Integer start = has_start ? luaL_optinteger(L, 3, 1) : 1;
+  const auto length = static_cast<lua_Integer>(n);
+  if (start < 0) start = start < -length ? 1 : length + start + 1;
+  if (start == 0) start = 1;
+  s.span = start > length + 1 ? 0 : static_cast<std::size_t>(length - start + 1);
+  s.anchored = !plain && s.pattern > 0 && pattern[0] == '^';
+  s.repeats = !plain && pattern_cost(pattern, s.pattern).repetitions > 0;
+  return s;
+}
+
+/// Comparisons as instructions, saturated.
+std::uint64_t instructions_for(double compares) {
+  return compares >= 1e19 ? std::numeric_limits<std::uint64_t>::max()
+                          : static_cast<std::uint64_t>(compares) / kComparesPerInstruction;
+}
+
+/// Refuses, before it runs, a search whose worst case passes the budget
+/// left, so that one search of hours never starts.
+void refuse_search_past_budget(lua_State* L, const char* name, const SearchSpan& s) {
+  const HostState& host = host_of(L);
+  if (!host.active()) return;
+  const std::uint64_t budget = host.limits.instructions_per_call;
+  const std::uint64_t left =
+      host.instructions_in_call < budget ? budget - host.instructions_in_call : 0;
+  const std::uint64_t worst = instructions_for(s.worst());
+  if (worst <= left) return;
   char what[160];
   std::snprintf(what, sizeof(what),
                 "string.%s: a search of %zu characters for a pattern of %zu may compare %.3g "
                 "characters",
-                name, n, m, compares);
-  charge(L,
-         compares >= 1e19 ? std::numeric_limits<std::uint64_t>::max()
-                          : static_cast<std::uint64_t>(compares) / kComparesPerInstruction,
-         what);
+                name, s.span, s.pattern, s.worst());
+  charge(L, worst, what);
+}
+
+/// Counts what a search looked at: `compares` characters.
+void charge_searched(lua_State* L, const char* name, double compares) {
+  char what[96];
+  std::snprintf(what, sizeof(what), "string.%s: %.3g characters compared", name, compares);
+  charge(L, instructions_for(compares), what);
 }
 
 /// Raises the refusal when `pattern` (argument 2) on the subject (argument 1)
@@ -501,15 +544,44 @@ int timed_search(lua_State* L, lua_CFunction search) {
   check_deadline(L);
   return results;
 }
+// Each search is refused before it runs when its worst case passes the
+// budget left, and charged after it for what it looked at: find up to where
+// it matched, an anchored match the characters it returned, the others
+// their worst case (gmatch for all its steps at once).
 int sandbox_string_find(lua_State* L) {
-  if (!lua_toboolean(L, 4)) check_pattern(L, "find");  // a plain search has no pattern
-  charge_search(L, "find");
-  return timed_search(L, host_of(L).string_find);
+  const bool plain = lua_toboolean(L, 4) != 0;
+  if (!plain) check_pattern(L, "find");  // a plain search has no pattern
+  const SearchSpan span = search_span(L, true, plain);
+  refuse_search_past_budget(L, "find", span);
+  std::size_t n = 0;
+  lua_tolstring(L, 1, &n);
+  const lua_Integer from = static_cast<lua_Integer>(n - span.span) + 1;
+  const int results = timed_search(L, host_of(L).string_find);
+  double compares = span.worst();
+  if (!span.repeats && !span.anchored && lua_type(L, -results) == LUA_TNUMBER) {
+    const lua_Integer at = lua_tointeger(L, -results);  // where it matched
+    compares = static_cast<double>(at - from + 1) *
+               static_cast<double>(std::max<std::size_t>(span.pattern, 1));
+  }
+  charge_searched(L, "find", compares);
+  return results;
 }
 int sandbox_string_match(lua_State* L) {
   check_pattern(L, "match");
-  charge_search(L, "match");
-  return timed_search(L, host_of(L).string_match);
+  const SearchSpan span = search_span(L, true, false);
+  refuse_search_past_budget(L, "match", span);
+  const int results = timed_search(L, host_of(L).string_match);
+  double compares = span.worst();
+  if (span.anchored) {
+    // One start: it read what it returns, and the pattern.
+    std::size_t returned = 0;
+    for (int i = lua_gettop(L) - results + 1; i <= lua_gettop(L); ++i) {
+      if (lua_type(L, i) == LUA_TSTRING) returned += lua_rawlen(L, i);
+    }
+    compares = static_cast<double>(returned + std::max<std::size_t>(span.pattern, 1));
+  }
+  charge_searched(L, "match", compares);
+  return results;
 }
 // One step of a gmatch iterator: the library's (upvalue 1), then the
 // wall clock, as after any other search.
@@ -522,7 +594,9 @@ int gmatch_step(lua_State* L) {
 }
 int sandbox_string_gmatch(lua_State* L) {
   check_pattern(L, "gmatch");
-  charge_search(L, "gmatch");  // for all its steps together
+  const SearchSpan span = search_span(L, true, false);
+  refuse_search_past_budget(L, "gmatch", span);
+  charge_searched(L, "gmatch", span.worst());  // for all its steps together
   const int results = host_of(L).string_gmatch(L);
   if (results != 1 || !lua_isfunction(L, -1)) return results;
   lua_pushcclosure(L, gmatch_step, 1);
@@ -530,36 +604,71 @@ int sandbox_string_gmatch(lua_State* L) {
 }
 int sandbox_string_gsub(lua_State* L) {
   check_pattern(L, "gsub");
-  charge_search(L, "gsub");
+  const SearchSpan span = search_span(L, false, false);
+  refuse_search_past_budget(L, "gsub", span);
+  charge_searched(L, "gsub", span.worst());
   return timed_search(L, host_of(L).string_gsub);
 }
 
-// ---- functions that read a whole string: one instruction per
+// ---- functions that read a string or a range of it: one instruction per
 // kComparesPerInstruction characters
 
-/// Charges `name` for reading all of the string at argument 1.
-void charge_string(lua_State* L, const char* name) {
-  if (lua_type(L, 1) != LUA_TSTRING) return;  // a number reads short; the library reports the rest
+/// The characters from argument `i` to argument `j` of the string at
+/// argument 1 (defaults `i_default` and `j_default`, negative from the
+/// end, as the library reads them), clamped to the string.
+std::size_t range_length(lua_State* L, int i, lua_Integer i_default, int j, lua_Integer j_default) {
   std::size_t n = 0;
   lua_tolstring(L, 1, &n);
+  const auto length = static_cast<lua_Integer>(n);
+  const auto position = [&](lua_Integer p) {
+    if (p < 0) p = length + p + 1;
+    return std::clamp<lua_Integer>(p, 1, length + 1);
+  };
+  const lua_Integer from = position(lua_isinteger(L, i) ? lua_tointeger(L, i) : i_default);
+  const lua_Integer to =
+      std::min(position(lua_isinteger(L, j) ? lua_tointeger(L, j) : j_default), length);
+  return to >= from ? static_cast<std::size_t>(to - from + 1) : 0;
+}
+
+/// Charges `name` for reading `count` characters of the string at argument 1.
+void charge_string(lua_State* L, const char* name, std::size_t count) {
   char what[96];
-  std::snprintf(what, sizeof(what), "%s on a string of %zu characters", name, n);
-  charge(L, n / kComparesPerInstruction, what);
+  std::snprintf(what, sizeof(what), "%s over %zu characters", name, count);
+  charge(L, count / kComparesPerInstruction, what);
+}
+/// The same for the whole of it.
+void charge_string(lua_State* L, const char* name) {
+  if (lua_type(L, 1) != LUA_TSTRING) return;  // a number reads short; the library reports the rest
+  charge_string(L, name, lua_rawlen(L, 1));
 }
 int sandbox_string_byte(lua_State* L) {
-  if (lua_gettop(L) >= 3) charge_string(L, "string.byte");  // a range of values
+  if (lua_type(L, 1) == LUA_TSTRING) {
+    const lua_Integer i = lua_isinteger(L, 2) ? lua_tointeger(L, 2) : 1;
+    charge_string(L, "string.byte", range_length(L, 2, 1, 3, i));
+  }
   return host_of(L).string_byte(L);
 }
 int sandbox_utf8_len(lua_State* L) {
-  charge_string(L, "utf8.len");
+  if (lua_type(L, 1) == LUA_TSTRING) charge_string(L, "utf8.len", range_length(L, 2, 1, 3, -1));
   return host_of(L).utf8_len(L);
 }
 int sandbox_utf8_codepoint(lua_State* L) {
-  if (lua_gettop(L) >= 3) charge_string(L, "utf8.codepoint");
+  if (lua_type(L, 1) == LUA_TSTRING) {
+    const lua_Integer i = lua_isinteger(L, 2) ? lua_tointeger(L, 2) : 1;
+    charge_string(L, "utf8.codepoint", range_length(L, 2, 1, 3, i));
+  }
   return host_of(L).utf8_codepoint(L);
 }
 int sandbox_utf8_offset(lua_State* L) {
-  charge_string(L, "utf8.offset");
+  // It walks |n| characters from its start, at most the whole string.
+  if (lua_type(L, 1) == LUA_TSTRING && lua_isinteger(L, 2)) {
+    const lua_Integer steps = lua_tointeger(L, 2);
+    const auto walked = steps == std::numeric_limits<lua_Integer>::min()
+                            ? std::numeric_limits<lua_Unsigned>::max()
+                            : static_cast<lua_Unsigned>(steps < 0 ? -steps : steps);
+    charge_string(L, "utf8.offset",
+                  static_cast<std::size_t>(std::min<lua_Unsigned>(walked, lua_rawlen(L, 1))));
+  }
   return host_of(L).utf8_offset(L);
 }
 int sandbox_tonumber(lua_State* L) {
@@ -612,14 +721,16 @@ int sandbox_table_move(lua_State* L) {
 
 /// Charges `name` on the table at argument 1 for every element of it: what
 /// insert and remove at a position shift, concat joins and unpack pushes is
-/// at most that.
+/// at most that. Its length as the library takes it (its __len, if any:
+/// a metamethod that claims 2^40 elements gets them counted).
 void charge_table(lua_State* L, const char* name) {
   if (lua_type(L, 1) != LUA_TTABLE) return;  // the library reports it
-  const lua_Unsigned length = lua_rawlen(L, 1);
+  const lua_Integer length = luaL_len(L, 1);
+  if (length <= 0) return;
   char what[80];
-  std::snprintf(what, sizeof(what), "table.%s on a table of %llu elements", name,
-                static_cast<unsigned long long>(length));
-  charge(L, length, what);
+  std::snprintf(what, sizeof(what), "table.%s on a table of %lld elements", name,
+                static_cast<long long>(length));
+  charge(L, static_cast<std::uint64_t>(length), what);
 }
 int sandbox_table_insert(lua_State* L) {
   if (lua_gettop(L) >= 3) charge_table(L, "insert");  // at a position: shifts the rest
@@ -634,15 +745,16 @@ int sandbox_table_concat(lua_State* L) {
   return host_of(L).table_concat(L);
 }
 int sandbox_table_unpack(lua_State* L) {
-  // Explicit bounds may reach past the table: the values pushed count.
-  if (lua_gettop(L) >= 3 && lua_isinteger(L, 2) && lua_isinteger(L, 3)) {
-    const lua_Integer first = lua_tointeger(L, 2), last = lua_tointeger(L, 3);
-    if (last >= first) {
-      const lua_Unsigned span = static_cast<lua_Unsigned>(last) - static_cast<lua_Unsigned>(first);
-      charge(L, span, "table.unpack");
-    }
-  } else {
-    charge_table(L, "unpack");
+  // The values pushed, from i to j as the library reads them (j defaults
+  // to the length; bounds may reach past the table).
+  const lua_Integer first = luaL_optinteger(L, 2, 1);
+  const lua_Integer last = lua_isnoneornil(L, 3) ? luaL_len(L, 1) : luaL_checkinteger(L, 3);
+  if (last >= first) {
+    const lua_Unsigned span = static_cast<lua_Unsigned>(last) - static_cast<lua_Unsigned>(first);
+    char what[80];
+    std::snprintf(what, sizeof(what), "table.unpack: %llu values",
+                  static_cast<unsigned long long>(span) + 1);
+    charge(L, span == std::numeric_limits<lua_Unsigned>::max() ? span : span + 1, what);
   }
   return host_of(L).table_unpack(L);
 }

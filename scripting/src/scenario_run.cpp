@@ -462,15 +462,24 @@ int api_log(lua_State* L) {
 int api_unknown(lua_State* L) {
   const char* what = lua_tostring(L, lua_upvalueindex(1));
   if (lua_type(L, 2) != LUA_TSTRING) return luaL_error(L, "%s has no such field", what);
-  const std::string name = lua_tostring(L, 2);
-  std::vector<std::string> known;
-  lua_pushnil(L);
-  while (lua_next(L, 1) != 0) {
-    if (lua_type(L, -2) == LUA_TSTRING) known.emplace_back(lua_tostring(L, -2));
-    lua_pop(L, 1);
+  {
+    // The message is built, and its C++ objects gone, before Lua's error
+    // unwinds this frame (a longjmp, which runs no destructor).
+    const std::string name = lua_tostring(L, 2);
+    std::vector<std::string> known;
+    lua_pushnil(L);
+    while (lua_next(L, 1) != 0) {
+      if (lua_type(L, -2) == LUA_TSTRING) known.emplace_back(lua_tostring(L, -2));
+      lua_pop(L, 1);
+    }
+    std::sort(known.begin(), known.end());
+    const std::string message =
+        std::string(what) + " has no '" + name + "'" + did_you_mean(name, known);
+    luaL_where(L, 1);
+    lua_pushlstring(L, message.data(), message.size());
+    lua_concat(L, 2);
   }
-  std::sort(known.begin(), known.end());
-  return luaL_error(L, "%s has no '%s'%s", what, name.c_str(), did_you_mean(name, known).c_str());
+  return lua_error(L);
 }
 
 /// Makes the table on top of the stack raise api_unknown for names it lacks.

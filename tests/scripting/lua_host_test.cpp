@@ -266,11 +266,22 @@ TEST(LuaHostBudget, LibraryWorkCountsAgainstTheBudget) {
        "(table.concat on a table of 100000 elements)"},
       {"local t = {}\nfor i = 1, 100000 do t[i] = i end\n"
        "for i = 1, 1000 do local a = select('#', table.unpack(t)) end",
-       "(table.unpack on a table of 100000 elements)"},
+       "(table.unpack: 100000 values)"},
       {"local s = ('7'):rep(1 << 20)\nfor i = 1, 1000 do local x = tonumber(s) end",
-       "(tonumber on a string of 1048576 characters)"},
+       "(tonumber over 1048576 characters)"},
       {"local s = ('x'):rep(1 << 20)\nfor i = 1, 1000 do local n = utf8.len(s) end",
-       "(utf8.len on a string of 1048576 characters)"},
+       "(utf8.len over 1048576 characters)"},
+      // A __len that claims 2^40 elements has them counted, as the library
+      // shifts them; float bounds count as integer ones.
+      {"local t = setmetatable({}, { __len = function() return 1 << 40 end })\n"
+       "table.insert(t, 1, 0)",
+       "script.lua:2: instruction budget of 1000000 exceeded (table.insert on a table of "
+       "1099511627776 elements)"},
+      {"local t = setmetatable({}, { __len = function() return 1 << 40 end })\n"
+       "table.remove(t, 1)",
+       "(table.remove on a table of 1099511627776 elements)"},
+      {"local t = {}\nfor i = 1, 100 do local a = select('#', table.unpack(t, 1, 100000.0)) end",
+       "script.lua:2: instruction budget of 1000000 exceeded (table.unpack: 100000 values)"},
   };
   for (const Case& c : cases) {
     LuaHost host(limits, 1);
@@ -278,6 +289,26 @@ TEST(LuaHostBudget, LibraryWorkCountsAgainstTheBudget) {
     EXPECT_EQ(error.kind(), Kind::kBudget) << c.script << " -> " << error.what();
     EXPECT_NE(error.message().find(c.names), std::string::npos) << error.message();
   }
+}
+
+// A search is charged for what it looked at: a tokenizer that finds each
+// next space from where it is reads the string once, however long.
+TEST(LuaHostBudget, ALinearScanOfFindsIsChargedLinearly) {
+  SandboxLimits limits = small_limits();
+  limits.wall_seconds_per_call = 1000;
+  LuaHost host(limits, 1);
+  EXPECT_EQ(run(host,
+                "local s = ('ab '):rep(40000)\n"
+                "local n, at = 0, 1\n"
+                "while true do\n"
+                "  local space = s:find(' ', at, true)\n"
+                "  if not space then break end\n"
+                "  n, at = n + 1, space + 1\n"
+                "end\n"
+                "local bytes = 0\n"
+                "for i = 1, #s, 3 do bytes = bytes + s:byte(i, i + 2) end\n"
+                "return tostring(n)"),
+            "40000");
 }
 
 // Copying a long string (a `..` is one instruction) counts by the bytes
