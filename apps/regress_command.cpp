@@ -154,12 +154,15 @@ void remove_old_outputs(const Job& job, const std::filesystem::path& out) {
   std::filesystem::remove(out / job.stem / "final.png", ec);
 }
 
-/// Removes what an earlier regress left in `out` of scenarios no longer in
-/// the folder (deleted or renamed since), so that OUT, kept as a CI
-/// artifact, holds only the outputs of the scenarios there; returns their
-/// names. OUT may hold other files: only a Dovetail report beside its log
-/// counts, and of its frames folder only the final frame.
+/// Removes what an earlier regress of this folder left in `out` of
+/// scenarios no longer in it (deleted or renamed since), so that OUT, kept
+/// as a CI artifact, holds only the outputs of the scenarios there; returns
+/// their names. OUT may hold other files, and other folders' outputs: only
+/// a Dovetail report beside its log whose scenario file was in this folder
+/// and is gone counts, and of its frames folder (not a link) only the final
+/// frame.
 std::vector<std::string> remove_stale_outputs(const std::filesystem::path& out,
+                                              const std::filesystem::path& folder,
                                               const std::vector<std::filesystem::path>& files) {
   std::set<std::string> stems;
   for (const std::filesystem::path& f : files) stems.insert(f.stem().string());
@@ -169,22 +172,32 @@ std::vector<std::string> remove_stale_outputs(const std::filesystem::path& out,
     const std::filesystem::path& report = entry.path();
     const std::string stem = report.stem().string();
     if (report.extension() != ".json" || stems.count(stem) != 0 ||
+        !std::filesystem::is_regular_file(report, ec) ||
         !std::filesystem::is_regular_file(out / (stem + ".log"), ec)) {
       continue;
     }
-    std::string head(256, '\0');
     std::ifstream in(report, std::ios::binary);
-    in.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(in.gcount()));
-    if (head.find("\"format\": \"dovetail-scenario-report\"") == std::string::npos) continue;
+    const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
+    if (!json.is_object() || json.value("format", "") != "dovetail-scenario-report" ||
+        !json.contains("file") || !json["file"].is_string()) {
+      continue;
+    }
+    const std::filesystem::path scenario = json["file"].get<std::string>();
+    if (std::filesystem::exists(scenario, ec) ||
+        !engine::same_file(scenario.parent_path().empty() ? "." : scenario.parent_path(), folder)) {
+      continue;
+    }
     removed.push_back(stem);
   }
   std::sort(removed.begin(), removed.end());
   for (const std::string& stem : removed) {
     std::filesystem::remove(out / (stem + ".json"), ec);
     std::filesystem::remove(out / (stem + ".log"), ec);
-    std::filesystem::remove(out / stem / "final.png", ec);
-    std::filesystem::remove(out / stem, ec);  // only if nothing else is in it
+    const std::filesystem::path frames = out / stem;
+    if (!std::filesystem::is_symlink(frames, ec)) {
+      std::filesystem::remove(frames / "final.png", ec);
+      std::filesystem::remove(frames, ec);  // only if nothing else is in it
+    }
   }
   return removed;
 }
@@ -743,7 +756,8 @@ int regress_command(std::span<const std::string> argv) {
   for (const std::optional<std::string>& summary : {junit, html}) {
     if (summary && inside(out, *summary)) check_writable(*summary);
   }
-  if (const std::vector<std::string> stale = remove_stale_outputs(out, scenario_files(folder));
+  if (const std::vector<std::string> stale =
+          remove_stale_outputs(out, folder, scenario_files(folder));
       !stale.empty()) {
     std::string names;
     for (const std::string& stem : stale) names += (names.empty() ? "" : ", ") + stem;

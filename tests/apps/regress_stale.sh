@@ -11,8 +11,9 @@ fail() {
   exit 1
 }
 rm -rf "$out" && mkdir -p "$out/reports/gone" "$out/reports/kept" || exit 1
-printf '{\n  "format": "dovetail-scenario-report",\n  "version": 1,\n  "outcome": "passed"\n}\n' \
-  > "$out/reports/gone.json" || exit 1
+# A report an earlier regress of this folder wrote for a scenario deleted since.
+printf '{\n  "format": "dovetail-scenario-report",\n  "version": 1,\n  "file": "%s/gone.lua",\n  "outcome": "passed"\n}\n' \
+  "$scenarios" > "$out/reports/gone.json" || exit 1
 echo 'an old log' > "$out/reports/gone.log"
 echo 'not a png' > "$out/reports/gone/final.png"
 # Files of the user's beside them: a JSON file that is no report, with a log,
@@ -22,6 +23,15 @@ echo 'notes' > "$out/reports/notes.log"
 echo 'mine' > "$out/reports/kept/final.png"
 echo 'mine' > "$out/reports/kept/other.txt"
 printf '{\n  "format": "dovetail-scenario-report"\n}\n' > "$out/reports/kept.json"
+# Reports beside a log that regress must not take for its own: one of a
+# scenario elsewhere that still exists (a `run --report` into OUT), and one
+# another folder's regress left of a scenario gone from there.
+printf '{\n  "format": "dovetail-scenario-report",\n  "file": "%s/01_peg_in_hole.lua"\n}\n' \
+  "$scenarios" > "$out/reports/mine.json"
+echo 'my log' > "$out/reports/mine.log"
+printf '{\n  "format": "dovetail-scenario-report",\n  "file": "%s/elsewhere/gone.lua"\n}\n' \
+  "$out" > "$out/reports/theirs.json"
+echo 'their log' > "$out/reports/theirs.log"
 # The first of the shipped scenarios only.
 "$program" regress "$scenarios" --out "$out/reports" --shard 1/99 > /dev/null 2> "$out/stderr.txt" ||
   fail "regress failed"
@@ -30,6 +40,7 @@ grep -q "note: regress: removed from .*reports the outputs of 1 scenario no long
 for gone in gone.json gone.log gone; do
   [ ! -e "$out/reports/$gone" ] || fail "$gone is left"
 done
-for kept in notes.json notes.log kept/final.png kept/other.txt kept.json 01_peg_in_hole.json; do
+for kept in notes.json notes.log kept/final.png kept/other.txt kept.json mine.json mine.log \
+  theirs.json theirs.log 01_peg_in_hole.json; do
   [ -e "$out/reports/$kept" ] || fail "$kept was removed"
 done
