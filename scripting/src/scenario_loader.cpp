@@ -17,6 +17,7 @@
 #include <map>
 #include <numbers>
 #include <set>
+#include <sstream>
 
 #include "dovetail/collision/primitives.h"
 #include "dovetail/engine/mesh_import.h"
@@ -226,39 +227,118 @@ class Loader {
     noted_.push_back({where, message});
   }
 
-  /// The line of `key = ...` in the declaration that starts at `where`: the
-  /// first line at or after it that assigns the key, outside comments; where
-  /// itself when there is none (a table built by a loop, say). Lua keeps no
-  /// line for a table's fields, so a mistake in one would otherwise be named
-  /// at the line its declaration opens.
-  SourceLocation field_line(const SourceLocation& where, std::string_view key) {
+  /// The line of `key = ...` in the declaration `word { ... }` that opens
+  /// on the line of `where`: the field assigned directly in its table (not
+  /// in a table within it), outside strings and comments; where itself when
+  /// there is none (a declaration of a table built elsewhere, `part(spec)`,
+  /// or by a loop). Lua keeps no line for a table's fields, so a mistake in
+  /// one would otherwise be named at the line its declaration opens.
+  SourceLocation field_line(const SourceLocation& where, std::string_view word,
+                            std::string_view key) {
     if (where.line <= 0 || key.empty()) return where;
-    auto [it, fresh] = source_lines_.try_emplace(where.file);
+    const std::string cache_key = where.file + '\n' + std::to_string(where.line) + '\n' +
+                                  std::string(word) + '\n' + std::string(key);
+    if (const auto hit = field_lines_.find(cache_key); hit != field_lines_.end()) {
+      return {where.file, hit->second};
+    }
+    auto [it, fresh] = source_text_.try_emplace(where.file);
     if (fresh) {
       std::ifstream in(where.file, std::ios::binary);
-      for (std::string line; std::getline(in, line);) it->second.push_back(line);
+      std::ostringstream text;
+      text << in.rdbuf();
+      it->second = text.str();
     }
-    const std::vector<std::string>& lines = it->second;
+    const int line = find_field_line(it->second, where.line, word, key);
+    field_lines_.emplace(cache_key, line > 0 ? line : where.line);
+    return {where.file, line > 0 ? line : where.line};
+  }
+
+  /// field_line's scan of `text`; 0 when the field is not found.
+  static int find_field_line(const std::string& text, int declaration_line, std::string_view word,
+                             std::string_view key) {
     const auto is_name = [](char c) {
       return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_';
     };
-    constexpr std::size_t kReach = 400;  // lines a declaration may span
-    for (std::size_t i = static_cast<std::size_t>(where.line) - 1;
-         i < lines.size() && i < static_cast<std::size_t>(where.line) - 1 + kReach; ++i) {
-      const std::string_view line = std::string_view(lines[i]).substr(0, lines[i].find("--"));
-      for (std::size_t at = line.find(key); at != std::string_view::npos;
-           at = line.find(key, at + 1)) {
-        if (at > 0 && (is_name(line[at - 1]) || line[at - 1] == '.')) continue;
+    // The start of the declaration's line.
+    std::size_t i = 0;
+    int line = 1;
+    while (line < declaration_line && i < text.size()) {
+      if (text[i++] == '\n') ++line;
+    }
+    if (line != declaration_line) return 0;
+    // `word` then `{` (or `({`) on that line, as a whole name.
+    const std::size_t line_end = std::min(text.find('\n', i), text.size());
+    std::size_t open = std::string::npos;
+    for (std::size_t at = text.find(word, i); at != std::string::npos && at < line_end;
+         at = text.find(word, at + 1)) {
+      if ((at > 0 && is_name(text[at - 1])) ||
+          (at + word.size() < text.size() && is_name(text[at + word.size()]))) {
+        continue;
+      }
+      std::size_t next = at + word.size();
+      while (next < line_end && (text[next] == ' ' || text[next] == '\t' || text[next] == '(')) {
+        ++next;
+      }
+      if (next < line_end && text[next] == '{') {
+        open = next;
+        break;
+      }
+    }
+    if (open == std::string::npos) return 0;
+    // Through the table, skipping strings and comments, to `key =` at depth 1.
+    int depth = 0;
+    for (std::size_t at = open; at < text.size(); ++at) {
+      const char c = text[at];
+      if (c == '\n') {
+        ++line;
+      } else if (c == '-' && at + 1 < text.size() && text[at + 1] == '-') {
+        // A comment: long (`--[[ ... ]]`, `--[==[`) or to the end of the line.
+        std::size_t level_end = at + 2;
+        if (level_end < text.size() && text[level_end] == '[') {
+          std::size_t eq = level_end + 1;
+          while (eq < text.size() && text[eq] == '=') ++eq;
+          if (eq < text.size() && text[eq] == '[') {
+            const std::string close = "]" + std::string(eq - level_end - 1, '=') + "]";
+            const std::size_t end = text.find(close, eq);
+            for (std::size_t k = at; k < std::min(end, text.size()); ++k) line += text[k] == '\n';
+            if (end == std::string::npos) return 0;
+            at = end + close.size() - 1;
+            continue;
+          }
+        }
+        const std::size_t end = text.find('\n', at);
+        if (end == std::string::npos) return 0;
+        at = end - 1;
+      } else if (c == '"' || c == '\'') {
+        for (++at; at < text.size() && text[at] != c && text[at] != '\n'; ++at) {
+          if (text[at] == '\\') ++at;
+        }
+      } else if (c == '[' && at + 1 < text.size() && (text[at + 1] == '[' || text[at + 1] == '=')) {
+        std::size_t eq = at + 1;
+        while (eq < text.size() && text[eq] == '=') ++eq;
+        if (eq < text.size() && text[eq] == '[') {  // a long string
+          const std::string close = "]" + std::string(eq - at - 1, '=') + "]";
+          const std::size_t end = text.find(close, eq);
+          for (std::size_t k = at; k < std::min(end, text.size()); ++k) line += text[k] == '\n';
+          if (end == std::string::npos) return 0;
+          at = end + close.size() - 1;
+        }
+      } else if (c == '{') {
+        ++depth;
+      } else if (c == '}') {
+        if (--depth == 0) return 0;  // the declaration ends without the field
+      } else if (depth == 1 && is_name(c) && (at == 0 || !is_name(text[at - 1])) &&
+                 text.compare(at, key.size(), key) == 0 &&
+                 (at + key.size() >= text.size() || !is_name(text[at + key.size()]))) {
         std::size_t next = at + key.size();
-        if (next < line.size() && is_name(line[next])) continue;
-        while (next < line.size() && (line[next] == ' ' || line[next] == '\t')) ++next;
-        if (next < line.size() && line[next] == '=' &&
-            (next + 1 >= line.size() || line[next + 1] != '=')) {
-          return {where.file, static_cast<int>(i) + 1};
+        while (next < text.size() && (text[next] == ' ' || text[next] == '\t')) ++next;
+        if (next < text.size() && text[next] == '=' &&
+            (next + 1 >= text.size() || text[next + 1] != '=')) {
+          return line;
         }
       }
     }
-    return where;
+    return 0;
   }
 
   void throw_noted() const {
@@ -669,7 +749,7 @@ class Loader {
     for (const Param& p : word.params) known.emplace_back(p.name);
     for (const std::string& key : keys) {
       if (std::find(known.begin(), known.end(), key) == known.end()) {
-        note(field_line(where, key),
+        note(field_line(where, word.name, key),
              what + ": unknown field '" + key + "'" + did_you_mean(key, known));
       }
     }
@@ -702,13 +782,13 @@ class Loader {
       };
       try {
         const Reading reading(reading_optional_field_);
-        arg = arg_at(lua_gettop(L_), p, field_line(where, name), what);
+        arg = arg_at(lua_gettop(L_), p, field_line(where, word.name, name), what);
       } catch (const OptionalFieldProblem&) {
         arg = Arg{};
         lua_settop(L_, top + 1);
       }
     } else if (lua_type(L_, -1) != LUA_TNIL) {
-      arg = arg_at(lua_gettop(L_), p, field_line(where, name), what);
+      arg = arg_at(lua_gettop(L_), p, field_line(where, word.name, name), what);
     } else if (!p.optional) {
       lua_pop(L_, 1);
       fail(where, what + ": missing field '" + std::string(name) + "'");
@@ -810,8 +890,9 @@ class Loader {
   struct OptionalFieldProblem {};
   std::vector<std::filesystem::path>* files_read_ = nullptr;
   bool hand_given_ = false;  ///< a replayed trace gives the hand the scenario lacks
-  /// The lines of the files read, for field_line.
-  std::map<std::string, std::vector<std::string>> source_lines_;
+  /// The text of the files read, and the lines found, for field_line.
+  std::map<std::string, std::string> source_text_;
+  std::map<std::string, int> field_lines_;
   std::map<std::string, engine::ImportReport> imports_;  ///< mesh files read by node
   /// Parts declared `open_surface = true`: no warning about their surface.
   std::set<std::string> open_surfaces_;
@@ -1495,8 +1576,8 @@ void Loader::resolve() {
     }
   };
   for (const MateSpec& m : scenario_.mates) {
-    check_part(m.mate.part, field_line(m.where, "part"), "mate '" + m.mate.name + "'");
-    check_part(m.mate.other, field_line(m.where, "into"), "mate '" + m.mate.name + "'");
+    check_part(m.mate.part, field_line(m.where, "mate", "part"), "mate '" + m.mate.name + "'");
+    check_part(m.mate.other, field_line(m.where, "mate", "into"), "mate '" + m.mate.name + "'");
     if (fixed(m.mate.part))
       note(m.where, "mate '" + m.mate.name + "': its part '" + m.mate.part + "' is fixed");
   }
@@ -1514,7 +1595,7 @@ void Loader::resolve() {
   for (const PartSpec& p : scenario_.parts) {
     if (p.attached_to.empty()) continue;
     const std::string what = "part '" + p.name + "': attached_to";
-    check_part(p.attached_to, field_line(p.where, "attached_to"), what);
+    check_part(p.attached_to, field_line(p.where, "part", "attached_to"), what);
     if (p.attached_to == p.name) {
       note(p.where, what + ": a part cannot be attached to itself");
       continue;

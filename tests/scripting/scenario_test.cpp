@@ -204,6 +204,30 @@ TEST(ScenarioRun, AMisspeltNameOfTheCustomActionsApiGetsTheNearestOne) {
             RunOutcome::Status::kPassed);
 }
 
+TEST(ScenarioLoad, AFieldsLineIsFoundInItsOwnDeclarationOnly) {
+  // A part built from a table elsewhere is named at its declaration, not at
+  // the next part's field of that name; fields in comments, strings and
+  // nested tables are no fields of the declaration.
+  const test::TempDir dir("dovetail_scenario");
+  const std::string what = load_error(
+      write(dir, "own.lua", R"(local spec = { shape = box { size = { 10, 10, 10 } }, fixed = "yes" }
+return scenario {
+  name = "own", units = "mm",
+  parts = {
+    peg = part(spec),
+    other = part {
+      --[[ at = { 1 } in a comment ]] shape = box { size = { 10, 10, 10 } }, tags = { "at = 1" },
+      fixed = true,
+      at = { 0, 0 },
+    },
+  },
+})"));
+  EXPECT_NE(what.find("own.lua:5: part 'peg' 'fixed' must be true or false"), std::string::npos)
+      << what;
+  EXPECT_NE(what.find("own.lua:9: part 'other' 'at' must be three numbers"), std::string::npos)
+      << what;
+}
+
 TEST(ScenarioLoad, MistakesInOptionalFieldsAreNamedAllAtOnce) {
   // Once, each of these ended the check on its own: fixing them took four
   // checks. An optional field's mistake now leaves the field unread and
