@@ -179,6 +179,7 @@ void Grasping::hold(const std::string& part, GraspType type) {
   X_HO_ = engine::compose(hand_->X_WH().inverse(), scene.world_pose(root));
   for (std::size_t d = 0; d < kDigitCount; ++d) {
     flexion_at_grasp_[d] = flexion(hand_->glove_angles(), digit_joints(d));
+    settle_floor_[d] = flexion_at_grasp_[d] - settings_.grasp.release_open_deg / 2;
     peak_flexion_[d] = flexion_at_grasp_[d];
     release_opening_[d] = settings_.grasp.release_open_deg;
     grasping_digit_[d] = type == GraspType::kPower || d <= (type == GraspType::kTripod ? 2U : 1U);
@@ -418,11 +419,13 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
 
   if (held_) {
     // The flexion at the grasp settles on the closed hand's, below the
-    // noise of the sample it was taken from.
+    // noise of the sample it was taken from: by half the release opening at
+    // most, so that a hand opening at once still lets go.
     constexpr Real kSettle_s = 0.1;
     if (t - grasped_at_ <= kSettle_s + 1e-9) {
       for (std::size_t d = 0; d < kDigitCount; ++d) {
-        flexion_at_grasp_[d] = std::min(flexion_at_grasp_[d], digit_flexion[d]);
+        flexion_at_grasp_[d] =
+            std::max(settle_floor_[d], std::min(flexion_at_grasp_[d], digit_flexion[d]));
       }
     }
     // Release: a grasping digit opened past its flexion at the grasp, long enough.

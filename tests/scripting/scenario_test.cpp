@@ -1003,9 +1003,12 @@ TEST(ScenarioRun, AStillClosedHandWithGloveNoiseGraspsNothing) {
 )");
     const RunOutcome o = run_scenario(file);
     ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary();
+    bool touched = false;
     for (const engine::Event& e : o.report.events) {
       EXPECT_NE(e.kind, engine::EventKind::kGrasp) << "at t=" << e.time;
+      touched = touched || (e.kind == engine::EventKind::kHandContactBegin && e.b == "bar");
     }
+    EXPECT_TRUE(touched) << "the hand must come down on the bar";
   }
 }
 
@@ -1042,6 +1045,28 @@ TEST(ScenarioRun, AHeldPartIsKeptWhenTheFirstSampleReadHigh) {
   for (const engine::Event& e : o.report.events) {
     EXPECT_NE(e.kind, engine::EventKind::kRelease) << e.b << " at t=" << e.time;
   }
+
+  // A hand that opens at once, within the settling, still lets go: the
+  // flexion at the grasp settles by half the release opening at most.
+  std::string opening = trace.substr(0, trace.find('\n') + 1);
+  for (int i = 0; i <= 90; ++i) {
+    char row[512];
+    const double k = i == 0 ? 1 : 0;  // closed at the first sample, open from the second
+    std::snprintf(row, sizeof(row),
+                  "%.17g,0,0.15,0.09,1,0,0,0,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,0,0,"
+                  "0,%g,0,0\n",
+                  i / 90.0, 50 * k, 30 * k, 30 * k, 30 * k, 60 * k, 70 * k, 40 * k, 60 * k, 70 * k,
+                  40 * k, 60 * k, 70 * k, 40 * k, 60 * k, 70 * k, 40 * k, 11 * k);
+    opening += row;
+  }
+  write(dir, "held.csv", opening);
+  const RunOutcome opened = run_scenario(file);
+  ASSERT_EQ(opened.status, RunOutcome::Status::kPassed) << opened.failure_summary();
+  bool released = false;
+  for (const engine::Event& e : opened.report.events) {
+    released = released || (e.kind == engine::EventKind::kRelease && e.time < 0.2);
+  }
+  EXPECT_TRUE(released) << opened.to_json();
 }
 
 TEST(ScenarioRun, AHandClosingOnABarGraspsItWhereverThePalmLiesOnIt) {

@@ -68,8 +68,9 @@ std::vector<std::string> trace_doubts(const std::filesystem::path& path,
                                       std::span<const GloveSample> samples);
 /// trace_doubts' first: samples more than 0.1 s apart at the median.
 std::optional<std::string> sparse_samples(std::span<const GloveSample> samples);
-/// trace_doubts' second: every joint angle within +-pi, some beyond 0.2
-/// (radians, where degrees are read).
+/// trace_doubts' second: every joint angle within +-pi while some joint
+/// sweeps over 0.5 (radians, where degrees are read; a still hand in
+/// degrees sweeps less).
 std::optional<std::string> radian_angles(std::span<const GloveSample> samples);
 
 /// The header row and one row per sample, each ending in '\n'. The samples

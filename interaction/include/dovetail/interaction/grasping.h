@@ -271,6 +271,8 @@ class Grasping {
   /// the grasp follows the glove down, so that a grasp taken from one noisy
   /// sample (`holding`'s first) does not sit above the closed hand.
   Real grasped_at_ = 0;
+  std::array<Real, kDigitCount>
+      settle_floor_{};  ///< the lowest the flexion at the grasp settles to
   /// The total glove flexion low-passed, and its values over the last
   /// moments (time, value): how much the hand closed lately, which the
   /// noise of 15 joints does not fake, decides a grasp's onset.
