@@ -465,7 +465,18 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
     if (!scene.movable(part) || !scene.movable(carried_root(scene, part))) continue;
     std::vector<GraspContact> touching = touches(scene, part);
     if (touching.empty()) continue;
-    if (const std::optional<GraspType> type = classify_grasp(touching, settings_.grasp.friction)) {
+    const std::optional<GraspType> type = classify_grasp(touching, settings_.grasp.friction);
+    // The closest try so far at this part, for why_not_grasped.
+    std::vector<Segment> segments;
+    for (const GraspContact& c : touching) {
+      if (std::find(segments.begin(), segments.end(), c.segment) == segments.end()) {
+        segments.push_back(c.segment);
+      }
+    }
+    if (Attempt& best = attempts_[scene.name(part)]; segments.size() > best.touching.size()) {
+      best = {t, std::move(segments), type};
+    }
+    if (type) {
       found = type;
       found_part = scene.name(part);
       found_contacts = std::move(touching);
@@ -717,6 +728,47 @@ Transform Grasping::guided(const engine::Scene& scene, PartId root, const Transf
     return root_pose_for(scene, root, p, X);
   }
   return X_WR_target;
+}
+
+std::string Grasping::why_not_grasped(const std::string& part) const {
+  const auto it = attempts_.find(part);
+  if (it == attempts_.end()) return "the hand never touched it while it held nothing";
+  const Attempt& a = it->second;
+  bool palm = false, thumb_tip = false, finger_tip = false;
+  std::size_t fingers = 0;
+  std::string names;
+  for (const Segment s : a.touching) {
+    names += (names.empty() ? "" : ", ") + std::string(segment_name(s));
+    palm = palm || s == Segment::kPalm;
+    thumb_tip = thumb_tip || s == Segment::kThumbDistal;
+    finger_tip = finger_tip || s == Segment::kIndexDistal || s == Segment::kMiddleDistal;
+    fingers += s != Segment::kPalm;
+  }
+  char when[48];
+  std::snprintf(when, sizeof when, "at t=%.3f s", a.time);
+  std::string why;
+  if (a.type) {
+    why = "they made a " + std::string(grasp_type_name(*a.type)) +
+          " grasp, but the hand was not closing (a grasp needs the glove's flexion to rise by "
+          "10 degrees within a quarter second while it builds up)";
+  } else if (!palm && !thumb_tip) {
+    why = "neither the palm (within " +
+          std::to_string(static_cast<int>(std::round(settings_.grasp.palm_gap * 1000))) +
+          " mm) nor the thumb's tip touched it: a power grasp needs the palm, a pinch the "
+          "thumb's tip";
+  } else if (palm && fingers < 2) {
+    why = "a power grasp needs the palm and two finger segments";
+  } else if (palm) {
+    why = "no finger segment opposed the palm (their contacts within the friction cones)";
+  } else if (!finger_tip) {
+    why = "a pinch needs the thumb's tip and the index's or middle's tip";
+  } else {
+    why =
+        "the thumb's tip did not oppose the index's or middle's (their contacts within the "
+        "friction cones)";
+  }
+  return "the most of the hand that touched it was " + std::string(when) + ": " + names + "; " +
+         why;
 }
 
 void Grasping::release(engine::Simulation& simulation, const std::string& reason) {

@@ -1188,7 +1188,8 @@ void Runner::evaluate_expectations() {
         e.detail =
             "'" + args[0].text + "' was never grasped as " + args[1].text +
             (other ? "; it was grasped as " + other->b + " at t=" + format_time(other->time) + " s"
-                   : std::string());
+             : grasping_ ? "; " + grasping_->why_not_grasped(args[0].text)
+                         : std::string());
       }
     }
     out_.expectations.push_back(std::move(e));

@@ -394,7 +394,9 @@ std::vector<Word> make_vocabulary() {
       {"grasped_as",
        WordKind::kExpectation,
        {{"part", kPart, kRequired, "the part"}, {"type", kGraspType, kRequired, "the grasp type"}},
-       "The hand grasps the part with this grasp type at some time.",
+       "The hand grasps the part with this grasp type at some time. Failed, it says the "
+       "hand's closest try: the moment most of the hand touched the part, what touched it, and "
+       "what the grasp lacked (the palm within 2 mm, a finger opposing it, the hand closing).",
        "grasped_as(\"pin\", \"precision\")"});
   return w;
 }

@@ -1106,6 +1106,37 @@ TEST(ScenarioRun, AHandClosingOnABarGraspsItWhereverThePalmLiesOnIt) {
   EXPECT_EQ(grasped, tried);
 }
 
+TEST(ScenarioRun, AGraspNeverMadeIsExplainedByTheHandsClosestTry) {
+  // A hand 5 mm too high wraps its fingers round the bar without its palm
+  // on it; one far above never touches it. The failure says which.
+  const test::TempDir dir("dovetail_scenario");
+  const auto detail = [&](double wrist_mm) {
+    char plan[128];
+    std::snprintf(plan, sizeof plan, "start 0 %.6f 0.060  1 0 0 0 open\nclose 0.5 fist\nwait 0.2\n",
+                  wrist_mm / 1000);
+    write(dir, "bar.plan", plan);
+    const RunOutcome o = run_scenario(write(dir, "bar.lua", R"(return scenario {
+  name = "bar", units = "mm",
+  parts = { bar = part { shape = cylinder { diameter = 30, length = 120 }, at = { -60, 0, 0 },
+                         turn = { y = 90 } } },
+  hand = glove { plan = "bar.plan" },
+  expect = { grasped_as("bar", "power") },
+})"));
+    EXPECT_EQ(o.status, RunOutcome::Status::kFailed) << o.failure_summary() << o.error;
+    return o.expectations.empty() ? std::string() : o.expectations[0].detail;
+  };
+  const std::string high = detail(15 + 10.45 + 5);
+  EXPECT_NE(high.find("'bar' was never grasped as power; the most of the hand that touched it "
+                      "was at t="),
+            std::string::npos)
+      << high;
+  EXPECT_NE(high.find("index_distal"), std::string::npos) << high;
+  EXPECT_NE(high.find("neither the palm (within 2 mm) nor the thumb's tip touched it"),
+            std::string::npos)
+      << high;
+  EXPECT_NE(detail(200).find("the hand never touched it while it held nothing"), std::string::npos);
+}
+
 TEST(ScenarioRun, AGraspBuildsUpThroughGloveNoise) {
   // A shaft with a collar, grasped by the shaft, carried into a hole, under
   // the glove's noise model (1 mm, 0.15 degrees, 0.5 degrees a joint): the

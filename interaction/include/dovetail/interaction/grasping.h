@@ -184,6 +184,11 @@ class Grasping {
   const InteractionStats& stats() const { return stats_; }
   /// Every snap refused so far, in order.
   const std::vector<RefusedSnap>& refused_snaps() const { return refused_snaps_; }
+  /// Why the hand never grasped `part`, for a report: the frame in which
+  /// most of its segments touched the part while it held nothing, what
+  /// touched and what the grasp lacked ("at t=1.240 s the palm and index
+  /// touched it, but ..."), or that it never touched it.
+  std::string why_not_grasped(const std::string& part) const;
 
  private:
   struct Models;
@@ -293,6 +298,14 @@ class Grasping {
   std::vector<engine::PartId> contact_bodies_;  ///< and of its moving bodies (SlideContact::body)
   InteractionStats stats_{};
   std::vector<RefusedSnap> refused_snaps_;
+  /// Per part: the frame in which most hand segments touched it while the
+  /// hand held nothing, for why_not_grasped.
+  struct Attempt {
+    Real time = 0;
+    std::vector<Segment> touching;
+    std::optional<GraspType> type;  ///< the grasp the contacts made, if any
+  };
+  std::map<std::string, Attempt> attempts_;
 };
 
 }  // namespace dovetail::interaction
