@@ -1450,8 +1450,17 @@ std::string RunOutcome::failure_summary() const {
     if (m.level == "fail")
       out += m.where.str() + ": failed at t=" + format_time(m.time) + " s: " + m.text + "\n";
   }
-  for (const ExpectationOutcome& e : expectations) {
-    if (!e.passed) out += e.where.str() + ": expectation " + e.text + " failed: " + e.detail + "\n";
+  // Then the expectations on what happened before those on the steps' order
+  // and time: a step never done is most often the effect of a part that
+  // touched, or never snapped, and the first line is what a summary shows.
+  const auto on_steps = [](const ExpectationOutcome& e) {
+    return e.text.rfind("steps_in_order(", 0) == 0 || e.text.rfind("finished_within(", 0) == 0;
+  };
+  for (const bool steps : {false, true}) {
+    for (const ExpectationOutcome& e : expectations) {
+      if (!e.passed && on_steps(e) == steps)
+        out += e.where.str() + ": expectation " + e.text + " failed: " + e.detail + "\n";
+    }
   }
   for (const Message& m : messages) {
     if (m.level == "violation")

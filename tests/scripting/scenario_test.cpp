@@ -521,6 +521,23 @@ TEST(ScenarioRun, TwoMovesOfAPartInOneFrameAreAWarning) {
   EXPECT_NEAR(o.final_poses[0].position.y(), 0.070, 1e-12);
 }
 
+TEST(ScenarioRun, AFailedStepsOrderComesAfterWhatWentWrong) {
+  // The peg never snaps, so its step is never done: the summary's first
+  // line (what regress shows) is the mate, not the steps' order.
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(dir, "cause.lua",
+                          moved_peg("",
+                                    "    steps_in_order { \"insert\", \"check\" },\n"
+                                    "    mate_made \"peg_in_hole\","));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed);
+  const std::string summary = o.failure_summary();
+  EXPECT_EQ(summary.rfind(file.string() + ":21: expectation mate_made(\"peg_in_hole\") failed", 0),
+            0u)
+      << summary;
+  EXPECT_NE(summary.find("expectation steps_in_order"), std::string::npos) << summary;
+}
+
 TEST(ScenarioRun, AStepOutOfOrderFailsNamingTheStepsAndTimes) {
   const test::TempDir dir("dovetail_scenario");
   const auto file =
