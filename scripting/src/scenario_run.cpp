@@ -1456,9 +1456,9 @@ std::string RunOutcome::failure_summary() const {
   const auto on_steps = [](const ExpectationOutcome& e) {
     return e.text.rfind("steps_in_order(", 0) == 0 || e.text.rfind("finished_within(", 0) == 0;
   };
-  for (const bool steps : {false, true}) {
+  for (const bool steps_pass : {false, true}) {
     for (const ExpectationOutcome& e : expectations) {
-      if (!e.passed && on_steps(e) == steps)
+      if (!e.passed && on_steps(e) == steps_pass)
         out += e.where.str() + ": expectation " + e.text + " failed: " + e.detail + "\n";
     }
   }
