@@ -641,11 +641,15 @@ void charge_string(lua_State* L, const char* name) {
   if (lua_type(L, 1) != LUA_TSTRING) return;  // a number reads short; the library reports the rest
   charge_string(L, name, lua_rawlen(L, 1));
 }
+/// The same for string.byte's and utf8.codepoint's range: i (default 1)
+/// to j (default i).
+void charge_i_to_j(lua_State* L, const char* name) {
+  if (lua_type(L, 1) != LUA_TSTRING) return;
+  const lua_Integer i = lua_isinteger(L, 2) ? lua_tointeger(L, 2) : 1;
+  charge_string(L, name, range_length(L, 2, 1, 3, i));
+}
 int sandbox_string_byte(lua_State* L) {
-  if (lua_type(L, 1) == LUA_TSTRING) {
-    const lua_Integer i = lua_isinteger(L, 2) ? lua_tointeger(L, 2) : 1;
-    charge_string(L, "string.byte", range_length(L, 2, 1, 3, i));
-  }
+  charge_i_to_j(L, "string.byte");
   return host_of(L).string_byte(L);
 }
 int sandbox_utf8_len(lua_State* L) {
@@ -653,10 +657,7 @@ int sandbox_utf8_len(lua_State* L) {
   return host_of(L).utf8_len(L);
 }
 int sandbox_utf8_codepoint(lua_State* L) {
-  if (lua_type(L, 1) == LUA_TSTRING) {
-    const lua_Integer i = lua_isinteger(L, 2) ? lua_tointeger(L, 2) : 1;
-    charge_string(L, "utf8.codepoint", range_length(L, 2, 1, 3, i));
-  }
+  charge_i_to_j(L, "utf8.codepoint");
   return host_of(L).utf8_codepoint(L);
 }
 int sandbox_utf8_offset(lua_State* L) {
@@ -706,16 +707,22 @@ int sandbox_string_format(lua_State* L) {
 
 // ---- table functions: each element moved or visited counts as one instruction
 
+/// Charges `name` one instruction per element from `first` to `last` (none
+/// when last < first), saturated; `noun` names them ("elements").
+void charge_elements(lua_State* L, lua_Integer first, lua_Integer last, const char* name,
+                     const char* noun) {
+  if (last < first) return;
+  const lua_Unsigned span = static_cast<lua_Unsigned>(last) - static_cast<lua_Unsigned>(first);
+  char what[80];
+  std::snprintf(what, sizeof(what), "%s: %llu %s", name, static_cast<unsigned long long>(span) + 1,
+                noun);
+  charge(L, span == std::numeric_limits<lua_Unsigned>::max() ? span : span + 1, what);
+}
+
 int sandbox_table_move(lua_State* L) {
   const lua_Integer first = luaL_checkinteger(L, 2);
   const lua_Integer last = luaL_checkinteger(L, 3);
-  if (last >= first) {
-    const lua_Unsigned span = static_cast<lua_Unsigned>(last) - static_cast<lua_Unsigned>(first);
-    char what[80];
-    std::snprintf(what, sizeof(what), "table.move: %llu elements",
-                  static_cast<unsigned long long>(span) + 1);
-    charge(L, span == std::numeric_limits<lua_Unsigned>::max() ? span : span + 1, what);
-  }
+  charge_elements(L, first, last, "table.move", "elements");
   return host_of(L).table_move(L);
 }
 
@@ -749,13 +756,7 @@ int sandbox_table_unpack(lua_State* L) {
   // to the length; bounds may reach past the table).
   const lua_Integer first = luaL_optinteger(L, 2, 1);
   const lua_Integer last = lua_isnoneornil(L, 3) ? luaL_len(L, 1) : luaL_checkinteger(L, 3);
-  if (last >= first) {
-    const lua_Unsigned span = static_cast<lua_Unsigned>(last) - static_cast<lua_Unsigned>(first);
-    char what[80];
-    std::snprintf(what, sizeof(what), "table.unpack: %llu values",
-                  static_cast<unsigned long long>(span) + 1);
-    charge(L, span == std::numeric_limits<lua_Unsigned>::max() ? span : span + 1, what);
-  }
+  charge_elements(L, first, last, "table.unpack", "values");
   return host_of(L).table_unpack(L);
 }
 
