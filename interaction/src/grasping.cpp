@@ -320,30 +320,25 @@ std::vector<GraspContact> Grasping::touches(const engine::Scene& scene, PartId p
     if (!overlap(collision::transformed_bounds(models_->mesh_bounds(proxy), X_WS), part_box, gap)) {
       continue;
     }
-    ++stats_.contact_queries;
-    const collision::ToleranceResult r = collision::within_tolerance(
-        part_model, models_->distance_model(proxy), engine::compose(X_PW, X_WS), gap);
-    if (!r.within) continue;
-    const auto& tri = mesh->triangles[r.triangle_a];
-    const Vec3 n_P = (mesh->vertices[tri[1]] - mesh->vertices[tri[0]])
-                         .cross(mesh->vertices[tri[2]] - mesh->vertices[tri[0]])
-                         .normalized();
-    out.push_back({segment, X_WP.apply(r.p_A), X_WP.R * n_P});
-    if (segment != Segment::kPalm) continue;
+    // A contact of the segment through `shape` (its proxy, or a strip of
+    // the palm), with the part's face normal at the witness point.
+    const auto touch = [&](const std::shared_ptr<const collision::Mesh>& shape) {
+      ++stats_.contact_queries;
+      const collision::ToleranceResult r = collision::within_tolerance(
+          part_model, models_->distance_model(shape), engine::compose(X_PW, X_WS), gap);
+      if (!r.within) return false;
+      const auto& tri = mesh->triangles[r.triangle_a];
+      const Vec3 n_P = (mesh->vertices[tri[1]] - mesh->vertices[tri[0]])
+                           .cross(mesh->vertices[tri[2]] - mesh->vertices[tri[0]])
+                           .normalized();
+      out.push_back({segment, X_WP.apply(r.p_A), X_WP.R * n_P});
+      return true;
+    };
+    if (!touch(proxy) || segment != Segment::kPalm) continue;
     // The palm meets a handle along a line, where its one nearest point may
     // lie under another finger than the one that wraps round: each strip
     // of it (one a finger's ray) touches where it does.
-    for (const auto& strip : model.palm_strips()) {
-      ++stats_.contact_queries;
-      const collision::ToleranceResult s = collision::within_tolerance(
-          part_model, models_->distance_model(strip), engine::compose(X_PW, X_WS), gap);
-      if (!s.within) continue;
-      const auto& t = mesh->triangles[s.triangle_a];
-      const Vec3 n_S = (mesh->vertices[t[1]] - mesh->vertices[t[0]])
-                           .cross(mesh->vertices[t[2]] - mesh->vertices[t[0]])
-                           .normalized();
-      out.push_back({segment, X_WP.apply(s.p_A), X_WP.R * n_S});
-    }
+    for (const auto& strip : model.palm_strips()) touch(strip);
   }
   return out;
 }
