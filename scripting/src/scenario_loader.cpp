@@ -125,6 +125,13 @@ SourceLocation parse_where(const std::string& text, const std::string& fallback_
 /// layer's limit for a mesh (collision::MeshLimits), as a pose list's.
 constexpr double kCoordinateLimit_m = 1e30;
 
+/// A size for a warning, to three figures.
+std::string brief(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", x);
+  return buffer;
+}
+
 std::string format_number(double x) {
   if (std::isnan(x)) return "nan (not a number, as 0/0 gives)";
   char buffer[32];
@@ -1480,11 +1487,6 @@ void Loader::warn_about_mesh_sizes() {
     const bool rare = metres < 2e-3 || metres > 20;
     const bool never = metres < 5e-5 || metres > 200;
     if (!(far && rare) && !never) continue;
-    const auto brief = [](double x) {
-      char buffer[32];
-      std::snprintf(buffer, sizeof buffer, "%.3g", x);
-      return std::string(buffer);
-    };
     const std::string& units = scenario_.units;
     scenario_.warnings.push_back(
         p.where.str() + ": part '" + p.name + "' (" + p.file + ") is " + brief(size) + " " + units +
@@ -1521,11 +1523,6 @@ void Loader::warn_about_parts_beside_the_hand() {
   constexpr double kRatio = 200;
   if (!(median > 0) || (median >= hand / kRatio && median <= hand * kRatio)) return;
   const double per_unit = scenario_.metres_per_unit;
-  const auto brief = [](double x) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.3g", x);
-    return std::string(buffer);
-  };
   const auto whole = [](double x) {
     char buffer[32];
     std::snprintf(buffer, sizeof buffer, "%.0f", x);
