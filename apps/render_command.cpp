@@ -16,6 +16,7 @@
 #include "dovetail/interaction/glove_source.h"
 #include "dovetail/interaction/glove_trace.h"
 #include "dovetail/interaction/hand.h"
+#include "dovetail/scripting/scenario_run.h"
 
 namespace dovetail::cli {
 
@@ -25,11 +26,20 @@ constexpr const char* kHelp =
     R"(usage: dovetail render INPUT --out PNG [--width W] [--height H] [--camera NAME|auto]
                        [--trace TRACE | --plan PLAN] [--time T] [--hand-size S]
                        [--hand-length M] [--units mm|cm|m]
+       dovetail render SCENARIO.lua --out PNG [--time T] [--trace TRACE]
+                       [--width W] [--height H] [--camera NAME|scenario|auto]
 
-Draws a mesh or assembly file off-screen and writes the picture as PNG.
+Draws a mesh or assembly file, or a scenario's frame, off-screen and writes
+the picture as PNG.
 
   INPUT          a mesh or assembly file (OBJ, STL, PLY, glTF or GLB);
                  every mesh instance becomes a part with its own palette colour
+  SCENARIO.lua   a scenario: it runs headless up to the first frame at or after
+                 --time (default 0) and that frame is drawn, the hand and the
+                 rules' highlights included, as 'dovetail run --render' draws
+                 it; --trace replays a glove trace, as 'dovetail replay' does.
+                 The camera is the scenario's (--camera scenario) when it
+                 declares one, else auto, fitted to that frame
   --out PNG      the image to write
   --width W      image width in pixels, 1 to 16384 (default 1024)
   --height H     image height in pixels, 1 to 16384 (default 768)
@@ -128,6 +138,40 @@ engine::RenderScene scene_with_hand(const Args& args, const std::string& input,
   return scene;
 }
 
+/// Whether INPUT names a scenario: a `.lua` file.
+bool is_scenario_file(const std::string& input) {
+  return std::filesystem::path(input).extension() == ".lua";
+}
+
+/// The scene of a scenario's frame at --time, run headless as `dovetail
+/// run` runs it (with --trace as `replay`); `camera` becomes the scenario's
+/// own when it has one and none was asked for.
+scripting::RunOutcome::Picture scenario_picture(const Args& args, const std::string& input,
+                                                const std::string& out, std::string& camera) {
+  for (const char* option : {"plan", "hand-size", "hand-length", "units"}) {
+    if (args.value(option)) {
+      throw UsageError(std::string("render: --") + option +
+                       " does not go with a scenario: its hand, glove and units are its own");
+    }
+  }
+  scripting::RunOptions options;
+  if (auto v = args.value("trace")) options.trace = *v;
+  options.picture_at = args.number("time", 0).value_or(0);
+  options.progress = stderr_is_terminal();
+  options.outputs.emplace_back(out);  // never a file the scenario reads
+  const scripting::RunOutcome outcome = scripting::run_scenario(input, options);
+  for (const std::string& w : outcome.warnings) {
+    std::fprintf(stderr, "warning: %s\n", engine::escape_control_bytes(w).c_str());
+  }
+  if (!outcome.picture) throw InputError(outcome.error);
+  if (camera.empty()) {
+    camera = engine::has_camera(outcome.picture->scene, scripting::kScenarioCamera)
+                 ? scripting::kScenarioCamera
+                 : "auto";
+  }
+  return *outcome.picture;
+}
+
 /// UsageError naming the scene's cameras and the built-in views when
 /// `camera` is neither.
 void check_camera(const engine::RenderScene& scene, const std::string& camera,
@@ -183,10 +227,10 @@ int render_command(std::span<const std::string> argv) {
     std::fputs(kHelp, stdout);
     return kExitOk;
   }
-  args.expect_positional(1, "one mesh or assembly file INPUT");
+  args.expect_positional(1, "one mesh or assembly file, or a scenario, INPUT");
   const std::string& input = args.positional()[0];
   const std::string out = args.required("out");
-  const engine::RenderSettings settings = render_settings(args);
+  engine::RenderSettings settings = render_settings(args);
   const std::optional<std::string> trace = args.value("trace");
   const std::optional<std::string> plan = args.value("plan");
   if (trace && plan) throw UsageError("render: give --trace or --plan, not both");
@@ -195,8 +239,9 @@ int render_command(std::span<const std::string> argv) {
   refuse_overwriting_input("render", out, inputs);
   check_writable(out);
 
-  const bool with_hand = trace || plan;
-  if (!with_hand) {
+  const bool scenario = is_scenario_file(input);
+  bool with_hand = trace || plan;
+  if (!with_hand && !scenario) {
     for (const char* option : {"time", "hand-size", "hand-length", "units"}) {
       if (args.value(option)) {
         throw UsageError(std::string("render: --") + option + " needs --trace or --plan");
@@ -205,22 +250,32 @@ int render_command(std::span<const std::string> argv) {
   }
   std::uint64_t triangles = 0;
   std::vector<std::string> files;
-  const engine::RenderScene scene =
-      with_hand ? scene_with_hand(args, input, trace, plan, triangles, files)
-                : scene_of_file(input, triangles, files);
-  refuse_overwriting_input("render", out, files);  // nor a file the input refers to
+  std::optional<scripting::RunOutcome::Picture> frame;
+  engine::RenderScene scene;
+  if (scenario) {
+    if (!args.value("camera")) settings.camera.clear();  // the scenario's, if it has one
+    frame = scenario_picture(args, input, out, settings.camera);
+    scene = std::move(frame->scene);
+    with_hand = frame->hand;
+    for (const engine::RenderItem& item : scene.items) triangles += item.mesh->triangle_count();
+  } else {
+    scene = with_hand ? scene_with_hand(args, input, trace, plan, triangles, files)
+                      : scene_of_file(input, triangles, files);
+    refuse_overwriting_input("render", out, files);  // nor a file the input refers to
+  }
 
   check_camera(scene, settings.camera, input);
   // A drawing that fails with a hand may be the hand's doing (a trace that
   // puts it far away): both inputs are named.
   const double render_ms = render_to_png(
-      scene, settings, with_hand ? input + " with the hand of " + (trace ? *trace : *plan) : input,
+      scene, settings,
+      with_hand && !scenario ? input + " with the hand of " + (trace ? *trace : *plan) : input,
       out);
 
   JsonLine json;
-  json.add("input", input)
-      .add("out", out)
-      .add("width", settings.width)
+  json.add("input", input).add("out", out);
+  if (frame) json.add("time", frame->time).add("frame", frame->frame);
+  json.add("width", settings.width)
       .add("height", settings.height)
       .add("camera", settings.camera)
       .add("parts", std::uint64_t{scene.items.size()})

@@ -85,3 +85,45 @@ add_test(NAME cli.render_to_a_full_device
          COMMAND sh -c "[ -c /dev/full ] || exit 77; \"$0\" render \"$1\" --width 8 --height 8 --out /dev/full; code=$?; [ -c /dev/full ] || { echo '/dev/full was replaced'; exit 1; }; [ $code -eq 1 ]"
                  $<TARGET_FILE:dovetail> ${data}/cube.obj)
 set_tests_properties(cli.render_to_a_full_device PROPERTIES SKIP_RETURN_CODE 77)
+
+# ---- a scenario's frame: the run up to --time, drawn as `run --render` draws it
+set(render_peg ${PROJECT_SOURCE_DIR}/scenarios/01_peg_in_hole.lua)
+dovetail_cli_test(render_scenario_frame EXIT 0
+                  ARGS render ${render_peg} --out ${out}/render_peg.png --time 2 --width 96
+                       --height 72
+                  STDOUT "\"time\":2,\"frame\":180&&\"camera\":\"scenario\"&&\"hand\":true"
+                  FILE ${out}/render_peg.png MATCHES "^.PNG" REMOVE ${out}/render_peg.png)
+# The same frame as `run --render DIR --every N` writes: the same bytes.
+dovetail_cli_test(render_scenario_run_frames EXIT 0
+                  ARGS run ${render_peg} --render ${out}/render_peg_run --every 90 --quiet
+                  REMOVE ${out}/render_peg_run)
+dovetail_cli_test(render_scenario_run_size EXIT 0
+                  ARGS render ${render_peg} --out ${out}/render_peg_180.png --time 2 --width 960
+                       --height 720
+                  STDOUT "\"frame\":180" REMOVE ${out}/render_peg_180.png)
+set_tests_properties(cli.render_scenario_run_frames PROPERTIES FIXTURES_SETUP render_peg_run)
+set_tests_properties(cli.render_scenario_run_size PROPERTIES FIXTURES_SETUP render_peg_180)
+add_test(NAME cli.render_scenario_same_bytes_as_run
+         COMMAND ${CMAKE_COMMAND} -E compare_files ${out}/render_peg_run/frame_000180.png
+                 ${out}/render_peg_180.png)
+set_tests_properties(cli.render_scenario_same_bytes_as_run PROPERTIES
+                     FIXTURES_REQUIRED "render_peg_run;render_peg_180")
+# A trace replayed, a built-in view, a frame between two frames' times.
+dovetail_cli_test(render_scenario_trace EXIT 0
+                  ARGS render ${render_peg} --out ${out}/render_peg_trace.png --width 32 --height 24
+                       --trace ${PROJECT_SOURCE_DIR}/assets/traces/peg_in_hole.csv --time 1.005
+                       --camera top
+                  STDOUT "\"time\":1.0111&&\"frame\":91&&\"camera\":\"top\""
+                  REMOVE ${out}/render_peg_trace.png)
+dovetail_cli_test(render_scenario_past_its_end EXIT 1
+                  ARGS render ${render_peg} --out ${out}/render_peg_late.png --time 200
+                  STDERR "01_peg_in_hole.lua: no frame at t=200.000 s: the run's last frame is at t=3.600 s")
+dovetail_cli_test(render_scenario_script_error EXIT 1
+                  ARGS render ${data}/scenarios/hostile/endless_custom_action.lua
+                       --out ${out}/render_endless.png --time 0.8
+                  STDERR "endless_custom_action.lua:5: instruction budget [^\n]* exceeded \\(at t=0.511 s\\)")
+dovetail_cli_test(render_scenario_units EXIT 2
+                  ARGS render ${render_peg} --out ${out}/render_peg_mm.png --units mm
+                  STDERR "--units does not go with a scenario")
+dovetail_cli_test(render_scenario_over_itself EXIT 2
+                  ARGS render ${render_peg} --out ${render_peg} STDERR "would be overwritten")

@@ -19,6 +19,7 @@
 
 #include "dovetail/collision/model.h"
 #include "dovetail/engine/pose_list.h"
+#include "dovetail/engine/render.h"
 #include "dovetail/engine/report.h"
 #include "dovetail/scripting/lua_host.h"
 #include "dovetail/scripting/scenario.h"
@@ -53,7 +54,15 @@ struct RunOptions {
   /// start, as it does for `record`, when one of them is a file the scenario
   /// reads (load_scenario's files_read) or the trace: it would be overwritten.
   std::vector<std::filesystem::path> outputs{};
+  /// Stops the run at the first frame at or after this simulated time and
+  /// keeps that frame's scene in RunOutcome::picture; the expectations are
+  /// not judged (`dovetail render SCENARIO --time T`). A run that ends, or
+  /// fails, before it is an error.
+  std::optional<double> picture_at{};
 };
+
+/// The name of the scenario's own camera among RunOutcome::picture's cameras.
+inline constexpr const char* kScenarioCamera = "scenario";
 
 /// One expectation's verdict.
 struct ExpectationOutcome {
@@ -110,6 +119,14 @@ struct RunOutcome {
   /// The frame loop alone (simulation, rules, steps, penetration), for benchmarks.
   double loop_seconds = 0;
   std::optional<std::filesystem::path> final_frame{};  ///< the PNG written, if any
+  /// With RunOptions::picture_at: the frame the run stopped at.
+  struct Picture {
+    engine::RenderScene scene{};  ///< the scenario's camera among its cameras as kScenarioCamera
+    double time = 0;
+    std::uint64_t frame = 0;
+    bool hand = false;  ///< whether the scene has the hand
+  };
+  std::optional<Picture> picture{};
   /// The run did not start because an output is a file it reads (`error`
   /// says which); the caller must not write its outputs either.
   bool outputs_refused = false;
