@@ -35,6 +35,7 @@
 #include "dovetail/engine/json.h"
 #include "dovetail/engine/paths.h"
 #include "dovetail/scripting/scenario_run.h"
+#include "report_diff.h"
 
 extern char** environ;
 
@@ -45,10 +46,11 @@ namespace {
 constexpr const char* kHelp =
     R"(usage: dovetail regress DIR [--out OUT] [--junit X.xml] [--html R.html] [-j N]
                         [--shard K/N] [--threads N] [--timeout S]
+                        [--baseline B [--baseline-tolerance T]]
 
 Runs every *.lua scenario in DIR (file-name order), each in its own process,
 checks its expectations and prints a line per scenario. Exits 0 when all pass,
-3 when one fails or cannot run.
+3 when one fails, cannot run or (with --baseline) changed.
 
   --out OUT      per-scenario reports, logs and final frames (default regress-out)
   --junit X      JUnit XML, one test case per scenario
@@ -58,7 +60,19 @@ checks its expectations and prints a line per scenario. Exits 0 when all pass,
                  to spread a folder over N machines
   --threads N    collision worker threads per scenario (default 1)
   --timeout S    seconds before a scenario is stopped (default 900)
+  --baseline B   compare every report with B/STEM.json, the OUT of an earlier regress
+                 (dovetail regress DIR --out B makes one): a scenario that passes
+                 but whose report differs in anything (a step's time, an event, a
+                 final pose, the state hash) is CHANGED, and the first difference
+                 is its reason
+  --baseline-tolerance T
+                 numbers a, b of the two reports are alike when |a - b| <= T * max(1,
+                 |a|, |b|), and the state hash is not compared (default 0: the reports
+                 must be the same bit for bit, as runs of one build are)
 )";
+
+/// How many of a scenario's differences from its baseline are kept.
+constexpr std::size_t kChangesKept = 50;
 
 struct Job {
   std::filesystem::path file;
@@ -71,6 +85,15 @@ struct Job {
   std::string status;   ///< passed, failed, error
   std::string log;      ///< what the run wrote on stderr
   nlohmann::json report;
+  /// With --baseline: the first differences from the baseline's report, how
+  /// many there are in all, why the baseline's report could not be read,
+  /// and whether there was none.
+  std::optional<std::filesystem::path> baseline;  ///< BASELINE/STEM.json
+  double baseline_tolerance = 0;
+  std::vector<ReportChange> changes;
+  std::size_t changes_total = 0;
+  std::string baseline_error;
+  bool without_baseline = false;
 };
 
 std::string read_file(const std::filesystem::path& path) {
@@ -135,8 +158,20 @@ std::string format_seconds(double s) {
   return buffer;
 }
 
+/// The first difference from the baseline, and how many more there are.
+std::string change_reason(const Job& job) {
+  if (job.changes.empty()) return {};
+  std::string reason = "changed from the baseline: " + job.changes.front().str();
+  if (job.changes_total > 1) {
+    reason += " (and " + std::to_string(job.changes_total - 1) + " more)";
+  }
+  return reason;
+}
+
 /// The first line of the log that says why, or the status.
 std::string first_reason(const Job& job) {
+  if (!job.baseline_error.empty()) return job.baseline_error;
+  if (job.status == "changed") return change_reason(job);
   std::istringstream lines(job.log);
   std::string line;
   while (std::getline(lines, line)) {
@@ -144,6 +179,29 @@ std::string first_reason(const Job& job) {
     return line;
   }
   return job.stopped.empty() ? job.status : job.stopped;
+}
+
+/// Compares the job's report (`report`, in OUT) with its baseline's: CHANGED
+/// when the run passed and they differ; an error when the baseline's report
+/// is not one. Both are read with their fields in the file's order, so the
+/// first difference is the first in the report.
+void compare_with_baseline(Job& job, const std::filesystem::path& report) {
+  std::error_code ec;
+  if (!std::filesystem::exists(*job.baseline, ec)) {
+    job.without_baseline = true;
+    return;
+  }
+  using Ordered = nlohmann::ordered_json;
+  const Ordered was = Ordered::parse(read_file(*job.baseline), nullptr, false);
+  if (!is_scenario_report(was)) {
+    job.baseline_error = job.baseline->string() + ": not a Dovetail scenario report";
+    job.status = "error";
+    return;
+  }
+  const Ordered now = Ordered::parse(read_file(report), nullptr, false);
+  if (!is_scenario_report(now)) return;  // the run wrote none: its error says why
+  job.changes = report_changes(was, now, kChangesKept, job.changes_total, job.baseline_tolerance);
+  if (job.changes_total > 0 && job.status == "passed") job.status = "changed";
 }
 
 /// Removes what an earlier regress left of `job`'s outputs, so that none of
@@ -283,12 +341,24 @@ void finish(Job& job, std::optional<int> wait_status, const std::filesystem::pat
     job.report = nlohmann::json::parse(read_file(report), nullptr, false);
     if (job.report.is_discarded()) job.report = nlohmann::json();
   }
+  if (job.baseline) compare_with_baseline(job, report);
+}
+
+/// The differences from the baseline, a line each, for the JUnit XML.
+std::string changes_text(const Job& job) {
+  if (job.changes.empty()) return {};
+  std::string text = "differences from the baseline (" + job.baseline->string() + "):\n";
+  for (const ReportChange& c : job.changes) text += "  " + c.str() + "\n";
+  if (job.changes_total > job.changes.size()) {
+    text += "  and " + std::to_string(job.changes_total - job.changes.size()) + " more\n";
+  }
+  return text;
 }
 
 void write_junit(const std::vector<Job>& jobs, const std::filesystem::path& path, double total) {
   std::size_t failures = 0, errors = 0;
   for (const Job& j : jobs) {
-    failures += j.status == "failed";
+    failures += j.status == "failed" || j.status == "changed";
     errors += j.status == "error";
   }
   std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
@@ -305,9 +375,9 @@ void write_junit(const std::vector<Job>& jobs, const std::filesystem::path& path
       xml += "/>\n";
       continue;
     }
-    xml += ">\n      <" + std::string(j.status == "failed" ? "failure" : "error") + " message=\"" +
-           xml_escape(first_reason(j)) + "\">" + xml_escape(j.log) + "</" +
-           (j.status == "failed" ? "failure" : "error") + ">\n    </testcase>\n";
+    const std::string element = j.status == "error" ? "error" : "failure";
+    xml += ">\n      <" + element + " message=\"" + xml_escape(first_reason(j)) + "\">" +
+           xml_escape(j.log + changes_text(j)) + "</" + element + ">\n    </testcase>\n";
   }
   xml += "  </testsuite>\n</testsuites>\n";
   std::ofstream out(path, std::ios::binary);
@@ -361,6 +431,21 @@ std::string html_scenario(const Job& j, std::size_t index, const std::filesystem
   h += " <span class=\"" + j.status + "\">" + j.status + "</span></h2>\n";
   h += "<p>" + xml_escape(j.file.generic_string()) + "</p>\n";
   if (!j.log.empty()) h += "<pre>" + xml_escape(j.log) + "</pre>\n";
+  if (!j.changes.empty()) {
+    h += "<details open><summary>changed from the baseline (" + std::to_string(j.changes_total) +
+         " differences)</summary><table><tr><th>where</th><th>now</th><th>baseline</th></tr>\n";
+    for (const ReportChange& c : j.changes) {
+      h += "<tr><td><code>" + xml_escape(c.where) + "</code></td><td><code>" + xml_escape(c.now) +
+           "</code></td><td><code>" + xml_escape(c.was) + "</code></td></tr>\n";
+    }
+    if (j.changes_total > j.changes.size()) {
+      h += "<tr><td colspan=\"3\">and " + std::to_string(j.changes_total - j.changes.size()) +
+           " more</td></tr>\n";
+    }
+    h += "</table></details>\n";
+  } else if (j.without_baseline) {
+    h += "<p>No baseline to compare with: " + xml_escape(j.baseline->string()) + "</p>\n";
+  }
   const std::filesystem::path png = out / j.stem / "final.png";
   std::error_code ec;
   if (std::filesystem::is_regular_file(png, ec)) {
@@ -416,16 +501,29 @@ std::string html_scenario(const Job& j, std::size_t index, const std::filesystem
   return h;
 }
 
+/// "k of n scenarios passed", and how many changed or had no baseline.
+std::string summary_of(const std::vector<Job>& jobs) {
+  std::size_t passed = 0, changed = 0, without = 0;
+  for (const Job& j : jobs) {
+    passed += j.status == "passed";
+    changed += j.status == "changed";
+    without += j.without_baseline;
+  }
+  std::string text =
+      std::to_string(passed) + " of " + std::to_string(jobs.size()) + " scenarios passed";
+  if (changed > 0) text += ", " + std::to_string(changed) + " changed from the baseline";
+  if (without > 0) text += ", " + std::to_string(without) + " without a baseline";
+  return text;
+}
+
 void write_html(const std::vector<Job>& jobs, const std::filesystem::path& path,
                 const std::filesystem::path& out, int interrupted) {
-  std::size_t passed = 0;
-  for (const Job& j : jobs) passed += j.status == "passed";
   std::string h = R"(<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>Dovetail regression</title>
 <style>
 body{font-family:sans-serif;margin:2em;color:#222;background:#fafafa}
 h1{font-size:1.5em} h2{font-size:1.2em;margin-top:2em}
-.passed{color:#1a7f37} .failed,.error{color:#c62828}
+.passed{color:#1a7f37} .failed,.error{color:#c62828} .changed{color:#b25e00}
 table{border-collapse:collapse;margin:.5em 0} td,th{border:1px solid #ccc;padding:.2em .6em;text-align:left;font-size:.9em}
 th{background:#eee} .scenario{background:#fff;border:1px solid #ddd;padding:1em;margin:1em 0}
 img{max-width:480px;border:1px solid #ccc} pre{background:#f0f0f0;padding:.5em;white-space:pre-wrap}
@@ -433,8 +531,7 @@ details{margin:.5em 0}
 </style></head><body>
 <h1>Dovetail regression</h1>
 )";
-  h += "<p id=\"summary\">" + std::to_string(passed) + " of " + std::to_string(jobs.size()) +
-       " scenarios passed" +
+  h += "<p id=\"summary\">" + summary_of(jobs) +
        (interrupted != 0 ? "; interrupted by signal " + std::to_string(interrupted)
                          : std::string()) +
        ".</p>\n<table><tr><th>scenario</th><th>outcome</th><th>seconds</th><th>reason</th></"
@@ -502,12 +599,16 @@ std::vector<Job> shard_jobs(const std::filesystem::path& folder, std::size_t sha
 
 /// Prints the line of a finished job.
 void print_line(const Job& job) {
-  std::printf("%-6s %-32s %8.2f s  %s\n",
-              job.status == "passed"   ? "PASS"
-              : job.status == "failed" ? "FAIL"
-                                       : "ERROR",
-              job.stem.c_str(), job.seconds,
-              job.status == "passed" ? "" : first_reason(job).c_str());
+  const std::string reason = job.status == "passed" ? "" : first_reason(job);
+  std::printf("%-6s %-32s %8.2f s  %s%s\n",
+              job.status == "passed"    ? "PASS"
+              : job.status == "failed"  ? "FAIL"
+              : job.status == "changed" ? "CHANGED"
+                                        : "ERROR",
+              job.stem.c_str(), job.seconds, reason.c_str(),
+              !job.without_baseline ? ""
+              : reason.empty()      ? "(no baseline)"
+                                    : " (no baseline)");
   std::fflush(stdout);
 }
 
@@ -729,8 +830,27 @@ void check_outputs(const std::optional<std::string>& junit, const std::optional<
 
 }  // namespace
 
+/// The baseline must be a folder, and not OUT: each run removes its old
+/// report from OUT before it starts.
+void check_baseline(const std::filesystem::path& baseline, const std::filesystem::path& out) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(baseline, ec)) {
+    throw InputError(baseline.string() +
+                     ": not a folder (make a baseline with 'dovetail regress "
+                     "DIR --out " +
+                     baseline.string() + "')");
+  }
+  if (engine::same_file(baseline, out)) {
+    throw UsageError("regress: --baseline " + baseline.string() +
+                     " is the output folder: its reports would be replaced before they are "
+                     "compared (give another --out)");
+  }
+}
+
 int regress_command(std::span<const std::string> argv) {
-  const Args args("regress", argv, {"out", "junit", "html", "j", "shard", "threads", "timeout"},
+  const Args args("regress", argv,
+                  {"out", "junit", "html", "j", "shard", "threads", "timeout", "baseline",
+                   "baseline-tolerance"},
                   {});
   if (args.help()) {
     std::fputs(kHelp, stdout);
@@ -749,6 +869,16 @@ int regress_command(std::span<const std::string> argv) {
   check_outputs(junit, html, scenario_files(folder), out);
   check_output_names(scenario_files(folder));
   std::vector<Job> jobs = shard_jobs(folder, shard_k, shard_n);
+  const double tolerance = args.number("baseline-tolerance", 0).value_or(0);
+  if (const std::optional<std::string> baseline = args.value("baseline")) {
+    check_baseline(*baseline, out);
+    for (Job& job : jobs) {
+      job.baseline = std::filesystem::path(*baseline) / (job.stem + ".json");
+      job.baseline_tolerance = tolerance;
+    }
+  } else if (args.value("baseline-tolerance")) {
+    throw UsageError("regress: --baseline-tolerance needs --baseline B");
+  }
   make_folder(out);
   if (::access(out.c_str(), W_OK | X_OK) != 0) {
     throw InputError(out.string() + ": cannot be written: " + std::strerror(errno));
@@ -774,7 +904,7 @@ int regress_command(std::span<const std::string> argv) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   std::size_t passed = 0;
   for (const Job& j : jobs) passed += j.status == "passed";
-  std::printf("%zu of %zu scenarios passed (%.1f s)%s\n", passed, jobs.size(), total,
+  std::printf("%s (%.1f s)%s\n", summary_of(jobs).c_str(), total,
               interrupted != 0 ? ", interrupted" : "");
   if (junit) write_junit(jobs, *junit, total);
   if (html) write_html(jobs, *html, out, interrupted);

@@ -274,6 +274,18 @@ add_test(NAME cli.regress_stale_outputs
          COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/regress_stale.sh $<TARGET_FILE:dovetail>
                  ${scenarios} ${out}/regress_stale)
 
+add_test(NAME cli.regress_baseline
+         COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/regress_baseline.sh $<TARGET_FILE:dovetail>
+                 ${scenarios} ${out}/regress_baseline)
+dovetail_cli_test(regress_baseline_is_out EXIT 2
+                  ARGS regress ${scenarios} --baseline ${out} --out ${out}
+                  STDERR "--baseline [^\n]* is the output folder")
+dovetail_cli_test(regress_baseline_missing EXIT 1
+                  ARGS regress ${scenarios} --baseline ${out}/no_such_baseline
+                  STDERR "no_such_baseline: not a folder \\(make a baseline with")
+dovetail_cli_test(regress_baseline_tolerance_alone EXIT 2
+                  ARGS regress ${scenarios} --baseline-tolerance 0.1
+                  STDERR "--baseline-tolerance needs --baseline")
 dovetail_cli_test(regress_bad_jobs EXIT 2 ARGS regress ${scenarios} -j 0 STDERR "regress: -j must be an integer from 1 to 256")
 file(MAKE_DIRECTORY ${out}/regress_empty_folder)
 dovetail_cli_test(regress_empty_folder EXIT 1 ARGS regress ${out}/regress_empty_folder

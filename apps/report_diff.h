@@ -1,0 +1,47 @@
+#pragma once
+/// \file report_diff.h
+/// What changed between two reports of one scenario: the baseline that
+/// `dovetail regress --baseline` compares against, and the run just made.
+///
+/// Why: expectations say what must hold; a regression suite must also catch
+/// what changed without breaking one (a grasp a frame later, a part seated
+/// 0.2 mm off, one more contact). Runs are deterministic, so the comparison
+/// is exact: any difference in the report's numbers is a change. Paths to the
+/// scenario are made alike first, so a checkout in another folder changes
+/// nothing.
+
+#include <cstddef>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace dovetail::cli {
+
+/// One difference: where in the report (`steps[insert].done_at`), and the
+/// value now and in the baseline as JSON (`null` where there is none).
+struct ReportChange {
+  std::string where;
+  std::string now;
+  std::string was;
+
+  /// `steps[insert].done_at: 2.5, was 2.411`.
+  std::string str() const;
+};
+
+/// Every difference between `baseline` and `now`, in the order of the
+/// report's fields, at most `limit` of them; `total` gets how many there are
+/// in all. The reports' `file` fields are not compared; the scenario's path
+/// in every text is read as its file name and the paths of its folder as
+/// relative to it.
+///
+/// With a `tolerance` above 0, two numbers a and b are alike when |a - b| <=
+/// tolerance * max(1, |a|, |b|), and the state hash, which changes with any
+/// bit of a pose, is not compared.
+std::vector<ReportChange> report_changes(const nlohmann::ordered_json& baseline,
+                                         const nlohmann::ordered_json& now, std::size_t limit,
+                                         std::size_t& total, double tolerance = 0);
+
+/// Whether `report` is a Dovetail scenario report (its `format`).
+bool is_scenario_report(const nlohmann::ordered_json& report);
+
+}  // namespace dovetail::cli

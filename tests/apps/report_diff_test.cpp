@@ -1,0 +1,101 @@
+#include "report_diff.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace dovetail::cli {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+/// A small report of the scenario at `file` whose step was done at `done_at`.
+json report(const std::string& file, double done_at) {
+  const std::string folder = file.substr(0, file.rfind('/') + 1);
+  json r;
+  r["format"] = "dovetail-scenario-report";
+  r["file"] = file;
+  r["outcome"] = "passed";
+  r["expectations"] = json::array(
+      {{{"expect", "steps_in_order({ \"insert\" })"}, {"where", file + ":42"}, {"passed", true}}});
+  r["steps"] = json::array({{{"name", "insert"}, {"done_at", done_at}}});
+  r["warnings"] = json::array({folder + "../assets/peg.stl: 3 open edges"});
+  r["simulation"] = {
+      {"state_hash", "0x01"},
+      {"events", json::array({{{"frame", 1}, {"kind", "grasped"}, {"a", "peg"}, {"b", "hand"}}})}};
+  return r;
+}
+
+std::vector<std::string> changes(const json& was, const json& now, double tolerance = 0) {
+  std::size_t total = 0;
+  std::vector<std::string> out;
+  for (const ReportChange& c : report_changes(was, now, 100, total, tolerance)) {
+    out.push_back(c.str());
+  }
+  EXPECT_EQ(total, out.size());
+  return out;
+}
+
+TEST(ReportDiff, TheSameReportInAnotherFolderHasNoChange) {
+  EXPECT_TRUE(
+      changes(report("/a/s/peg.lua", 2.5), report("/elsewhere/deeper/s/peg.lua", 2.5)).empty());
+}
+
+TEST(ReportDiff, AChangedValueIsNamedByItsPlaceAndBothValues) {
+  EXPECT_EQ(changes(report("s/peg.lua", 2.5), report("s/peg.lua", 2.25)),
+            std::vector<std::string>{"steps[insert].done_at: 2.25, was 2.5"});
+}
+
+TEST(ReportDiff, AnEventMoreIsCountedAndShown) {
+  json was = report("peg.lua", 1);
+  json now = was;
+  now["simulation"]["events"].push_back({{"frame", 9}, {"kind", "released"}, {"a", "peg"}});
+  EXPECT_EQ(changes(was, now),
+            (std::vector<std::string>{
+                "simulation.events entries: 2, was 1",
+                R"(simulation.events[1]: {"frame":9,"kind":"released","a":"peg"}, was null)"}));
+}
+
+TEST(ReportDiff, AnotherEntryInAListsPlaceIsOneChange) {
+  json was = report("peg.lua", 1);
+  json now = was;
+  now["steps"][0]["name"] = "seat";
+  now["steps"][0]["done_at"] = 3;
+  EXPECT_EQ(changes(was, now),
+            (std::vector<std::string>{
+                R"(steps[0]: {"name":"seat","done_at":3}, was {"name":"insert","done_at":1.0})"}));
+}
+
+TEST(ReportDiff, AFieldOnlyOneReportHasIsAChange) {
+  json was = report("peg.lua", 1);
+  json now = was;
+  now["error"] = "peg.lua:3: boom";
+  was.erase("warnings");
+  EXPECT_EQ(changes(was, now),
+            (std::vector<std::string>{R"(warnings: ["../assets/peg.stl: 3 open edges"], was null)",
+                                      R"(error: "peg.lua:3: boom", was null)"}));
+}
+
+TEST(ReportDiff, ATolerancePassesNearNumbersAndTheStateHash) {
+  json was = report("peg.lua", 2.5);
+  json now = report("peg.lua", 2.5 + 1e-10);
+  now["simulation"]["state_hash"] = "0x02";
+  EXPECT_EQ(changes(was, now).size(), 2U);  // the time and the hash
+  EXPECT_TRUE(changes(was, now, 1e-9).empty());
+  EXPECT_EQ(changes(report("peg.lua", 2.5), report("peg.lua", 2.6), 1e-9).size(), 1U);
+  // Relative to the larger number, absolute below 1.
+  json small_was = json{{"x", 1e-12}};
+  EXPECT_TRUE(changes(small_was, json{{"x", 5e-10}}, 1e-9).empty());
+  EXPECT_EQ(changes(json{{"x", 1000.0}}, json{{"x", 1000.002}}, 1e-9).size(), 1U);
+}
+
+TEST(ReportDiff, OnlyScenarioReportsAreReports) {
+  EXPECT_TRUE(is_scenario_report(report("peg.lua", 1)));
+  EXPECT_FALSE(is_scenario_report(json::parse(R"({"format": 3})")));
+  EXPECT_FALSE(is_scenario_report(json::parse("[1, 2]")));
+  EXPECT_FALSE(is_scenario_report(json()));
+}
+
+}  // namespace
+}  // namespace dovetail::cli
