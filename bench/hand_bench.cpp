@@ -1,13 +1,14 @@
 // Hand benchmark: what the glove-driven hand costs per frame.
 //
 //   hand_bench [--runs R] [--detail pairs|triangles|both] [--pictures DIR] [--slow MS]
-//              [--sweep TABLE]
+//              [--sweep TABLE] [--grasping]
 // --slow MS lists the sliding frames slower than MS milliseconds, with their
 // sub-steps, collision queries and contacts. --sweep TABLE runs only the
 // sliding scene along the wall (below), with the contact search's resolution
 // and sub-step budget varied, measuring the deepest overlap of peg and block
 // every frame and their distance in the frames in contact, and writes the
-// table behind the sliding chart (scripts/charts.sh).
+// table behind the sliding chart (scripts/charts.sh). --grasping runs only
+// the grasping scenes (below).
 //
 // One collision thread. Each scene is a 10,000-triangle part and the hand,
 // driven by the simulated glove through a plan that approaches, closes
@@ -37,6 +38,9 @@
 // search (a whole-part collision query per halving toward each contact pose,
 // the contact patches analysed at every hit), the one guided by the colliding
 // triangle pair without separation fronts, and the default (guided, fronts).
+//
+// Grasping: the interaction step while the open hand closes on a
+// 10,240-triangle bar and holds it (grasping(), below).
 
 #include <algorithm>
 #include <chrono>
@@ -477,6 +481,67 @@ void sliding_sweep(int runs, const std::string& table_path) {
   if (table) std::fclose(table);
 }
 
+/// Grasping: the interaction step (closing the fingers joint by joint onto
+/// the part, the contact analysis of every touching segment and the palm's
+/// strips) while the open hand closes to `fist` on a 10,240-triangle bar of
+/// 30, 40 and 50 mm lying along x, the wrist 60 mm behind its axis, and then
+/// holds it. With the palm on the bar it grasps; 2.5 mm above it, it never
+/// does, and every frame of the close tries to (the worst case).
+void grasping(int runs) {
+  std::printf(
+      "grasping: open hand closing to fist for 0.5 s on a 10,240-triangle bar, then 0.2 s "
+      "still; ms per frame of the interaction step: the first frame (it builds the bar's "
+      "distance model) apart, then the other 62; collision queries a frame\n");
+  std::printf("%-6s %-9s %9s %9s %9s %9s %9s %8s %9s %s\n", "bar mm", "palm", "grasped", "first",
+              "median", "p95", "worst", "frames", "queries", "run medians (min..max)");
+  for (const Real diameter : {0.030, 0.040, 0.050}) {
+    const auto bar =
+        std::make_shared<const collision::Mesh>(banded_cylinder(diameter / 2, 0.12, 256, 19));
+    Transform X_bar;
+    X_bar.R = interaction::rotation_y_deg(90);  // its z axis along x
+    X_bar.t = Vec3(-0.06, 0, 0);
+    for (const Real above : {0.0, 0.0025}) {
+      std::vector<double> frame_ms, run_medians, first_ms;
+      std::uint64_t grasped = 0, queries = 0, frames = 0;
+      for (int run = 0; run < runs; ++run) {
+        engine::Scene scene;
+        scene.add_part({.name = "bar", .X_QP = X_bar, .render_mesh = bar});
+        engine::Simulation sim(std::move(scene), {.collision_threads = 1});
+        GlovePlan p;
+        // The palm's face lies 10.45 mm below the wrist for the default hand.
+        p.start.p_WH = Vec3(0, diameter / 2 + 0.01045 + above, 0.06);
+        p.start_posture = *interaction::named_posture("open");
+        PlanStep wait;
+        wait.duration = 0.2;
+        p.steps = {close(0.5, "fist"), wait};
+        interaction::Hand hand(sim, std::make_shared<interaction::SimulatedGlove>(p));
+        interaction::Grasping g(sim, hand);
+        sim.prepare();
+        std::vector<double> run_ms;
+        for (int frame = 0; frame < 63; ++frame) {
+          sim.step();
+          // The first frame builds the bar's distance model: apart.
+          (frame == 0 ? first_ms : run_ms).push_back(g.stats().frame_ms);
+        }
+        grasped += g.held().has_value();
+        queries += g.stats().finger_queries + g.stats().contact_queries + g.stats().slide_queries;
+        frames += run_ms.size();
+        frame_ms.insert(frame_ms.end(), run_ms.begin(), run_ms.end());
+        run_medians.push_back(percentile(run_ms, 0.5));
+      }
+      std::printf("%-6.0f %-9s %5llu/%-3d %9.2f %9.4f %9.4f %9.4f %8llu %9.1f %.4f (%.4f..%.4f)\n",
+                  1000 * diameter, above > 0 ? "2.5 above" : "on it",
+                  static_cast<unsigned long long>(grasped), runs, percentile(first_ms, 0.5),
+                  percentile(frame_ms, 0.5), percentile(frame_ms, 0.95), percentile(frame_ms, 1.0),
+                  static_cast<unsigned long long>(frames / runs),
+                  static_cast<double>(queries) / static_cast<double>(frames + first_ms.size()),
+                  percentile(run_medians, 0.5),
+                  *std::min_element(run_medians.begin(), run_medians.end()),
+                  *std::max_element(run_medians.begin(), run_medians.end()));
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -485,6 +550,7 @@ int main(int argc, char** argv) {
   double slow_ms = 0;    // list sliding frames slower than this (0: none)
   std::string sweep;     // sliding accuracy against cost: the table, then stop
   std::string pictures;  // folder for PNGs of the sliding peg
+  bool grasping_only = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--runs" && i + 1 < argc) {
@@ -495,14 +561,20 @@ int main(int argc, char** argv) {
       slow_ms = dovetail::bench::real("hand_bench", "--slow", argv[++i], 0);
     } else if (arg == "--sweep" && i + 1 < argc) {
       sweep = argv[++i];
+    } else if (arg == "--grasping") {
+      grasping_only = true;
     } else if (arg == "--detail" && i + 1 < argc) {
       detail = argv[++i];
     } else {
       std::fprintf(stderr,
                    "usage: hand_bench [--runs R] [--detail pairs|triangles|both] [--pictures DIR] "
-                   "[--slow MS] [--sweep TABLE]\n");
+                   "[--slow MS] [--sweep TABLE] [--grasping]\n");
       return 2;
     }
+  }
+  if (grasping_only) {
+    grasping(runs);
+    return 0;
   }
   if (!sweep.empty()) {
     sliding_sweep(runs, sweep);
@@ -549,6 +621,7 @@ int main(int argc, char** argv) {
     sliding(runs, "", true, false, slow_ms, carry);
     sliding(runs, shots, true, true, slow_ms, carry);
   }
+  grasping(runs);
   if (!pictures.empty()) grasp_picture(pictures);
   return 0;
 }
