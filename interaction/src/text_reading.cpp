@@ -34,6 +34,7 @@ std::optional<std::string_view> LineReader::next() {
   // failbit with characters extracted: the buffer filled before the line ended.
   if (in_.fail()) fail("line longer than " + std::to_string(kMaxTraceLineBytes) + " bytes");
   const bool ended_by_newline = !in_.eof();
+  unended_ = !ended_by_newline;
   std::size_t length = ended_by_newline ? extracted - 1 : extracted;
   if (length > 0 && buffer_[length - 1] == '\r') --length;
   if (length > kMaxTraceLineBytes) {
@@ -58,7 +59,11 @@ std::optional<std::string_view> LineReader::next_content() {
 }
 
 void LineReader::fail(const std::string& what) const {
-  throw TraceError(name_ + ":" + std::to_string(line_) + ": " + what);
+  // A broken last line without a line end: most likely a file cut short.
+  const char* cut = unended_ ? " (the file's last line has no line end: was the file cut short "
+                               "while it was written? Without that line the rest can be read)"
+                             : "";
+  throw TraceError(name_ + ":" + std::to_string(line_) + ": " + what + cut);
 }
 
 bool is_blank_or_comment(std::string_view line) {

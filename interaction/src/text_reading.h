@@ -35,7 +35,9 @@ class LineReader {
   /// 1-based number of the line last returned; 0 before the first.
   std::size_t line() const { return line_; }
   const std::string& name() const { return name_; }
-  /// Throws TraceError `name:line: what` for the line last returned.
+  /// Throws TraceError `name:line: what` for the line last returned, with a
+  /// hint that the file was cut short when that line is its last and has no
+  /// line end.
   [[noreturn]] void fail(const std::string& what) const;
 
  private:
@@ -43,6 +45,7 @@ class LineReader {
   std::string name_;
   std::vector<char> buffer_;
   std::size_t line_ = 0;
+  bool unended_ = false;  ///< the line last returned ended the file without a line end
 };
 
 /// True for a line that holds only blanks or whose first non-blank is `#`.

@@ -419,6 +419,35 @@ TEST(GloveTrace, ReportsWriteFailure) {
   }
 }
 
+TEST(GloveTrace, AFileCutShortInItsLastLineIsSaidToBe) {
+  test::TempDir dir("dovetail_trace");
+  const auto error_of = [&](const std::string& text) {
+    write_bytes(dir / "trace.csv", text);
+    try {
+      read_trace(dir / "trace.csv");
+    } catch (const TraceError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  std::string cut = row_line(2);
+  cut.resize(cut.size() / 2);  // no line end, and too few fields
+  const std::string message = error_of(header_line() + row_line(1) + cut);
+  EXPECT_NE(message.find("trace.csv:3: expected 30 fields"), std::string::npos) << message;
+  EXPECT_NE(message.find("last line has no line end: was the file cut short"), std::string::npos)
+      << message;
+  // A broken line that is not the last, or a last line that ends, is no sign of it.
+  std::string few = row_line(2);
+  few.erase(few.rfind(','));
+  const std::string unended = row_line(3).substr(0, row_line(3).size() - 1);
+  for (const std::string& text :
+       {header_line() + few + "\n" + unended, header_line() + row_line(1) + few + "\n"}) {
+    const std::string m = error_of(text);
+    EXPECT_NE(m.find("expected 30 fields"), std::string::npos) << m;
+    EXPECT_EQ(m.find("cut short"), std::string::npos) << m;
+  }
+}
+
 TEST(GloveTrace, WrittenFileReadsBack) {
   test::TempDir dir("dovetail_trace");
   const std::vector<GloveSample> samples = {simple_sample(0), simple_sample(0.5)};
