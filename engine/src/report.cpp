@@ -96,7 +96,9 @@ std::string Report::to_json(bool with_timings) const {
   out += "  \"frames\": " + std::to_string(frames) + ",\n";
   out += "  \"time\": " + number(static_cast<double>(frames) * time_step) + ",\n";
   out += "  \"parts\": " + std::to_string(parts) + ",\n";
-  out += "  \"state_hash\": \"" + hex(state_hash) + "\",\n";
+  // No frame, no state to hash: null, never a hash of nothing that could pass for one.
+  out += "  \"state_hash\": " + (frames > 0 ? "\"" + hex(state_hash) + "\"" : std::string("null")) +
+         ",\n";
   out += "  \"events\": [";
   for (std::size_t i = 0; i < events.size(); ++i) {
     const Event& e = events[i];
