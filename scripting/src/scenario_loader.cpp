@@ -205,6 +205,18 @@ class Loader {
   void warn_about_open_surfaces();
 
  private:
+  /// Sets a flag for its lifetime.
+  class Flag {
+   public:
+    explicit Flag(bool& flag) : flag_(flag) { flag_ = true; }
+    ~Flag() { flag_ = false; }
+    Flag(const Flag&) = delete;
+    Flag& operator=(const Flag&) = delete;
+
+   private:
+    bool& flag_;
+  };
+
   /// A mistake in the file, where it is.
   struct Problem {
     SourceLocation where;
@@ -219,6 +231,13 @@ class Loader {
       // default stands in, and nothing else depends on it), reading goes on.
       noted_.push_back({where, message});
       throw OptionalFieldProblem{};
+    }
+    if (reading_part_) {
+      // A mistake that stops reading a part: noted, the part kept by its
+      // name alone (what names it still resolves), reading goes on with
+      // the next; the check fails at its end with every mistake.
+      noted_.push_back({where, message});
+      throw PartProblem{};
     }
     std::vector<Problem> all = noted_;
     all.push_back({where, message});
@@ -780,15 +799,8 @@ class Loader {
     if (lua_type(L_, -1) != LUA_TNIL && p.optional && !reading_optional_field_) {
       // A mistake here is noted and reading goes on, so that one check
       // names the mistakes of every field.
-      struct Reading {
-        bool& flag;
-        explicit Reading(bool& f) : flag(f) { flag = true; }
-        ~Reading() { flag = false; }
-        Reading(const Reading&) = delete;
-        Reading& operator=(const Reading&) = delete;
-      };
       try {
-        const Reading reading(reading_optional_field_);
+        const Flag reading(reading_optional_field_);
         arg = arg_at(lua_gettop(L_), p, field_line(where, word.name, name), what);
       } catch (const OptionalFieldProblem&) {
         arg = Arg{};
@@ -866,6 +878,8 @@ class Loader {
 
   void read_scenario_fields(int table, const SourceLocation& where);
   void read_parts(int map, const SourceLocation& where);
+  /// Reads the part `part.name` of the parts table at `map` into `part`.
+  void read_part(int map, PartSpec& part);
   std::shared_ptr<const collision::Mesh> read_shape(int index, const SourceLocation& where,
                                                     const std::string& what);
   void read_mates(int map, const SourceLocation& where);
@@ -895,6 +909,9 @@ class Loader {
   /// Set while an optional field's value is read (field()): see fail().
   mutable bool reading_optional_field_ = false;
   struct OptionalFieldProblem {};
+  /// Set while a part is read (read_parts): see fail().
+  mutable bool reading_part_ = false;
+  struct PartProblem {};
   std::vector<std::filesystem::path>* files_read_ = nullptr;
   bool hand_given_ = false;  ///< a replayed trace gives the hand the scenario lacks
   /// The text of the files read, and the lines found, for field_line.
@@ -1034,13 +1051,33 @@ void Loader::read_parts(int map, const SourceLocation& where) {
   const std::vector<std::string> names =
       declaration_names(map, where, "parts", "part", "parts = { peg = part { ... } }");
   if (names.empty()) fail(where, "scenario: parts is empty");
-  const Word& word = *find_word("part");
   for (const std::string& name : names) {
+    const int top = lua_gettop(L_);
+    PartSpec part;
+    part.name = name;
+    part.where = where;
+    try {
+      const Flag reading(reading_part_);
+      read_part(map, part);
+    } catch (const PartProblem&) {
+      // Noted: the part stands by its name alone, without a mesh.
+      lua_settop(L_, top);
+      part.mesh = nullptr;
+      part.file.clear();
+      part.attached_to.clear();
+    }
+    scenario_.parts.push_back(std::move(part));
+  }
+}
+
+void Loader::read_part(int map, PartSpec& part) {
+  const Word& word = *find_word("part");
+  const std::string& name = part.name;
+  {
+    const SourceLocation& where = part.where;
     raw_getfield(map, name);
     const int declaration = lua_gettop(L_);
     const std::string what = "part '" + name + "'";
-    PartSpec part;
-    part.name = name;
     part.where = open_declaration(declaration, "part", where, what);
     const int t = lua_gettop(L_);
     check_fields(t, word, part.where, what);
@@ -1106,7 +1143,6 @@ void Loader::read_parts(int map, const SourceLocation& where) {
     if (const Arg c = field(t, word, "color", part.where, what); c.given) part.color = c.color;
     part.tags = field(t, word, "tags", part.where, what).names;
     lua_pop(L_, 2);
-    scenario_.parts.push_back(std::move(part));
   }
 }
 

@@ -255,6 +255,39 @@ TEST(ScenarioLoad, MistakesInOptionalFieldsAreNamedAllAtOnce) {
   }
 }
 
+TEST(ScenarioLoad, APartThatCannotBeReadLeavesTheOthersToBeChecked) {
+  // A mistake in a required field (a box's size, a missing mesh file) ended
+  // the check at the first part. Now the part stands by its name alone and
+  // reading goes on: every part's mistake in one check, and what names the
+  // broken part (a mate, a rule) adds no error of its own.
+  const test::TempDir dir("dovetail_scenario");
+  const std::string what = load_error(write(dir, "parts.lua", R"(return scenario {
+  name = "parts", units = "mm",
+  parts = {
+    a = part { shape = box { size = { 10, 10 } } },
+    b = part { shape = cylinder { diameter = "wide", length = 5 } },
+    c = part { mesh = "nowhere.stl" },
+    d = part { shape = box { size = { 5, 5, 5 } }, fixed = true },
+  },
+  mates = { m = mate { part = "a", point = { 0, 0, 0 }, axis = "z",
+                       into = "b", at = { 0, 0, 0 }, along = "y" } },
+  rules = { rule { when = touches("a", "c"), act = { log "x" } },
+            rule { when = touches("a", "e"), act = { log "x" } } },
+})"));
+  const std::vector<std::string> expected = {
+      "parts.lua:4: box 'size' must be three numbers { x, y, z }",
+      "parts.lua:5: cylinder 'diameter' must be a number, not \"wide\"",
+      "parts.lua:6: part 'c': ", "nowhere.stl: file not found",
+      "parts.lua:12: touches: no part 'e'"};
+  std::size_t from = 0;
+  for (const std::string& line : expected) {
+    const std::size_t at = what.find(line, from);
+    EXPECT_NE(at, std::string::npos) << line << " in the order of the file, in:\n" << what;
+    if (at != std::string::npos) from = at;
+  }
+  EXPECT_EQ(std::count(what.begin(), what.end(), '\n') + 1, 4) << what;
+}
+
 TEST(ScenarioLoad, CoordinatesBeyondTheLimitAreErrors) {
   // 1e300 squared overflows: refused as a pose list refuses it, at load and
   // in a custom action.
