@@ -1,7 +1,9 @@
--- Peg in hole: a 20 mm peg, held a little off the hole's axis and tilted by
--- 2 degrees, is carried down into a 20.5 mm hole 40 mm deep. It slides along
--- the hole's rim and wall instead of passing through, and snaps into place at
--- the bottom when the hand opens.
+-- Peg in hole: a 20 mm peg, held 1.5 mm off the hole's axis and tilted by
+-- 2 degrees, is carried down to a 20.5 mm hole 40 mm deep. As its tip comes
+-- within 2 mm of the block the mate draws it onto the hole's axis, as a
+-- chamfer would; it goes down without touching the wall, lands on the bottom
+-- and slides there instead of passing through, and snaps into place when the
+-- hand opens.
 return scenario {
   name = "Peg in hole",
   units = "mm",

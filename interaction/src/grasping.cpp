@@ -686,6 +686,23 @@ void Grasping::report_sliding(const engine::Scene& scene, std::span<const PartId
   sliding_pairs_ = std::move(sliding);
 }
 
+std::pair<Real, Real> Grasping::extent_along(const engine::Scene& scene, PartId part,
+                                             const Transform& X_WP, const Vec3& q_W,
+                                             const Vec3& b_W) {
+  const collision::Bounds box =
+      collision::transformed_bounds(models_->mesh_bounds(scene.collision_mesh(part)), X_WP);
+  Real low = std::numeric_limits<Real>::infinity();
+  Real high = -low;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vec3 c((corner & 1) != 0 ? box.max.x() : box.min.x(),
+                 (corner & 2) != 0 ? box.max.y() : box.min.y(),
+                 (corner & 4) != 0 ? box.max.z() : box.min.z());
+    low = std::min(low, b_W.dot(c - q_W));
+    high = std::max(high, b_W.dot(c - q_W));
+  }
+  return {low, high};
+}
+
 Transform Grasping::guided(const engine::Scene& scene, PartId root, const Transform& X_WR_target) {
   for (std::size_t m = 0; m < mates_.size(); ++m) {
     const Mate& mate = mates_[m];
@@ -704,10 +721,16 @@ Transform Grasping::guided(const engine::Scene& scene, PartId root, const Transf
     const Vec3 off_axis = (p_W - q_W) - b_W * b_W.dot(p_W - q_W);
     const Real angle = std::atan2(a_W.cross(b_W).norm(), a_W.dot(b_W));
     // Captured within the tolerances, kept within three times them (glove noise
-    // must not pull the part in and out of the guide).
+    // must not pull the part in and out of the guide), once the part's leading
+    // end has come within the position tolerance of the other's near end along
+    // the axis: a chamfer draws in a peg that reaches the hole, not one held
+    // above it.
     const Real widen = guiding_ == m ? kGuideHysteresis : 1;
+    const Real other_near = extent_along(scene, o, scene.world_pose(o), q_W, b_W).first;
+    const Real part_lead = extent_along(scene, p, X_WP_target, q_W, b_W).second;
     if (off_axis.norm() > widen * mate.position_tolerance ||
-        angle > widen * mate.angle_tolerance_deg * kDegree) {
+        angle > widen * mate.angle_tolerance_deg * kDegree ||
+        part_lead < other_near - widen * mate.position_tolerance) {
       if (guiding_ == m) guiding_.reset();
       continue;
     }

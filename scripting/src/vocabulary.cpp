@@ -83,8 +83,8 @@ std::vector<Word> make_vocabulary() {
          "it would without a chamfer (default true)"}},
        "A fit: released within the tolerances, the part snaps so its point and axis meet "
        "the other's, and `mated` fires, unless in place it would overlap another part (then a "
-       "warning names it). While carried near it, the part is drawn onto the axis (unless "
-       "guide = false).",
+       "warning names it). Carried near the axis, the part is drawn onto it as it reaches the "
+       "other part, as a chamfer draws a peg (unless guide = false).",
        "peg_in_hole = mate { part = \"peg\", point = { 0, 0, 60 }, axis = \"z\", into = "
        "\"block\", at = { 0, -10, 0 }, along = \"-y\" }"});
   w.push_back({"glove",

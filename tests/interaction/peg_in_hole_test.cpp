@@ -85,7 +85,8 @@ struct PegRun {
   Real max_depth = 0;
   bool ever_colliding = false;
   Transform X_WPeg;
-  Transform X_WTab;  ///< when there is a tab
+  std::vector<Transform> peg_poses;  ///< every frame's
+  Transform X_WTab;                  ///< when there is a tab
   std::uint64_t state_hash = 0;
   Real max_stretch = 0;
   std::vector<GloveSample> recorded;  ///< the glove samples the run used
@@ -165,6 +166,7 @@ PegRun run_peg(const PegSetup& setup) {
   for (int frame = 0; frame < 270; ++frame) {
     const engine::FrameResult& r = sim.step();
     run.events.insert(run.events.end(), r.events.begin(), r.events.end());
+    run.peg_poses.push_back(sim.scene().world_pose("peg"));
     if (!measure_depth) continue;
     // Penetration every frame, by the collision layer's contact depth.
     const Transform X_WB = sim.scene().world_pose("block");
@@ -258,6 +260,29 @@ TEST(PegInHole, APegStoppedShortByAPebbleIsNotSnappedThroughIt) {
   EXPECT_GE(bottom.y(), kBlockTop - kHoleDepth + 0.0015);
   EXPECT_LT(bottom.y(), kBlockTop - kHoleDepth + 0.0015 + 1e-4);
   EXPECT_LT(run.max_depth, 1e-5);
+}
+
+TEST(PegInHole, APegIsDrawnOntoTheAxisOnlyAsItReachesTheBlock) {
+  // Guidance stands for a chamfer: it draws in a peg whose tip reaches the
+  // hole. Held 10 mm above the block the peg keeps its offset and tilt, so a
+  // start 0.5 mm further off is another run (it was drawn in at once, and
+  // two such starts gave the same report).
+  const PegRun run = run_peg({.measure_depth = false});
+  bool drawn = false;
+  for (const Transform& X : run.peg_poses) {
+    const Vec3 tip = X.apply(Vec3(0, 0, kPegLength));
+    if (tip.y() > kBlockTop + 0.003) {
+      EXPECT_NEAR(X.t.x(), 0.0015, 1e-12)
+          << "drawn in with its tip " << tip.y() - kBlockTop << " m above";
+    } else if (tip.y() < kBlockTop - 0.001) {
+      EXPECT_NEAR(tip.x(), 0, 1e-5) << "in the hole off its axis";
+      drawn = true;
+    }
+  }
+  EXPECT_TRUE(drawn);
+  const PegRun further = run_peg({.offset = 0.0019, .measure_depth = false});
+  expect_in_the_hole(further);
+  EXPECT_NE(further.report, run.report);
 }
 
 TEST(PegInHole, WithoutGuidanceAPegOffTheAxisStaysOnTheRim) {

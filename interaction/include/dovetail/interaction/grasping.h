@@ -77,11 +77,16 @@ struct GraspSettings {
 /// a point and an axis in each part's frame.
 ///
 /// Guidance: while `part` is carried with its target's feature point within
-/// the position tolerance of the other's axis line and the axes within the
-/// angle tolerance, the band pulls it onto the axis: the target turned by
-/// the least rotation onto the other's axis and moved onto the line (a peg
-/// held a little off a hole's axis is drawn in, not left on the rim). Once
-/// drawn, it stays drawn until three times the tolerances away.
+/// the position tolerance of the other's axis line, the axes within the
+/// angle tolerance, and its leading end (of its bounding box, along the
+/// axis) within the position tolerance of where the other begins along the
+/// axis (the near end of its bounding box) or past it, the band pulls it
+/// onto the axis: the target turned by the least
+/// rotation onto the other's axis and moved onto the line (a peg held a
+/// little off a hole's axis is drawn in as it reaches the hole, as a chamfer
+/// would draw it, not left on the rim; held above the hole it keeps its
+/// misalignment). Once drawn, it stays drawn until three times the
+/// tolerances away.
 /// Snap: when `part` is released with its point within the position
 /// tolerance of the other's point and the axes within the angle tolerance,
 /// its axis turns onto the other's (the least turn), its point onto the
@@ -230,6 +235,10 @@ class Grasping {
   /// of its sub-assembly whose capture region the move reaches draws that part
   /// onto its axis.
   Transform guided(const engine::Scene& scene, engine::PartId root, const Transform& X_WR_target);
+  /// Where `part` at X_WP lies along a mate's axis: the least and the
+  /// greatest b_W . (x - q_W) over the corners of its world bounding box.
+  std::pair<Real, Real> extent_along(const engine::Scene& scene, engine::PartId part,
+                                     const Transform& X_WP, const Vec3& q_W, const Vec3& b_W);
   void release(engine::Simulation& simulation, const std::string& reason);
   /// Seats the sub-assembly of the released `part` by the first of its mates
   /// within tolerance whose seat overlaps nothing.
