@@ -192,9 +192,34 @@ void compare_with_baseline(Job& job, const std::filesystem::path& report) {
     return;
   }
   using Ordered = nlohmann::ordered_json;
-  const Ordered was = Ordered::parse(read_file(*job.baseline), nullptr, false);
+  Ordered was;
+  try {
+    was = Ordered::parse(read_file(*job.baseline));
+  } catch (const nlohmann::json::parse_error& e) {
+    // The parser's own words give the place: "at line 3, column 1: ...".
+    std::string what = e.what();
+    what = what.substr(std::min(what.find("at line"), what.size()));
+    job.baseline_error = job.baseline->string() + ": not a Dovetail scenario report: no JSON " +
+                         (what.empty() ? std::string() : "(" + what + ")") +
+                         "; make it again with regress --out";
+    job.status = "error";
+    return;
+  }
   if (!is_scenario_report(was)) {
-    job.baseline_error = job.baseline->string() + ": not a Dovetail scenario report";
+    job.baseline_error = job.baseline->string() +
+                         ": not a Dovetail scenario report (its \"format\" is not "
+                         "\"dovetail-scenario-report\")";
+    job.status = "error";
+    return;
+  }
+  if (const auto version = was.find("version");
+      version == was.end() ||
+      *version != nlohmann::ordered_json(scripting::kScenarioReportVersion)) {
+    job.baseline_error = job.baseline->string() + ": a report of version " +
+                         (version == was.end() ? std::string("none") : version->dump()) +
+                         ", where this Dovetail writes version " +
+                         std::to_string(scripting::kScenarioReportVersion) +
+                         ": make the baseline again";
     job.status = "error";
     return;
   }
@@ -372,12 +397,17 @@ void write_junit(const std::vector<Job>& jobs, const std::filesystem::path& path
     xml += "    <testcase classname=\"scenarios\" name=\"" + xml_escape(j.stem) + "\" file=\"" +
            xml_escape(j.file.generic_string()) + "\" time=\"" + format_seconds(j.seconds) + "\"";
     if (j.status == "passed") {
-      xml += "/>\n";
+      xml += j.without_baseline
+                 ? ">\n      <system-out>no baseline to compare with: " +
+                       xml_escape(j.baseline->string()) + "</system-out>\n    </testcase>\n"
+                 : "/>\n";
       continue;
     }
     const std::string element = j.status == "error" ? "error" : "failure";
     xml += ">\n      <" + element + " message=\"" + xml_escape(first_reason(j)) + "\">" +
-           xml_escape(j.log + changes_text(j)) + "</" + element + ">\n    </testcase>\n";
+           xml_escape(j.log + changes_text(j) +
+                      (j.baseline_error.empty() ? "" : j.baseline_error + "\n")) +
+           "</" + element + ">\n    </testcase>\n";
   }
   xml += "  </testsuite>\n</testsuites>\n";
   std::ofstream out(path, std::ios::binary);
@@ -503,14 +533,18 @@ std::string html_scenario(const Job& j, std::size_t index, const std::filesystem
 
 /// "k of n scenarios passed", and how many changed or had no baseline.
 std::string summary_of(const std::vector<Job>& jobs) {
-  std::size_t passed = 0, changed = 0, without = 0;
+  std::size_t passed = 0, failed = 0, errors = 0, changed = 0, without = 0;
   for (const Job& j : jobs) {
     passed += j.status == "passed";
+    failed += j.status == "failed";
+    errors += j.status == "error";
     changed += j.status == "changed";
     without += j.without_baseline;
   }
   std::string text =
       std::to_string(passed) + " of " + std::to_string(jobs.size()) + " scenarios passed";
+  if (failed > 0) text += ", " + std::to_string(failed) + " failed";
+  if (errors > 0) text += ", " + std::to_string(errors) + (errors == 1 ? " error" : " errors");
   if (changed > 0) text += ", " + std::to_string(changed) + " changed from the baseline";
   if (without > 0) text += ", " + std::to_string(without) + " without a baseline";
   return text;
@@ -599,16 +633,16 @@ std::vector<Job> shard_jobs(const std::filesystem::path& folder, std::size_t sha
 
 /// Prints the line of a finished job.
 void print_line(const Job& job) {
-  const std::string reason = job.status == "passed" ? "" : first_reason(job);
-  std::printf("%-6s %-32s %8.2f s  %s%s\n",
-              job.status == "passed"    ? "PASS"
-              : job.status == "failed"  ? "FAIL"
-              : job.status == "changed" ? "CHANGED"
-                                        : "ERROR",
-              job.stem.c_str(), job.seconds, reason.c_str(),
-              !job.without_baseline ? ""
-              : reason.empty()      ? "(no baseline)"
-                                    : " (no baseline)");
+  std::string reason = job.status == "passed" ? "" : first_reason(job);
+  if (job.without_baseline) reason += reason.empty() ? "(no baseline)" : " (no baseline)";
+  char line[128];
+  std::snprintf(line, sizeof line, "%-7s %-32s %8.2f s",
+                job.status == "passed"    ? "PASS"
+                : job.status == "failed"  ? "FAIL"
+                : job.status == "changed" ? "CHANGED"
+                                          : "ERROR",
+                job.stem.c_str(), job.seconds);
+  std::printf("%s%s%s\n", line, reason.empty() ? "" : "  ", reason.c_str());
   std::fflush(stdout);
 }
 
@@ -828,24 +862,69 @@ void check_outputs(const std::optional<std::string>& junit, const std::optional<
   }
 }
 
-}  // namespace
-
-/// The baseline must be a folder, and not OUT: each run removes its old
-/// report from OUT before it starts.
-void check_baseline(const std::filesystem::path& baseline, const std::filesystem::path& out) {
+/// The baseline: a folder, not OUT (each run removes its old report from
+/// OUT before it starts), holding a report of at least one of DIR's
+/// scenarios; neither --junit nor --html may write into it. Notes the
+/// reports of scenarios no longer in DIR.
+void check_baseline(const std::filesystem::path& baseline, const std::filesystem::path& out,
+                    const std::optional<std::string>& junit, const std::optional<std::string>& html,
+                    const std::vector<std::filesystem::path>& files,
+                    const std::filesystem::path& folder) {
   std::error_code ec;
+  const std::string make_one = " (make a baseline with 'dovetail regress " + folder.string() +
+                               " --out " + baseline.string() + "')";
+  if (!std::filesystem::exists(baseline, ec)) {
+    throw InputError(baseline.string() + ": no such folder" + make_one);
+  }
   if (!std::filesystem::is_directory(baseline, ec)) {
     throw InputError(baseline.string() +
-                     ": not a folder (make a baseline with 'dovetail regress "
-                     "DIR --out " +
-                     baseline.string() + "')");
+                     ": not a folder; --baseline names the folder an earlier regress wrote its "
+                     "reports into" +
+                     make_one);
   }
   if (engine::same_file(baseline, out)) {
     throw UsageError("regress: --baseline " + baseline.string() +
                      " is the output folder: its reports would be replaced before they are "
                      "compared (give another --out)");
   }
+  for (const auto& [option, summary] : {std::pair{"junit", junit}, std::pair{"html", html}}) {
+    if (summary && inside(baseline, *summary)) {
+      throw UsageError(std::string("regress: --") + option + " '" + *summary +
+                       "' is in the baseline folder " + baseline.string() +
+                       ": it would overwrite what the runs are compared with");
+    }
+  }
+  std::set<std::string> stems;
+  std::size_t found = 0;
+  for (const std::filesystem::path& f : files) {
+    stems.insert(f.stem().string());
+    found += std::filesystem::exists(baseline / (f.stem().string() + ".json"), ec) ? 1 : 0;
+  }
+  if (found == 0) {
+    throw InputError(baseline.string() + ": holds no report of a scenario in " + folder.string() +
+                     " (STEM.json for STEM.lua)" + make_one);
+  }
+  std::vector<std::string> gone;
+  for (const auto& entry : std::filesystem::directory_iterator(baseline, ec)) {
+    const std::filesystem::path& p = entry.path();
+    if (p.extension() != ".json" || stems.count(p.stem().string()) != 0) continue;
+    if (is_scenario_report(nlohmann::ordered_json::parse(read_file(p), nullptr, false))) {
+      gone.push_back(p.stem().string());
+    }
+  }
+  std::sort(gone.begin(), gone.end());
+  if (!gone.empty()) {
+    std::string names;
+    for (const std::string& stem : gone) names += (names.empty() ? "" : ", ") + stem;
+    std::fprintf(stderr,
+                 "dovetail: note: regress: the baseline %s has reports of %zu scenario%s not in "
+                 "%s (deleted or renamed since it was made?): %s\n",
+                 baseline.string().c_str(), gone.size(), gone.size() == 1 ? "" : "s",
+                 folder.string().c_str(), names.c_str());
+  }
 }
+
+}  // namespace
 
 int regress_command(std::span<const std::string> argv) {
   const Args args("regress", argv,
@@ -871,7 +950,7 @@ int regress_command(std::span<const std::string> argv) {
   std::vector<Job> jobs = shard_jobs(folder, shard_k, shard_n);
   const double tolerance = args.number("baseline-tolerance", 0).value_or(0);
   if (const std::optional<std::string> baseline = args.value("baseline")) {
-    check_baseline(*baseline, out);
+    check_baseline(*baseline, out, junit, html, scenario_files(folder), folder);
     for (Job& job : jobs) {
       job.baseline = std::filesystem::path(*baseline) / (job.stem + ".json");
       job.baseline_tolerance = tolerance;

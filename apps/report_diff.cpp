@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <regex>
 #include <string_view>
 
 namespace dovetail::cli {
@@ -33,16 +35,68 @@ void replace_in_strings(json& value, const std::string& from, const std::string&
   }
 }
 
+/// `name:LINE` read as `name` in every text: where a clause stands in the
+/// file is no behaviour (a comment added above it moves it).
+void drop_line_numbers(json& value, const std::string& name) {
+  if (name.empty()) return;
+  if (value.is_string()) {
+    std::string text = value.get<std::string>();
+    const std::string with_colon = name + ":";
+    for (std::size_t at = text.find(with_colon); at != std::string::npos;
+         at = text.find(with_colon, at + name.size())) {
+      std::size_t end = at + with_colon.size();
+      while (end < text.size() && text[end] >= '0' && text[end] <= '9') ++end;
+      if (end > at + with_colon.size()) text.erase(at + name.size(), end - at - name.size());
+    }
+    value = std::move(text);
+  } else if (value.is_structured()) {
+    for (json& child : value) drop_line_numbers(child, name);
+  }
+}
+
 /// The report without its `file`, the scenario's path in its texts read as
-/// the file's name, and its folder's paths as relative to the folder.
+/// the file's name without line numbers, and its folder's paths as
+/// relative to the folder; its outcome and error first, the first thing a
+/// change should say.
 json normalized(const json& report) {
   json r = report;
-  if (!r.is_object() || !r.contains("file") || !r["file"].is_string()) return r;
-  const std::filesystem::path file = r["file"].get<std::string>();
-  r.erase("file");
-  replace_in_strings(r, file.string(), file.filename().string());
-  if (file.has_parent_path()) replace_in_strings(r, file.parent_path().string() + "/", "");
-  return r;
+  if (!r.is_object()) return r;
+  if (r.contains("file") && r["file"].is_string()) {
+    const std::filesystem::path file = r["file"].get<std::string>();
+    r.erase("file");
+    const std::string name = file.filename().string();
+    replace_in_strings(r, file.string(), name);
+    if (file.has_parent_path()) replace_in_strings(r, file.parent_path().string() + "/", "");
+    drop_line_numbers(r, name);
+  }
+  json ordered = json::object();
+  for (const char* first : {"outcome", "error"}) {
+    if (const auto it = r.find(first); it != r.end()) ordered[first] = *it;
+  }
+  for (const auto& [key, value] : r.items()) {
+    if (!ordered.contains(key)) ordered[key] = value;
+  }
+  return ordered;
+}
+
+/// The text's numbers and the text between them.
+struct NumberedText {
+  std::vector<std::string> words;  ///< one more than numbers
+  std::vector<double> numbers;
+};
+
+NumberedText numbered(const std::string& text, const std::regex& number) {
+  NumberedText out;
+  std::size_t from = 0;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), number);
+       it != std::sregex_iterator(); ++it) {
+    const auto at = static_cast<std::size_t>(it->position());
+    out.words.push_back(text.substr(from, at - from));
+    out.numbers.push_back(std::strtod(it->str().c_str(), nullptr));
+    from = at + static_cast<std::size_t>(it->length());
+  }
+  out.words.push_back(text.substr(from));
+  return out;
 }
 
 /// What names an entry of a list: a step's or part's name, an
@@ -105,10 +159,13 @@ class Differ {
       }
       return;
     }
-    if (was.is_number() && now.is_number() && tolerance_ > 0) {
-      const double a = was.get<double>();
-      const double b = now.get<double>();
-      if (std::abs(a - b) <= tolerance_ * std::max({1.0, std::abs(a), std::abs(b)})) return;
+    if (was.is_number() && now.is_number() && tolerance_ > 0 &&
+        alike(was.get<double>(), now.get<double>())) {
+      return;
+    }
+    if (was.is_string() && now.is_string() && tolerance_ > 0 &&
+        alike_texts(was.get<std::string>(), now.get<std::string>())) {
+      return;
     }
     if (was != now) add(where, shown(now), shown(was));
   }
@@ -117,6 +174,22 @@ class Differ {
   std::size_t total = 0;
 
  private:
+  bool alike(double a, double b) const {
+    return std::abs(a - b) <= tolerance_ * std::max({1.0, std::abs(a), std::abs(b)});
+  }
+
+  /// The same words with alike numbers between them (an expectation's
+  /// detail: "overlapped 1.214e-14 mm").
+  bool alike_texts(const std::string& a, const std::string& b) const {
+    const NumberedText x = numbered(a, number_);
+    const NumberedText y = numbered(b, number_);
+    if (x.words != y.words) return false;
+    for (std::size_t i = 0; i < x.numbers.size(); ++i) {
+      if (!alike(x.numbers[i], y.numbers[i])) return false;
+    }
+    return true;
+  }
+
   void add(std::string where, std::string now, std::string was) {
     ++total;
     if (changes.size() < limit_)
@@ -125,6 +198,7 @@ class Differ {
 
   std::size_t limit_;
   double tolerance_;
+  std::regex number_{R"([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)"};
 };
 
 }  // namespace

@@ -30,12 +30,15 @@ struct ReportChange {
 
 /// Every difference between `baseline` and `now`, in the order of the
 /// report's fields, at most `limit` of them; `total` gets how many there are
-/// in all. The reports' `file` fields are not compared; the scenario's path
-/// in every text is read as its file name and the paths of its folder as
+/// in all, the outcome and the error first. The reports' `file` fields are
+/// not compared; the scenario's path in every text is read as its file name
+/// without the line number after it (`peg.lua:32` as `peg.lua`: a comment
+/// added above a rule is no change), and the paths of its folder as
 /// relative to it.
 ///
 /// With a `tolerance` above 0, two numbers a and b are alike when |a - b| <=
-/// tolerance * max(1, |a|, |b|), and the state hash, which changes with any
+/// tolerance * max(1, |a|, |b|), so are two texts with the same words and
+/// alike numbers between them, and the state hash, which changes with any
 /// bit of a pose, is not compared.
 std::vector<ReportChange> report_changes(const nlohmann::ordered_json& baseline,
                                          const nlohmann::ordered_json& now, std::size_t limit,

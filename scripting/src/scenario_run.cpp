@@ -1424,7 +1424,8 @@ std::string_view status_name(RunOutcome::Status status) {
 std::string RunOutcome::to_json() const {
   using engine::json_number;
   using engine::json_string;
-  std::string out = "{\n  \"format\": \"dovetail-scenario-report\",\n  \"version\": 1,\n";
+  std::string out = "{\n  \"format\": \"dovetail-scenario-report\",\n  \"version\": " +
+                    std::to_string(kScenarioReportVersion) + ",\n";
   out += "  \"scenario\": " + json_string(name) + ",\n";
   out += "  \"file\": " + json_string(file.generic_string()) + ",\n";
   out += "  \"outcome\": " + json_string(status_name(status)) + ",\n";

@@ -27,6 +27,26 @@ cp -RP "$out/a" "$out/b" || exit 1
 regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o" --junit "$out/j.xml"
 grep -q "^2 of 2 scenarios passed (" "$out/stdout.txt" || fail "not every scenario passed"
 grep -q "CHANGED" "$out/stdout.txt" && fail "a scenario moved to another folder changed"
+# A comment added above every clause moves them all a line down: no change.
+{ echo '-- reviewed'; cat "$out/b/s/01_peg_in_hole.lua"; } > "$out/commented.lua" &&
+  mv "$out/commented.lua" "$out/b/s/01_peg_in_hole.lua" || exit 1
+regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o"
+
+# The baseline is an input: no summary may be written into it, and one that
+# holds no report of the folder's scenarios (an empty folder, the scenarios'
+# own folder) is an error, not a pass that compared nothing.
+regress 2 "$out/b/s" --baseline "$out/base" --out "$out/o" --html "$out/base/01_peg_in_hole.json"
+grep -q "is in the baseline folder" "$out/stderr.txt" || fail "--html into the baseline not refused"
+mkdir -p "$out/empty" || exit 1
+regress 1 "$out/b/s" --baseline "$out/empty" --out "$out/o"
+grep -q "empty: holds no report of a scenario in" "$out/stderr.txt" || fail "an empty baseline passed"
+regress 1 "$out/b/s" --baseline "$out/b/s" --out "$out/o"
+# A report of a scenario no longer in the folder is named.
+cp "$out/base/04_stacked_bricks.json" "$out/base/05_gone.json" || exit 1
+regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o"
+grep -q "note: regress: the baseline .*base has reports of 1 scenario not in .*: 05_gone$" \
+  "$out/stderr.txt" || fail "no note naming the baseline's report of a scenario gone"
+rm "$out/base/05_gone.json"
 
 # A step done at another time: CHANGED, with that difference, exit 3.
 sed 's/"done_at": 2.41[0-9]*/"done_at": 2.5/' "$out/base/01_peg_in_hole.json" > "$out/edited.json" &&
@@ -35,7 +55,7 @@ grep -q '"done_at": 2.5' "$out/base/01_peg_in_hole.json" || fail "the baseline w
 regress 3 "$out/b/s" --baseline "$out/base" --out "$out/o" --junit "$out/j.xml" --html "$out/r.html"
 grep -q '^CHANGED 01_peg_in_hole .*changed from the baseline: steps\[insert\]\.done_at: 2\.41[0-9]*, was 2\.5$' \
   "$out/stdout.txt" || fail "no CHANGED line naming the step's time"
-grep -q "^PASS   04_stacked_bricks" "$out/stdout.txt" || fail "the other scenario did not pass"
+grep -q "^PASS  *04_stacked_bricks" "$out/stdout.txt" || fail "the other scenario did not pass"
 grep -q "^1 of 2 scenarios passed, 1 changed from the baseline (" "$out/stdout.txt" ||
   fail "no summary counting the change"
 grep -q '<failure message="changed from the baseline: steps\[insert\]' "$out/j.xml" ||
@@ -48,11 +68,14 @@ regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o" --baseline-tolerance 
 # report is an error naming it.
 rm "$out/base/04_stacked_bricks.json"
 regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o" --baseline-tolerance 0.1
-grep -q "^PASS   04_stacked_bricks .*(no baseline)$" "$out/stdout.txt" || fail "no '(no baseline)' note"
+grep -q "^PASS  *04_stacked_bricks .*(no baseline)$" "$out/stdout.txt" || fail "no '(no baseline)' note"
 grep -q "^2 of 2 scenarios passed, 1 without a baseline (" "$out/stdout.txt" ||
   fail "no summary counting the scenario without a baseline"
+regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o" --baseline-tolerance 0.1 --junit "$out/j.xml"
+grep -q "<system-out>no baseline to compare with: .*04_stacked_bricks.json</system-out>" "$out/j.xml" ||
+  fail "the JUnit XML does not say a scenario had no baseline"
 echo '{' > "$out/base/04_stacked_bricks.json"
 regress 3 "$out/b/s" --baseline "$out/base" --out "$out/o"
-grep -q "^ERROR  04_stacked_bricks .*base/04_stacked_bricks.json: not a Dovetail scenario report$" \
+grep -q "^ERROR  *04_stacked_bricks .*base/04_stacked_bricks.json: not a Dovetail scenario report: no JSON" \
   "$out/stdout.txt" || fail "no error naming the baseline that is no report"
 echo "regress_baseline: ok"

@@ -40,7 +40,7 @@ if pgrep -f "$out/scenarios" > /dev/null; then fail "a run outlived regress"; fi
 grep -q "stopped: regress was interrupted by signal 15" "$out/stdout.txt" || fail "no stopped run"
 grep -q "c .*not run: regress was interrupted" "$out/stdout.txt" || fail "no run left out"
 grep -q 'tests="3" failures="0" errors="3"' "$out/junit.xml" || fail "no JUnit summary"
-grep -q '0 of 3 scenarios passed; interrupted by signal 15\.' "$out/report.html" ||
+grep -q '0 of 3 scenarios passed, 3 errors; interrupted by signal 15\.' "$out/report.html" ||
   fail "the HTML summary does not say it was interrupted"
 for name in a b c; do
   grep -q '"outcome": "error"' "$out/reports/$name.json" || fail "no report for $name"

@@ -72,9 +72,47 @@ TEST(ReportDiff, AFieldOnlyOneReportHasIsAChange) {
   json now = was;
   now["error"] = "peg.lua:3: boom";
   was.erase("warnings");
+  // The error first, the first thing a change should say; without its line.
+  EXPECT_EQ(changes(was, now), (std::vector<std::string>{
+                                   R"(error: "peg.lua: boom", was null)",
+                                   R"(warnings: ["../assets/peg.stl: 3 open edges"], was null)"}));
+}
+
+TEST(ReportDiff, AClauseMovedToAnotherLineIsNoChange) {
+  json was = report("/a/peg.lua", 1);
+  json now = report("/a/peg.lua", 1);
+  now["expectations"][0]["where"] = "/a/peg.lua:43";
+  was["messages"] = json::array({{{"text", "warning at /a/peg.lua:12: x"}}});
+  now["messages"] = json::array({{{"text", "warning at /a/peg.lua:13: x"}}});
+  EXPECT_TRUE(changes(was, now).empty());
+  now["messages"][0]["text"] = "warning at /a/peg.lua:13: y";
   EXPECT_EQ(changes(was, now),
-            (std::vector<std::string>{R"(warnings: ["../assets/peg.stl: 3 open edges"], was null)",
-                                      R"(error: "peg.lua:3: boom", was null)"}));
+            std::vector<std::string>{
+                R"(messages[0].text: "warning at peg.lua: y", was "warning at peg.lua: x")"});
+}
+
+TEST(ReportDiff, AToleranceReadsTheNumbersInTexts) {
+  json was = report("peg.lua", 1);
+  json now = report("peg.lua", 1);
+  was["expectations"][0]["detail"] = "'a' and 'b' overlapped 1.214e-14 mm at t=0.5 s";
+  now["expectations"][0]["detail"] = "'a' and 'b' overlapped 1.6e-14 mm at t=0.5 s";
+  EXPECT_EQ(changes(was, now).size(), 1U);
+  EXPECT_TRUE(changes(was, now, 1e-9).empty());
+  now["expectations"][0]["detail"] = "'a' and 'b' overlapped 1.6e-14 mm at t=0.6 s";
+  EXPECT_EQ(changes(was, now, 1e-9).size(), 1U);  // another time
+  now["expectations"][0]["detail"] = "'a' and 'c' overlapped 1.214e-14 mm at t=0.5 s";
+  EXPECT_EQ(changes(was, now, 1e-9).size(), 1U);  // another part
+}
+
+TEST(ReportDiff, TheOutcomeComesFirst) {
+  json was = report("peg.lua", 1);
+  json now = report("peg.lua", 2);
+  was["scenario"] = "p";
+  now["scenario"] = "Peg";
+  now["outcome"] = "failed";
+  const std::vector<std::string> found = changes(was, now);
+  ASSERT_FALSE(found.empty());
+  EXPECT_EQ(found.front(), R"(outcome: "failed", was "passed")");
 }
 
 TEST(ReportDiff, ATolerancePassesNearNumbersAndTheStateHash) {

@@ -135,7 +135,7 @@ dovetail_cli_test(fails_pushed_through EXIT 3 ARGS run ${scenario_data}/failing/
 # regress: hostile scripts end with clear errors, the others still run, every report is written.
 dovetail_cli_test(regress_hostile EXIT 3
                   ARGS regress ${scenario_data}/hostile --out ${out}/hostile -j 2 --junit ${out}/hostile.xml
-                  STDOUT "PASS   well_behaved&&ERROR  infinite_loop .*instruction budget&&ERROR  string_rep .*string.rep&&ERROR  memory_bomb .*memory&&ERROR  deep_recursion .*stack overflow&&ERROR  coroutine_loop .*instruction budget&&ERROR  os_exit .*'os'&&ERROR  io_open .*'io'&&ERROR  require_module .*'require'&&ERROR  package_loadlib .*'package'&&ERROR  debug_sethook .*'debug'&&ERROR  binary_chunk .*binary chunk&&ERROR  setmetatable_G .*protected metatable&&ERROR  syntax_error .*syntax_error.lua:2:&&ERROR  pcall_swallow .*instruction budget&&ERROR  endless_custom_action .*endless_custom_action.lua:5: .*instruction budget&&ERROR  pattern_backtracking .*pattern_backtracking.lua:4: string.find: the pattern&&1 of 17 scenarios passed"
+                  STDOUT "PASS +well_behaved&&ERROR +infinite_loop .*instruction budget&&ERROR +string_rep .*string.rep&&ERROR +memory_bomb .*memory&&ERROR +deep_recursion .*stack overflow&&ERROR +coroutine_loop .*instruction budget&&ERROR +os_exit .*'os'&&ERROR +io_open .*'io'&&ERROR +require_module .*'require'&&ERROR +package_loadlib .*'package'&&ERROR +debug_sethook .*'debug'&&ERROR +binary_chunk .*binary chunk&&ERROR +setmetatable_G .*protected metatable&&ERROR +syntax_error .*syntax_error.lua:2:&&ERROR +pcall_swallow .*instruction budget&&ERROR +endless_custom_action .*endless_custom_action.lua:5: .*instruction budget&&ERROR +pattern_backtracking .*pattern_backtracking.lua:4: string.find: the pattern&&1 of 17 scenarios passed"
                   FILE ${out}/hostile.xml MATCHES "tests=\"17\" failures=\"0\" errors=\"16\"")
 set_tests_properties(cli.regress_hostile PROPERTIES FIXTURES_SETUP regress_hostile)
 add_test(NAME cli.regress_hostile_reports_written
@@ -145,7 +145,7 @@ set_tests_properties(cli.regress_hostile_reports_written PROPERTIES FIXTURES_REQ
 # A scenario stopped by the timeout still gets its report and a log line saying why.
 dovetail_cli_test(regress_timeout EXIT 3
                   ARGS regress ${scenario_data}/slow --out ${out}/slow --timeout 1
-                  STDOUT "ERROR  slow .*stopped after the timeout of 1 s"
+                  STDOUT "ERROR +slow .*stopped after the timeout of 1 s"
                   FILE ${out}/slow/slow.json
                   MATCHES "\"outcome\": \"error\"&&stopped after the timeout&&\"simulation\": {&&\"max_penetration\"")
 
@@ -250,7 +250,7 @@ file(CREATE_LINK ${out}/regress_odd/no_such_file.lua ${out}/regress_odd/-dash/br
 add_test(NAME cli.regress_odd_names
          COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:dovetail>
                  "-DARGS=regress|--out|odd_out|--html|odd.html|--|-dash" -DEXPECT_EXIT=3
-                 "-DEXPECT_STDOUT=ERROR  broken .*broken.lua: file not found&&ERROR  not_utf8 &&PASS   ok"
+                 "-DEXPECT_STDOUT=ERROR +broken .*broken.lua: file not found&&ERROR +not_utf8 &&PASS +ok"
                  -DEXPECT_FILE=${out}/regress_odd/odd_out/not_utf8.json "-DEXPECT_FILE_MATCHES=bad ��"
                  -P ${CMAKE_CURRENT_SOURCE_DIR}/check_command.cmake
          WORKING_DIRECTORY ${out}/regress_odd)
@@ -282,7 +282,7 @@ dovetail_cli_test(regress_baseline_is_out EXIT 2
                   STDERR "--baseline [^\n]* is the output folder")
 dovetail_cli_test(regress_baseline_missing EXIT 1
                   ARGS regress ${scenarios} --baseline ${out}/no_such_baseline
-                  STDERR "no_such_baseline: not a folder \\(make a baseline with")
+                  STDERR "no_such_baseline: no such folder \\(make a baseline with")
 dovetail_cli_test(regress_baseline_tolerance_alone EXIT 2
                   ARGS regress ${scenarios} --baseline-tolerance 0.1
                   STDERR "--baseline-tolerance needs --baseline")

@@ -61,6 +61,9 @@ struct RunOptions {
   std::optional<double> picture_at{};
 };
 
+/// The version of the scenario report RunOutcome::to_json writes.
+inline constexpr int kScenarioReportVersion = 1;
+
 /// The name of the scenario's own camera among RunOutcome::picture's cameras.
 inline constexpr const char* kScenarioCamera = "scenario";
 
