@@ -965,41 +965,52 @@ void Loader::read_scenario_fields(int table, const SourceLocation& where) {
   check_fields(table, word, where, "scenario");
   scenario_.name = field(table, word, "name", where, "scenario").text;
   // Units first: every length depends on them.
+  // A value out of its range is noted at the field's line and its default
+  // stands, so that one check names every such mistake.
+  const auto at = [&](std::string_view key) { return field_line(where, "scenario", key); };
   const Arg units = field(table, word, "units", where, "scenario");
   if (units.given) {
-    scenario_.units = units.text;
-    const std::optional<double> metres = engine::metres_per_unit(units.text);
-    if (!metres) {
-      fail(where, "scenario: units must be \"mm\", \"cm\" or \"m\", not \"" + units.text + "\"");
+    if (const std::optional<double> metres = engine::metres_per_unit(units.text)) {
+      scenario_.units = units.text;
+      scenario_.metres_per_unit = *metres;
+    } else {
+      note(at("units"),
+           "scenario: units must be \"mm\", \"cm\" or \"m\", not \"" + units.text + "\"");
     }
-    scenario_.metres_per_unit = *metres;
   }
   if (const Arg a = field(table, word, "seed", where, "scenario"); a.given) {
     scenario_.seed = static_cast<std::uint64_t>(a.number);
   }
   if (const Arg a = field(table, word, "duration", where, "scenario"); a.given) {
     if (a.number > kMaxRunSeconds) {
-      fail(where, "scenario: duration must be at most " + format_number(kMaxRunSeconds) + " s");
+      note(at("duration"),
+           "scenario: duration must be at most " + format_number(kMaxRunSeconds) + " s");
+    } else {
+      scenario_.duration = a.number;
     }
-    scenario_.duration = a.number;
   }
   if (const Arg a = field(table, word, "time_step", where, "scenario"); a.given) {
-    if (!(a.number >= 1e-4 && a.number <= 1))
-      fail(where, "scenario: time_step must be in [0.0001, 1] s");
-    scenario_.time_step = a.number;
+    if (!(a.number >= 1e-4 && a.number <= 1)) {
+      note(at("time_step"),
+           "scenario: time_step must be in [0.0001, 1] s, not " + format_number(a.number));
+    } else {
+      scenario_.time_step = a.number;
+    }
   }
   // "exact" or a length: not one of the argument types, so read here.
   raw_getfield(table, "accuracy");
   if (lua_type(L_, -1) == LUA_TNUMBER) {
     const double tolerance = lua_tonumber(L_, -1);
     if (!(tolerance > 0) || !std::isfinite(tolerance)) {
-      fail(where, "scenario: accuracy must be \"exact\" or a length > 0 (a tolerance), not " +
-                      format_number(tolerance));
+      note(at("accuracy"),
+           "scenario: accuracy must be \"exact\" or a length > 0 (a tolerance), not " +
+               format_number(tolerance));
+    } else {
+      scenario_.tolerance_m = tolerance * scenario_.metres_per_unit;
     }
-    scenario_.tolerance_m = tolerance * scenario_.metres_per_unit;
   } else if (lua_type(L_, -1) != LUA_TNIL &&
              !(lua_type(L_, -1) == LUA_TSTRING && string_at(-1) == "exact")) {
-    fail(where,
+    note(at("accuracy"),
          std::string("scenario: accuracy must be \"exact\" or a length > 0 (a tolerance), "
                      "not a ") +
              luaL_typename(L_, -1) +

@@ -288,6 +288,27 @@ TEST(ScenarioLoad, APartThatCannotBeReadLeavesTheOthersToBeChecked) {
   EXPECT_EQ(std::count(what.begin(), what.end(), '\n') + 1, 4) << what;
 }
 
+TEST(ScenarioLoad, TheScenarioFieldsOutOfRangeAreNamedAllAtTheirLines) {
+  // They were named at the `return scenario` line, one per check, and a
+  // second on the same line was lost.
+  const test::TempDir dir("dovetail_scenario");
+  const std::string what = load_error(write(dir, "range.lua", R"(return scenario {
+  name = "range",
+  units = "inch",
+  time_step = 2, duration = 99999,
+  accuracy = "fine",
+  parts = { a = part { shape = box { size = { 10, 10, 10 } } } },
+})"));
+  const std::vector<std::string> expected = {
+      "range.lua:3: scenario: units must be \"mm\", \"cm\" or \"m\", not \"inch\"",
+      "range.lua:4: scenario: time_step must be in [0.0001, 1] s, not 2",
+      "range.lua:4: scenario: duration must be at most 3600 s",
+      "range.lua:5: scenario: accuracy must be \"exact\" or a length > 0"};
+  for (const std::string& line : expected) {
+    EXPECT_NE(what.find(line), std::string::npos) << line << " in:\n" << what;
+  }
+}
+
 TEST(ScenarioLoad, CoordinatesBeyondTheLimitAreErrors) {
   // 1e300 squared overflows: refused as a pose list refuses it, at load and
   // in a custom action.
