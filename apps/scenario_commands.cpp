@@ -87,6 +87,28 @@ std::filesystem::path default_scenario() {
       "run: no scenario given and no scenarios/ folder found (see 'dovetail run --help')");
 }
 
+/// Whether `name` is that of a frame `run --render DIR --every N` writes.
+bool is_frame_name(const std::string& name) {
+  static const std::regex frame("frame_[0-9]{6,}\\.png");
+  return std::regex_match(name, frame);
+}
+
+/// Removes the frame_NNNNNN.png an earlier run left in `folder`, so that a
+/// shorter run's frames are not mixed with them; says how many.
+void remove_old_frames(const std::filesystem::path& folder) {
+  std::error_code ec;
+  std::size_t removed = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
+    if (!entry.is_regular_file(ec) || entry.is_symlink(ec)) continue;
+    if (!is_frame_name(entry.path().filename().string())) continue;
+    removed += std::filesystem::remove(entry.path(), ec) ? 1 : 0;
+  }
+  if (removed > 0) {
+    std::fprintf(stderr, "dovetail: note: removed %zu frame%s an earlier run left in %s\n", removed,
+                 removed == 1 ? "" : "s", folder.string().c_str());
+  }
+}
+
 /// The run's options from the command line (run and replay share them).
 scripting::RunOptions run_options(const Args& args, std::optional<std::filesystem::path> trace) {
   scripting::RunOptions options;
@@ -95,6 +117,7 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
   if (auto v = args.value("render")) {
     options.render_dir = *v;
     make_folder(*v);
+    remove_old_frames(*v);
   }
   options.render_every = args.unsigned_integer("every").value_or(0);
   if (args.value("every") && !options.render_dir)
@@ -198,8 +221,7 @@ bool written_into(const std::filesystem::path& folder, const std::filesystem::pa
   if (!engine::same_file(parent, folder)) return false;
   const std::string name = file.filename().string();
   if (!render) return name.ends_with(".capture");
-  static const std::regex frame("frame_[0-9]{6,}\\.png");
-  return name == "final.png" || std::regex_match(name, frame);
+  return name == "final.png" || is_frame_name(name);
 }
 
 /// The report and the recording, before the run and before its folders

@@ -127,3 +127,9 @@ dovetail_cli_test(render_scenario_units EXIT 2
                   STDERR "--units does not go with a scenario")
 dovetail_cli_test(render_scenario_over_itself EXIT 2
                   ARGS render ${render_peg} --out ${render_peg} STDERR "would be overwritten")
+
+# `run --render DIR` removes the frames an earlier run left in DIR (a
+# shorter run's frames are not mixed with them), and nothing else.
+add_test(NAME cli.run_render_removes_old_frames
+         COMMAND sh -c "rm -rf \"$1\" && mkdir -p \"$1\" && touch \"$1/frame_009999.png\" \"$1/mine.png\" && \"$0\" run \"$2\" --render \"$1\" --every 1000 --quiet 2> \"$1.err\" && [ ! -e \"$1/frame_009999.png\" ] && [ -e \"$1/mine.png\" ] && [ -e \"$1/frame_000000.png\" ] && grep -q 'removed 1 frame an earlier run left in' \"$1.err\""
+                 $<TARGET_FILE:dovetail> ${out}/render_old_frames ${PROJECT_SOURCE_DIR}/scenarios/04_stacked_bricks.lua)
