@@ -1319,9 +1319,17 @@ void Runner::run() {
       // The picture is what was asked for: the expectations are not judged.
       out_.status = RunOutcome::Status::kPassed;
       if (!out_.picture) {
+        // A rule's fail ended the run before: which, where and why.
+        std::string why = "a rule failed the run";
+        for (const Message& m : out_.messages) {
+          if (m.level == "fail") {
+            why = m.where.str() + ": a rule failed the run at t=" + format_time(m.time) +
+                  " s: " + m.text;
+          }
+        }
         out_.status = RunOutcome::Status::kError;
         out_.error = file_.string() + ": no frame at t=" + format_time(*options_.picture_at) +
-                     " s: a rule failed the run at t=" + format_time(sim_->time()) + " s";
+                     " s: " + why;
       }
       out_.report = sim_->report();
       out_.wall_seconds =

@@ -133,3 +133,7 @@ dovetail_cli_test(render_scenario_over_itself EXIT 2
 add_test(NAME cli.run_render_removes_old_frames
          COMMAND sh -c "rm -rf \"$1\" && mkdir -p \"$1\" && touch \"$1/frame_009999.png\" \"$1/mine.png\" && \"$0\" run \"$2\" --render \"$1\" --every 1000 --quiet 2> \"$1.err\" && [ ! -e \"$1/frame_009999.png\" ] && [ -e \"$1/mine.png\" ] && [ -e \"$1/frame_000000.png\" ] && grep -q 'removed 1 frame an earlier run left in' \"$1.err\""
                  $<TARGET_FILE:dovetail> ${out}/render_old_frames ${PROJECT_SOURCE_DIR}/scenarios/04_stacked_bricks.lua)
+dovetail_cli_test(render_scenario_failed_before EXIT 1
+                  ARGS render ${data}/scenarios/failing/rule_fails.lua --out ${out}/render_failed.png
+                       --time 1
+                  STDERR "rule_fails.lua: no frame at t=1.000 s: [^\n]*rule_fails.lua:4: a rule failed the run at t=0.500 s: stop here")
