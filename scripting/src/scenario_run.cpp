@@ -1212,8 +1212,11 @@ std::optional<std::string> Runner::output_read() const {
   for (const std::filesystem::path& w : writes) {
     for (const std::filesystem::path& r : reads) {
       if (engine::same_file(w, r)) {
-        return "the output '" + w.string() + "' is '" + r.string() +
-               "', which the run reads; it would be overwritten";
+        // Named once when both name it alike, else both ways (a link, another path).
+        const std::string which =
+            w == r ? "'" + w.string() + "'"
+                   : "'" + w.string() + "' (which is '" + r.string() + "')";
+        return "the output " + which + " is a file the run reads; it would be overwritten";
       }
     }
   }
