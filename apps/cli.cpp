@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "dovetail/engine/paths.h"
+#include "dovetail/scripting/vocabulary.h"
 
 namespace dovetail::cli {
 
@@ -20,6 +21,19 @@ namespace {
 
 std::string see_help(const std::string& command) {
   return " (see 'dovetail " + command + " --help')";
+}
+
+/// " (did you mean '--report'?)" for a misspelt option, else see_help.
+std::string option_hint(const std::string& command, const std::string& option,
+                        const std::set<std::string>& value_options,
+                        const std::set<std::string>& flags) {
+  std::vector<std::string> known;
+  for (const std::set<std::string>* names : {&value_options, &flags}) {
+    for (const std::string& n : *names) known.push_back((n.size() == 1 ? "-" : "--") + n);
+  }
+  known.emplace_back("--help");
+  const std::string hint = scripting::did_you_mean(option, known);
+  return hint.empty() ? see_help(command) : hint;
 }
 
 }  // namespace
@@ -50,7 +64,8 @@ Args::Args(std::string command, std::span<const std::string> argv,
     const bool short_joined = arg.size() > 2 && arg[1] != '-' &&
                               value_options.count(arg.substr(1, 1)) != 0 && arg[2] != '=';
     if (arg.rfind("--", 0) != 0 && !short_option && !short_joined) {
-      throw UsageError(command_ + ": unknown option '" + arg + "'" + see_help(command_));
+      throw UsageError(command_ + ": unknown option '" + arg + "'" +
+                       option_hint(command_, arg, value_options, flags));
     }
     std::string name =
         short_joined ? arg.substr(1, 1) + "=" + arg.substr(2) : arg.substr(short_option ? 1 : 2);
@@ -79,7 +94,8 @@ Args::Args(std::string command, std::span<const std::string> argv,
       }
       values_[name] = *inline_value;
     } else {
-      throw UsageError(command_ + ": unknown option '--" + name + "'" + see_help(command_));
+      throw UsageError(command_ + ": unknown option '--" + name + "'" +
+                       option_hint(command_, "--" + name, value_options, flags));
     }
   }
 }

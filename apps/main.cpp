@@ -16,6 +16,7 @@
 #include "dovetail/engine/pose_list.h"
 #include "dovetail/scripting/lua_host.h"
 #include "dovetail/scripting/scenario.h"
+#include "dovetail/scripting/vocabulary.h"
 
 namespace {
 
@@ -102,7 +103,11 @@ int dispatch(const std::vector<std::string>& args) {
       return command.run(std::span<const std::string>(args).subspan(1));
     }
   }
-  throw dovetail::cli::UsageError("unknown command '" + name + "' (see 'dovetail --help')");
+  std::vector<std::string> names;
+  for (const Command& command : kCommands) names.emplace_back(command.name);
+  const std::string hint = dovetail::scripting::did_you_mean(name, names);
+  throw dovetail::cli::UsageError("unknown command '" + name + "'" +
+                                  (hint.empty() ? " (see 'dovetail --help')" : hint));
 }
 
 /// Prints `message` whole: a control byte a file brought in is written as
