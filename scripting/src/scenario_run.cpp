@@ -233,6 +233,8 @@ class Runner {
   /// Fills `error` and returns false for an unknown part.
   bool part_pose(const char* name, Transform& X, char* error, std::size_t size);
   bool set_part_pose(const char* name, const Transform& X, char* error, std::size_t size);
+  /// Fills `error` for an unknown part: its name and the nearest the scenario declares.
+  void no_part(const char* name, char* error, std::size_t size) const;
   /// The time of the frame whose start runs the action (or of the last
   /// frame, for actions applied after it).
   double time() const { return action_time_; }
@@ -525,10 +527,16 @@ void push_api(lua_State* L) {
 
 // ---- the runner
 
+void Runner::no_part(const char* name, char* error, std::size_t size) const {
+  std::vector<std::string> parts;
+  for (const PartSpec& p : scenario_.parts) parts.push_back(p.name);
+  std::snprintf(error, size, "dt.part: no part '%s'%s", name, did_you_mean(name, parts).c_str());
+}
+
 bool Runner::part_pose(const char* name, Transform& X, char* error, std::size_t size) {
   const PartId p = sim_->scene().find(name);
   if (!p.valid()) {
-    std::snprintf(error, size, "dt.part: no part '%s'", name);
+    no_part(name, error, size);
     return false;
   }
   X = sim_->scene().world_pose(p);
@@ -538,7 +546,7 @@ bool Runner::part_pose(const char* name, Transform& X, char* error, std::size_t 
 bool Runner::set_part_pose(const char* name, const Transform& X, char* error, std::size_t size) {
   const PartId p = sim_->scene().find(name);
   if (!p.valid()) {
-    std::snprintf(error, size, "dt.part: no part '%s'", name);
+    no_part(name, error, size);
     return false;
   }
   if (!sim_->scene().movable(p)) {
@@ -1213,9 +1221,8 @@ std::optional<std::string> Runner::output_read() const {
     for (const std::filesystem::path& r : reads) {
       if (engine::same_file(w, r)) {
         // Named once when both name it alike, else both ways (a link, another path).
-        const std::string which =
-            w == r ? "'" + w.string() + "'"
-                   : "'" + w.string() + "' (which is '" + r.string() + "')";
+        const std::string which = w == r ? "'" + w.string() + "'"
+                                         : "'" + w.string() + "' (which is '" + r.string() + "')";
         return "the output " + which + " is a file the run reads; it would be overwritten";
       }
     }
@@ -1331,8 +1338,8 @@ void Runner::run() {
           }
         }
         out_.status = RunOutcome::Status::kError;
-        out_.error = file_.string() + ": no frame at t=" + format_time(*options_.picture_at) +
-                     " s: " + why;
+        out_.error =
+            file_.string() + ": no frame at t=" + format_time(*options_.picture_at) + " s: " + why;
       }
       out_.report = sim_->report();
       out_.wall_seconds =

@@ -202,6 +202,11 @@ TEST(ScenarioRun, AMisspeltNameOfTheCustomActionsApiGetsTheNearestOne) {
       << function.error;
   EXPECT_EQ(run("right.lua", "dt.part(\"a\"):set_translation(1, 2, 3)").status,
             RunOutcome::Status::kPassed);
+  const RunOutcome part = run("part.lua", "dt.part(\"aa\"):translation()");
+  ASSERT_EQ(part.status, RunOutcome::Status::kError);
+  EXPECT_NE(part.error.find("part.lua:5: dt.part: no part 'aa' (did you mean 'a'?)"),
+            std::string::npos)
+      << part.error;
 }
 
 TEST(ScenarioLoad, AFieldsLineIsFoundInItsOwnDeclarationOnly) {
