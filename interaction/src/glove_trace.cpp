@@ -189,9 +189,33 @@ std::optional<std::string> radian_angles(std::span<const GloveSample> samples) {
   return std::string(text);
 }
 
+std::optional<std::string> dropped_samples(std::span<const GloveSample> samples) {
+  // A gap of many samples: the hand moves in a straight line across it.
+  if (samples.size() < 3) return std::nullopt;
+  std::vector<Real> gaps;
+  Real widest = 0, after = 0;
+  for (std::size_t i = 1; i < samples.size(); ++i) {
+    const Real gap = samples[i].t - samples[i - 1].t;
+    gaps.push_back(gap);
+    if (gap > widest) widest = gap, after = samples[i - 1].t;
+  }
+  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2),
+                   gaps.end());
+  const Real median = gaps[gaps.size() / 2];
+  constexpr Real kDropped = 5;  // times the median gap
+  if (!(widest > kDropped * median)) return std::nullopt;
+  char text[300];
+  std::snprintf(text, sizeof text,
+                "no sample for %.6g s after t=%.6g s, %.0f times the median gap of %.6g s: "
+                "were samples dropped? The hand moves in a straight line across the gap",
+                widest, after, widest / median, median);
+  return std::string(text);
+}
+
 std::vector<std::string> trace_doubts(const fs::path& path, std::span<const GloveSample> samples) {
   std::vector<std::string> doubts;
   if (std::optional<std::string> sparse = sparse_samples(samples)) doubts.push_back(*sparse);
+  if (std::optional<std::string> dropped = dropped_samples(samples)) doubts.push_back(*dropped);
   if (std::optional<std::string> radians = radian_angles(samples)) doubts.push_back(*radians);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (in && in.tellg() > 0) {

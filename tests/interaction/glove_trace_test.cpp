@@ -460,3 +460,30 @@ TEST(GloveTrace, WrittenFileReadsBack) {
 
 }  // namespace
 }  // namespace dovetail::interaction
+
+namespace dovetail::interaction {
+namespace {
+
+std::vector<GloveSample> samples_at(std::initializer_list<Real> times) {
+  std::vector<GloveSample> samples;
+  for (const Real t : times) samples.push_back(simple_sample(t));
+  return samples;
+}
+
+TEST(GloveTraceDoubts, AGapOfManySamplesIsNamedAndAnEvenTraceIsNot) {
+  std::vector<GloveSample> even;
+  for (int i = 0; i < 100; ++i) even.push_back(simple_sample(i / 90.0));
+  EXPECT_FALSE(dropped_samples(even).has_value());
+  // Jitter of a sample or two is no drop.
+  EXPECT_FALSE(dropped_samples(samples_at({0, 0.01, 0.02, 0.04, 0.05, 0.06})).has_value());
+  std::vector<GloveSample> dropped = even;
+  dropped.erase(dropped.begin() + 40, dropped.begin() + 60);
+  const std::optional<std::string> doubt = dropped_samples(dropped);
+  ASSERT_TRUE(doubt.has_value());
+  EXPECT_NE(doubt->find("no sample for 0.233333 s after t=0.433333 s, 21 times the median gap"),
+            std::string::npos)
+      << *doubt;
+}
+
+}  // namespace
+}  // namespace dovetail::interaction

@@ -61,14 +61,17 @@ std::vector<GloveSample> read_trace(const std::filesystem::path& path);
 
 /// What makes a trace that reads cleanly doubtful, one sentence each, without
 /// the file's name: samples far sparser than any glove's (times written in
-/// milliseconds read as seconds), joint angles in radians, and a last line
-/// without a line end (a file cut short while written, whose last value may
-/// be cut too). For warnings.
+/// milliseconds read as seconds), a gap of many samples (samples dropped),
+/// joint angles in radians, and a last line without a line end (a file cut
+/// short while written, whose last value may be cut too). For warnings.
 std::vector<std::string> trace_doubts(const std::filesystem::path& path,
                                       std::span<const GloveSample> samples);
 /// trace_doubts' first: samples more than 0.1 s apart at the median.
 std::optional<std::string> sparse_samples(std::span<const GloveSample> samples);
-/// trace_doubts' second: every joint angle within +-pi while some joint
+/// trace_doubts' second: the widest gap between samples over 5 times the
+/// median gap (samples dropped; the hand moves in a straight line across it).
+std::optional<std::string> dropped_samples(std::span<const GloveSample> samples);
+/// trace_doubts' third: every joint angle within +-pi while some joint
 /// sweeps over 0.5 (radians, where degrees are read; a still hand in
 /// degrees sweeps less).
 std::optional<std::string> radian_angles(std::span<const GloveSample> samples);
