@@ -120,6 +120,9 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
     remove_old_frames(*v);
   }
   options.render_every = args.unsigned_integer("every").value_or(0);
+  if (args.value("every") && options.render_every == 0) {
+    throw UsageError(args.command() + ": --every must be at least 1 (every N-th frame)");
+  }
   if (args.value("every") && !options.render_dir)
     throw UsageError(args.command() + ": --every needs --render DIR");
   options.threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));

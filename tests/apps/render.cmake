@@ -137,3 +137,6 @@ dovetail_cli_test(render_scenario_failed_before EXIT 1
                   ARGS render ${data}/scenarios/failing/rule_fails.lua --out ${out}/render_failed.png
                        --time 1
                   STDERR "rule_fails.lua: no frame at t=1.000 s: [^\n]*rule_fails.lua:4: a rule failed the run at t=0.500 s: stop here")
+dovetail_cli_test(run_render_every_zero EXIT 2
+                  ARGS run ${PROJECT_SOURCE_DIR}/scenarios/04_stacked_bricks.lua --render ${out}/every_zero --every 0
+                  STDERR "run: --every must be at least 1")
