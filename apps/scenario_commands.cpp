@@ -114,11 +114,7 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
   scripting::RunOptions options;
   options.trace = std::move(trace);
   if (auto v = args.value("record")) options.record = *v;
-  if (auto v = args.value("render")) {
-    options.render_dir = *v;
-    make_folder(*v);
-    remove_old_frames(*v);
-  }
+  if (auto v = args.value("render")) options.render_dir = *v;
   options.render_every = args.unsigned_integer("every").value_or(0);
   if (args.value("every") && options.render_every == 0) {
     throw UsageError(args.command() + ": --every must be at least 1 (every N-th frame)");
@@ -132,10 +128,7 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
     if (!options.method)
       throw UsageError(args.command() + ": unknown --method '" + *v + "' (" + method_list() + ")");
   }
-  if (auto v = args.value("capture")) {
-    options.capture_dir = *v;
-    make_folder(*v);
-  }
+  if (auto v = args.value("capture")) options.capture_dir = *v;
   if (auto v = args.value("cross-check")) {
     if (!options.capture_dir)
       throw UsageError(args.command() + ": --cross-check needs --capture DIR");
@@ -145,6 +138,12 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
                        method_list() + ")");
     }
   }
+  // The folders last, once every option is known to be right.
+  if (options.render_dir) {
+    make_folder(*options.render_dir);
+    remove_old_frames(*options.render_dir);
+  }
+  if (options.capture_dir) make_folder(*options.capture_dir);
   return options;
 }
 
