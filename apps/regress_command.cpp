@@ -94,6 +94,7 @@ struct Job {
   std::size_t changes_total = 0;
   std::string baseline_error;
   bool without_baseline = false;
+  bool compared = false;  ///< both reports read and compared
 };
 
 std::string read_file(const std::filesystem::path& path) {
@@ -226,6 +227,7 @@ void compare_with_baseline(Job& job, const std::filesystem::path& report) {
   const Ordered now = Ordered::parse(read_file(report), nullptr, false);
   if (!is_scenario_report(now)) return;  // the run wrote none: its error says why
   job.changes = report_changes(was, now, kChangesKept, job.changes_total, job.baseline_tolerance);
+  job.compared = true;
   if (job.changes_total > 0 && job.status == "passed") job.status = "changed";
 }
 
@@ -533,13 +535,14 @@ std::string html_scenario(const Job& j, std::size_t index, const std::filesystem
 
 /// "k of n scenarios passed", and how many changed or had no baseline.
 std::string summary_of(const std::vector<Job>& jobs) {
-  std::size_t passed = 0, failed = 0, errors = 0, changed = 0, without = 0;
+  std::size_t passed = 0, failed = 0, errors = 0, changed = 0, without = 0, same = 0;
   for (const Job& j : jobs) {
     passed += j.status == "passed";
     failed += j.status == "failed";
     errors += j.status == "error";
     changed += j.status == "changed";
     without += j.without_baseline;
+    same += j.compared && j.changes_total == 0;
   }
   std::string text =
       std::to_string(passed) + " of " + std::to_string(jobs.size()) + " scenarios passed";
@@ -547,6 +550,7 @@ std::string summary_of(const std::vector<Job>& jobs) {
   if (errors > 0) text += ", " + std::to_string(errors) + (errors == 1 ? " error" : " errors");
   if (changed > 0) text += ", " + std::to_string(changed) + " changed from the baseline";
   if (without > 0) text += ", " + std::to_string(without) + " without a baseline";
+  if (same > 0) text += ", " + std::to_string(same) + " the same as the baseline";
   return text;
 }
 

@@ -295,6 +295,10 @@ int run_command(std::span<const std::string> argv) {
     throw UsageError("run: one scenario at a time (see 'dovetail regress')");
   const std::filesystem::path scenario =
       args.positional().empty() ? default_scenario() : std::filesystem::path(args.positional()[0]);
+  if (args.positional().empty() && !args.flag("quiet")) {
+    std::fprintf(stderr, "dovetail: note: running the first shipped scenario, %s\n",
+                 scenario.string().c_str());
+  }
   std::optional<std::filesystem::path> trace;
   if (auto v = args.value("trace")) trace = *v;
   return run_scenario_command(args, scenario, trace);

@@ -25,7 +25,7 @@ ln -s "$(cd "$scenarios/../assets" && pwd)" "$out/a/assets" || exit 1
 regress 0 "$out/a/s" --out "$out/base"
 cp -RP "$out/a" "$out/b" || exit 1
 regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o" --junit "$out/j.xml"
-grep -q "^2 of 2 scenarios passed (" "$out/stdout.txt" || fail "not every scenario passed"
+grep -q "^2 of 2 scenarios passed, 2 the same as the baseline (" "$out/stdout.txt" || fail "not every scenario passed the same"
 grep -q "CHANGED" "$out/stdout.txt" && fail "a scenario moved to another folder changed"
 # A comment added above every clause moves them all a line down: no change.
 { echo '-- reviewed'; cat "$out/b/s/01_peg_in_hole.lua"; } > "$out/commented.lua" &&
@@ -56,7 +56,7 @@ regress 3 "$out/b/s" --baseline "$out/base" --out "$out/o" --junit "$out/j.xml" 
 grep -q '^CHANGED 01_peg_in_hole .*changed from the baseline: steps\[insert\]\.done_at: 2\.41[0-9]*, was 2\.5$' \
   "$out/stdout.txt" || fail "no CHANGED line naming the step's time"
 grep -q "^PASS  *04_stacked_bricks" "$out/stdout.txt" || fail "the other scenario did not pass"
-grep -q "^1 of 2 scenarios passed, 1 changed from the baseline (" "$out/stdout.txt" ||
+grep -q "^1 of 2 scenarios passed, 1 changed from the baseline, 1 the same as the baseline (" "$out/stdout.txt" ||
   fail "no summary counting the change"
 grep -q '<failure message="changed from the baseline: steps\[insert\]' "$out/j.xml" ||
   fail "the JUnit XML has no failure for the change"
@@ -69,7 +69,7 @@ regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o" --baseline-tolerance 
 rm "$out/base/04_stacked_bricks.json"
 regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o" --baseline-tolerance 0.1
 grep -q "^PASS  *04_stacked_bricks .*(no baseline)$" "$out/stdout.txt" || fail "no '(no baseline)' note"
-grep -q "^2 of 2 scenarios passed, 1 without a baseline (" "$out/stdout.txt" ||
+grep -q "^2 of 2 scenarios passed, 1 without a baseline, 1 the same as the baseline (" "$out/stdout.txt" ||
   fail "no summary counting the scenario without a baseline"
 regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o" --baseline-tolerance 0.1 --junit "$out/j.xml"
 grep -q "<system-out>no baseline to compare with: .*04_stacked_bricks.json</system-out>" "$out/j.xml" ||
