@@ -251,23 +251,26 @@ void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
     obstacles.push_back({models_->collision_model(scene.collision_mesh(part)), nullptr,
                          carried_pose(scene, part, X_WH), part.index});
   }
-  auto digit_collides = [&](const JointAngles& q, const DigitJoints& d) {
+  auto digit_collides = [&](const JointAngles& q, const DigitJoints& d,
+                            std::span<const SlideObstacle> against) {
     const HandPose pose = model.forward_kinematics(q);
     for (const Segment s : d.segments) {
       const auto& proxy = models_->collision_model(model.proxy(s));
       const Transform X_WS = engine::compose(X_WH, pose.X_HS[static_cast<std::size_t>(s)]);
       int queries = 0;
-      const bool hit = collides(*proxy, X_WS, obstacles, &queries);
+      const bool hit = collides(*proxy, X_WS, against, &queries);
       stats_.finger_queries += static_cast<std::uint64_t>(queries);
       if (hit) return true;
     }
     return false;
   };
   const JointAngles target = angles;
+  std::vector<SlideObstacle> others;
   for (std::size_t digit = 0; digit < kDigitCount; ++digit) {
     const DigitJoints d = digit_joints(digit);
     if (flexion(target, d) <= flexion(previous, d)) continue;  // opening: nothing to stop
-    if (!digit_collides(angles, d)) continue;
+    std::span<const SlideObstacle> against = obstacles;
+    if (!digit_collides(angles, d, against)) continue;
     // Closing into a part: from the last free posture toward the glove's, to
     // the first contact. Then, as a finger curls round a handle once its
     // base is stopped, the joints beyond the first close on together toward
@@ -275,7 +278,28 @@ void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
     // digit stopped whole at its first contact leaves its tip in the air.
     JointAngles q = angles;
     for (std::size_t j : d.joints) q[j] = previous[j];
-    if (digit_collides(q, d)) continue;  // already in contact where it was: the glove's angles
+    if (digit_collides(q, d, against)) {
+      // Already in a part where it was (the tracker put the hand there). In
+      // a fixed part (a finger inside a table) it closes no further, through
+      // the part or round it, until the hand moves it free; it may still
+      // open. In a movable part (a palm pressed a little into a handle) it
+      // closes through that part, and stops at the others.
+      others.clear();
+      bool in_fixed = false;
+      for (std::size_t i = 0; i < obstacles.size(); ++i) {
+        if (!digit_collides(q, d, std::span(&obstacles[i], 1))) {
+          others.push_back(obstacles[i]);
+        } else if (!scene.movable(parts[i])) {
+          in_fixed = true;
+        }
+      }
+      if (in_fixed) {
+        for (std::size_t j : d.joints) angles[j] = previous[j];
+        continue;
+      }
+      against = others;
+      if (!digit_collides(angles, d, against)) continue;  // the glove's angles
+    }
     const std::vector<std::vector<std::size_t>> stages = joint_stages(digit);
     for (std::size_t stage = 0; stage < stages.size(); ++stage) {
       std::vector<std::size_t> moving;
@@ -287,12 +311,12 @@ void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
         for (std::size_t j : moving) q[j] = from[j] + f * (target[j] - from[j]);
       };
       at(1);
-      if (!digit_collides(q, d)) break;  // the rest reach the glove's angles
+      if (!digit_collides(q, d, against)) break;  // the rest reach the glove's angles
       Real free = 0, hit = 1;
       for (int i = 0; i < settings_.grasp.finger_bisection_steps; ++i) {
         const Real mid = (free + hit) / 2;
         at(mid);
-        (digit_collides(q, d) ? hit : free) = mid;
+        (digit_collides(q, d, against) ? hit : free) = mid;
       }
       at(free);
     }

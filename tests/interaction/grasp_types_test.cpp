@@ -203,6 +203,47 @@ TEST(GraspTypes, AGraspRecordedAndReplayedFromItsTraceIsTheSameRun) {
   EXPECT_EQ(grasp_of(original, "bar"), "power");
 }
 
+TEST(GraspTypes, AFingerThatStartsInsideAFixedPartClosesNoFurther) {
+  // The palm 5 mm above a fixed table: the thumb's metacarpal, which hangs
+  // below the palm, starts inside it. Once, a digit that collided where it
+  // was took the glove's angles: the closing thumb went through the 10 mm
+  // table and wrapped under whatever lay on it. It now keeps its angles
+  // until the hand moves it free; the free fingers stop on the table.
+  constexpr Real kPalmFace = 0.01045;  // below the wrist, for the default hand
+  constexpr Real kTop = -kPalmFace - 0.005, kThick = 0.01;
+  engine::Scene scene;
+  Transform X_table;
+  X_table.t = Vec3(0, kTop - kThick / 2, -0.05);
+  scene.add_part({.name = "table",
+                  .X_QP = X_table,
+                  .movable = false,
+                  .render_mesh = std::make_shared<const collision::Mesh>(
+                      collision::make_box(Vec3(0.2, kThick / 2, 0.1)))});
+  engine::Simulation sim(std::move(scene));
+  GlovePlan plan;
+  PlanStep close{.kind = PlanStep::Kind::kClose, .duration = 0.5};
+  close.posture = *named_posture("fist");
+  PlanStep wait{.kind = PlanStep::Kind::kWait, .duration = 0.3};
+  plan.steps = {close, wait};
+  Hand hand(sim, std::make_shared<SimulatedGlove>(plan));
+  Grasping grasping(sim, hand);
+  sim.step();
+  const JointAngles start = hand.angles();
+  for (int frame = 1; frame < 80; ++frame) sim.step();
+  for (const Joint j : {Joint::kThumbRoll, Joint::kThumbMcp, Joint::kThumbIp, Joint::kThumbAbd}) {
+    const auto i = static_cast<std::size_t>(j);
+    EXPECT_EQ(hand.angles()[i], start[i]) << joint_name(j) << " closed inside the table";
+  }
+  // Every segment's origin is above the table's underside: none went through it.
+  for (std::size_t i = 0; i < kSegmentCount; ++i) {
+    const Vec3 p_W = engine::compose(hand.X_WH(), hand.pose().X_HS[i]).t;
+    EXPECT_GT(p_W.y(), kTop - kThick) << segment_name(static_cast<Segment>(i));
+  }
+  const auto index_mcp = static_cast<std::size_t>(Joint::kIndexMcp);
+  EXPECT_GT(hand.angles()[index_mcp], start[index_mcp] + 1)
+      << "the index finger closed until it met the table";
+}
+
 TEST(GraspTypes, AnOpenHandBrushingPastGraspsNothing) {
   // The open hand sweeps sideways across a block so that its fingers run through its top.
   engine::Scene scene;
