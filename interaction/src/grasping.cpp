@@ -745,16 +745,18 @@ Transform Grasping::guided(const engine::Scene& scene, PartId root, const Transf
     const Vec3 off_axis = (p_W - q_W) - b_W * b_W.dot(p_W - q_W);
     const Real angle = std::atan2(a_W.cross(b_W).norm(), a_W.dot(b_W));
     // Captured within the tolerances, kept within three times them (glove noise
-    // must not pull the part in and out of the guide), once the part's leading
-    // end has come within the position tolerance of the other's near end along
-    // the axis: a chamfer draws in a peg that reaches the hole, not one held
-    // above it.
+    // must not pull the part in and out of the guide), once the part has
+    // come within the position tolerance of the other along the axis: a
+    // chamfer draws in a peg that reaches the hole, not one held above it.
     const Real widen = guiding_ == m ? kGuideHysteresis : 1;
-    const Real other_near = extent_along(scene, o, scene.world_pose(o), q_W, b_W).first;
-    const Real part_lead = extent_along(scene, p, X_WP_target, q_W, b_W).second;
+    // Whichever way the mate's axis points: the two parts' spans along it
+    // overlap, the other's widened by the tolerance.
+    const auto [other_low, other_high] = extent_along(scene, o, scene.world_pose(o), q_W, b_W);
+    const auto [part_low, part_high] = extent_along(scene, p, X_WP_target, q_W, b_W);
+    const Real reach = widen * mate.position_tolerance;
+    const bool at_the_other = part_high >= other_low - reach && part_low <= other_high + reach;
     if (off_axis.norm() > widen * mate.position_tolerance ||
-        angle > widen * mate.angle_tolerance_deg * kDegree ||
-        part_lead < other_near - widen * mate.position_tolerance) {
+        angle > widen * mate.angle_tolerance_deg * kDegree || !at_the_other) {
       if (guiding_ == m) guiding_.reset();
       continue;
     }

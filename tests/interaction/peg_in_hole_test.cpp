@@ -105,13 +105,14 @@ struct PegSetup {
   Real pebble = 0;                                      ///< on the hole's bottom
   bool guide = true;                                    ///< the mate's guidance
   std::optional<Tab> tab = std::nullopt;                ///< attached to the peg
+  bool flip_axes = false;  ///< the mate's two axes pointing the other way (the same fit)
 };
 
 /// The hand holds the peg from the start, carries it 90 mm down along the
 /// hole's axis (20 mm past the bottom) in 2 s, waits, and opens.
 PegRun run_peg(const PegSetup& setup) {
-  const auto& [offset, tilt_deg, noise, threads, measure_depth, sides, replay, pebble, guide, tab] =
-      setup;
+  const auto& [offset, tilt_deg, noise, threads, measure_depth, sides, replay, pebble, guide, tab,
+               flip_axes] = setup;
   const Transform X_WPeg0 = peg_start(offset, tilt_deg);
   engine::Simulation sim(
       peg_and_block(X_WPeg0, sides, pebble, tab),
@@ -146,10 +147,10 @@ PegRun run_peg(const PegSetup& setup) {
   grasping.add_mate({.name = "peg_in_hole",
                      .part = "peg",
                      .p_PF = Vec3(0, 0, kPegLength),
-                     .axis_P = Vec3::UnitZ(),
+                     .axis_P = Vec3(0, 0, flip_axes ? -1 : 1),
                      .other = "block",
                      .p_OF = Vec3(0, kBlockTop - kHoleDepth, 0),
-                     .axis_O = -Vec3::UnitY(),
+                     .axis_O = Vec3(0, flip_axes ? 1 : -1, 0),
                      .guide = guide});
   grasping.hold("peg", GraspType::kPower);
 
@@ -267,19 +268,25 @@ TEST(PegInHole, APegIsDrawnOntoTheAxisOnlyAsItReachesTheBlock) {
   // hole. Held 10 mm above the block the peg keeps its offset and tilt, so a
   // start 0.5 mm further off is another run (it was drawn in at once, and
   // two such starts gave the same report).
+  // The mate's axes pointing out of the hole are the same fit, drawn in at
+  // the same place (the gate once read "past the block" along the axis only
+  // one way, and drew such a peg in from 100 mm up).
   const PegRun run = run_peg({.measure_depth = false});
-  bool drawn = false;
-  for (const Transform& X : run.peg_poses) {
-    const Vec3 tip = X.apply(Vec3(0, 0, kPegLength));
-    if (tip.y() > kBlockTop + 0.003) {
-      EXPECT_NEAR(X.t.x(), 0.0015, 1e-12)
-          << "drawn in with its tip " << tip.y() - kBlockTop << " m above";
-    } else if (tip.y() < kBlockTop - 0.001) {
-      EXPECT_NEAR(tip.x(), 0, 1e-5) << "in the hole off its axis";
-      drawn = true;
+  for (const bool flip : {false, true}) {
+    const PegRun r = flip ? run_peg({.measure_depth = false, .flip_axes = true}) : run;
+    bool drawn = false;
+    for (const Transform& X : r.peg_poses) {
+      const Vec3 tip = X.apply(Vec3(0, 0, kPegLength));
+      if (tip.y() > kBlockTop + 0.003) {
+        EXPECT_NEAR(X.t.x(), 0.0015, 1e-12)
+            << "drawn in with its tip " << tip.y() - kBlockTop << " m above, axes flipped " << flip;
+      } else if (tip.y() < kBlockTop - 0.001) {
+        EXPECT_NEAR(tip.x(), 0, 1e-5) << "in the hole off its axis";
+        drawn = true;
+      }
     }
+    EXPECT_TRUE(drawn);
   }
-  EXPECT_TRUE(drawn);
   const PegRun further = run_peg({.offset = 0.0019, .measure_depth = false});
   expect_in_the_hole(further);
   EXPECT_NE(further.report, run.report);

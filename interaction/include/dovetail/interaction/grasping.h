@@ -78,10 +78,9 @@ struct GraspSettings {
 ///
 /// Guidance: while `part` is carried with its target's feature point within
 /// the position tolerance of the other's axis line, the axes within the
-/// angle tolerance, and its leading end (of its bounding box, along the
-/// axis) within the position tolerance of where the other begins along the
-/// axis (the near end of its bounding box) or past it, the band pulls it
-/// onto the axis: the target turned by the least
+/// angle tolerance, and the two parts' spans along the axis (of their
+/// bounding boxes) overlapping, the other's widened by the position
+/// tolerance, the band pulls it onto the axis: the target turned by the least
 /// rotation onto the other's axis and moved onto the line (a peg held a
 /// little off a hole's axis is drawn in as it reaches the hole, as a chamfer
 /// would draw it, not left on the rim; held above the hole it keeps its
