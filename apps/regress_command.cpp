@@ -195,14 +195,10 @@ void compare_with_baseline(Job& job, const std::filesystem::path& report) {
   using Ordered = nlohmann::ordered_json;
   Ordered was;
   try {
-    was = Ordered::parse(read_file(*job.baseline));
-  } catch (const nlohmann::json::parse_error& e) {
-    // The parser's own words give the place: "at line 3, column 1: ...".
-    std::string what = e.what();
-    what = what.substr(std::min(what.find("at line"), what.size()));
-    job.baseline_error = job.baseline->string() + ": not a Dovetail scenario report: no JSON " +
-                         (what.empty() ? std::string() : "(" + what + ")") +
-                         "; make it again with regress --out";
+    was = parse_report(read_file(*job.baseline));
+  } catch (const std::runtime_error& e) {
+    job.baseline_error = job.baseline->string() + ": not a Dovetail scenario report (" + e.what() +
+                         "); make it again with regress --out";
     job.status = "error";
     return;
   }
@@ -224,8 +220,13 @@ void compare_with_baseline(Job& job, const std::filesystem::path& report) {
     job.status = "error";
     return;
   }
-  const Ordered now = Ordered::parse(read_file(report), nullptr, false);
-  if (!is_scenario_report(now)) return;  // the run wrote none: its error says why
+  Ordered now;
+  try {
+    now = parse_report(read_file(report));
+  } catch (const std::runtime_error&) {
+    return;  // the run wrote none: its error says why
+  }
+  if (!is_scenario_report(now)) return;
   job.changes = report_changes(was, now, kChangesKept, job.changes_total, job.baseline_tolerance);
   job.compared = true;
   if (job.changes_total > 0 && job.status == "passed") job.status = "changed";

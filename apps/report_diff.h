@@ -44,6 +44,13 @@ std::vector<ReportChange> report_changes(const nlohmann::ordered_json& baseline,
                                          const nlohmann::ordered_json& now, std::size_t limit,
                                          std::size_t& total, double tolerance = 0);
 
+/// Reads a report's text with its fields in the file's order. Throws
+/// std::runtime_error for text that is no JSON (saying where, as the parser
+/// does: "at line 3, column 1: ...") or that nests deeper than 32 levels
+/// (a report nests 4: deeper text is no report, and would only exhaust the
+/// stack of whatever walks it).
+nlohmann::ordered_json parse_report(const std::string& text);
+
 /// Whether `report` is a Dovetail scenario report (its `format`).
 bool is_scenario_report(const nlohmann::ordered_json& report);
 

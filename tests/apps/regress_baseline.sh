@@ -21,11 +21,22 @@ regress() {
 rm -rf "$out" && mkdir -p "$out/a/s" || exit 1
 cp "$scenarios/01_peg_in_hole.lua" "$scenarios/04_stacked_bricks.lua" "$out/a/s/" || exit 1
 ln -s "$(cd "$scenarios/../assets" && pwd)" "$out/a/assets" || exit 1
-# The baseline, and the same scenarios in another folder: nothing changed.
-regress 0 "$out/a/s" --out "$out/base"
+# A scenario whose report names a path beside its folder: an open mesh's warning.
+mkdir -p "$out/a/meshes" && cp "$(dirname "$0")/../data/open_box.obj" "$out/a/meshes/" || exit 1
+cat > "$out/a/s/05_open.lua" <<'LUA'
+return scenario { name = "open", units = "mm", duration = 0.1,
+  parts = { box = part { mesh = "../meshes/open_box.obj" } } }
+LUA
+# The baseline, made from inside the folder ("."), and the same scenarios
+# in another folder, named by its full path: nothing changed.
+(cd "$out/a/s" && "$program" regress . --out ../../base > /dev/null 2>&1) ||
+  fail "making the baseline failed"
 cp -RP "$out/a" "$out/b" || exit 1
 regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o" --junit "$out/j.xml"
-grep -q "^2 of 2 scenarios passed, 2 the same as the baseline (" "$out/stdout.txt" || fail "not every scenario passed the same"
+grep -q "open_box.obj" "$out/o/05_open.json" || fail "the report names no mesh path: the test tests nothing"
+rm "$out/a/s/05_open.lua" "$out/b/s/05_open.lua" "$out/base/05_open."* && rm -r "$out/base/05_open" "$out/o/05_open"* ||
+  exit 1
+grep -q "^3 of 3 scenarios passed, 3 the same as the baseline (" "$out/stdout.txt" || fail "not every scenario passed the same"
 grep -q "CHANGED" "$out/stdout.txt" && fail "a scenario moved to another folder changed"
 # A comment added above every clause moves them all a line down: no change.
 { echo '-- reviewed'; cat "$out/b/s/01_peg_in_hole.lua"; } > "$out/commented.lua" &&
@@ -41,6 +52,8 @@ mkdir -p "$out/empty" || exit 1
 regress 1 "$out/b/s" --baseline "$out/empty" --out "$out/o"
 grep -q "empty: holds no report of a scenario in" "$out/stderr.txt" || fail "an empty baseline passed"
 regress 1 "$out/b/s" --baseline "$out/b/s" --out "$out/o"
+grep -q "s: holds no report of a scenario in" "$out/stderr.txt" ||
+  fail "the scenarios' folder taken for the baseline was not refused"
 # A report of a scenario no longer in the folder is named.
 cp "$out/base/04_stacked_bricks.json" "$out/base/05_gone.json" || exit 1
 regress 0 "$out/b/s" --baseline "$out/base" --out "$out/o"
@@ -76,6 +89,6 @@ grep -q "<system-out>no baseline to compare with: .*04_stacked_bricks.json</syst
   fail "the JUnit XML does not say a scenario had no baseline"
 echo '{' > "$out/base/04_stacked_bricks.json"
 regress 3 "$out/b/s" --baseline "$out/base" --out "$out/o"
-grep -q "^ERROR  *04_stacked_bricks .*base/04_stacked_bricks.json: not a Dovetail scenario report: no JSON" \
+grep -q "^ERROR  *04_stacked_bricks .*base/04_stacked_bricks.json: not a Dovetail scenario report (at line" \
   "$out/stdout.txt" || fail "no error naming the baseline that is no report"
 echo "regress_baseline: ok"

@@ -78,6 +78,44 @@ TEST(ReportDiff, AFieldOnlyOneReportHasIsAChange) {
                                    R"(warnings: ["../assets/peg.stl: 3 open edges"], was null)"}));
 }
 
+TEST(ReportDiff, AnErrorOnlyTheBaselineHadComesFirst) {
+  json was = report("peg.lua", 1);
+  json now = report("peg.lua", 2);
+  was["error"] = "peg.lua:3: boom";
+  const std::vector<std::string> found = changes(was, now);
+  ASSERT_FALSE(found.empty());
+  EXPECT_EQ(found.front(), R"(error: null, was "peg.lua: boom")");
+}
+
+TEST(ReportDiff, PathsAreReadOnlyWhereTheyBegin) {
+  // The folder "s" in "../assets/" is no path: only "s/" starting a path is
+  // the scenario's folder. And "." is a folder too.
+  for (const std::string& folder : {std::string("s"), std::string(".")}) {
+    json was = report(folder + "/plate.lua", 1);
+    json now = report("/home/ci/checkout/s/plate.lua", 1);
+    was["warnings"] = json::array({folder + "/../assets/plate.gltf: 3 open edges"});
+    now["warnings"] = json::array({"/home/ci/checkout/s/../assets/plate.gltf: 3 open edges"});
+    EXPECT_TRUE(changes(was, now).empty()) << folder;
+  }
+}
+
+TEST(ReportDiff, LongTextsAreReadInOnePass) {
+  // Equal texts are not read for numbers; a long run of digits is one number.
+  json was = report("peg.lua", 1);
+  was["messages"] = json::array({{{"text", std::string(200000, '7')}}});
+  json now = was;
+  EXPECT_TRUE(changes(was, now, 1e-9).empty());
+  now["messages"][0]["text"] = std::string(199999, '7') + "8";
+  EXPECT_TRUE(changes(was, now, 1e-9).empty());  // 7.7e199999 overflows alike
+}
+
+TEST(ReportDiff, ATextNestedDeeperThanAnyReportIsNoReport) {
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  EXPECT_THROW(parse_report(deep), std::runtime_error);
+  EXPECT_THROW(parse_report("{"), std::runtime_error);
+  EXPECT_TRUE(is_scenario_report(parse_report(R"({"format": "dovetail-scenario-report"})")));
+}
+
 TEST(ReportDiff, AClauseMovedToAnotherLineIsNoChange) {
   json was = report("/a/peg.lua", 1);
   json now = report("/a/peg.lua", 1);
