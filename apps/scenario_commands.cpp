@@ -7,7 +7,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -87,28 +86,6 @@ std::filesystem::path default_scenario() {
       "run: no scenario given and no scenarios/ folder found (see 'dovetail run --help')");
 }
 
-/// Whether `name` is that of a frame `run --render DIR --every N` writes.
-bool is_frame_name(const std::string& name) {
-  static const std::regex frame("frame_[0-9]{6,}\\.png");
-  return std::regex_match(name, frame);
-}
-
-/// Removes the frame_NNNNNN.png an earlier run left in `folder`, so that a
-/// shorter run's frames are not mixed with them; says how many.
-void remove_old_frames(const std::filesystem::path& folder) {
-  std::error_code ec;
-  std::size_t removed = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
-    if (!entry.is_regular_file(ec) || entry.is_symlink(ec)) continue;
-    if (!is_frame_name(entry.path().filename().string())) continue;
-    removed += std::filesystem::remove(entry.path(), ec) ? 1 : 0;
-  }
-  if (removed > 0) {
-    std::fprintf(stderr, "dovetail: note: removed %zu frame%s an earlier run left in %s\n", removed,
-                 removed == 1 ? "" : "s", folder.string().c_str());
-  }
-}
-
 /// The run's options from the command line (run and replay share them).
 scripting::RunOptions run_options(const Args& args, std::optional<std::filesystem::path> trace) {
   scripting::RunOptions options;
@@ -139,10 +116,7 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
     }
   }
   // The folders last, once every option is known to be right.
-  if (options.render_dir) {
-    make_folder(*options.render_dir);
-    remove_old_frames(*options.render_dir);
-  }
+  if (options.render_dir) make_folder(*options.render_dir);
   if (options.capture_dir) make_folder(*options.capture_dir);
   return options;
 }
@@ -160,6 +134,11 @@ void write_report(const std::string& path, const scripting::RunOutcome& outcome)
 
 /// Warnings, failures and suspect queries, on standard error.
 void print_problems(const scripting::RunOptions& options, const scripting::RunOutcome& outcome) {
+  if (outcome.old_frames_removed > 0) {
+    std::fprintf(stderr, "dovetail: note: removed %zu frame%s an earlier run left in %s\n",
+                 outcome.old_frames_removed, outcome.old_frames_removed == 1 ? "" : "s",
+                 options.render_dir->string().c_str());
+  }
   for (const std::string& w : outcome.warnings) {
     std::fprintf(stderr, "warning: %s\n", shown(w).c_str());
   }
@@ -223,7 +202,7 @@ bool written_into(const std::filesystem::path& folder, const std::filesystem::pa
   if (!engine::same_file(parent, folder)) return false;
   const std::string name = file.filename().string();
   if (!render) return name.ends_with(".capture");
-  return name == "final.png" || is_frame_name(name);
+  return name == "final.png" || scripting::is_frame_file_name(name);
 }
 
 /// The report and the recording, before the run and before its folders

@@ -1302,6 +1302,15 @@ void Runner::run() {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return;
   }
+  // Frames an earlier run left are not to be mixed with this run's.
+  if (options_.render_dir) {
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(*options_.render_dir, ec)) {
+      if (entry.is_symlink(ec) || !entry.is_regular_file(ec)) continue;
+      if (!is_frame_file_name(entry.path().filename().string())) continue;
+      out_.old_frames_removed += std::filesystem::remove(entry.path(), ec) ? 1 : 0;
+    }
+  }
   std::optional<engine::ProgressMeter> meter;
   if (options_.progress) meter.emplace(frames);
   const auto loop_start = std::chrono::steady_clock::now();
@@ -1426,6 +1435,15 @@ void Runner::run() {
 }
 
 }  // namespace
+
+bool is_frame_file_name(std::string_view name) {
+  constexpr std::string_view kPrefix = "frame_", kSuffix = ".png";
+  if (!name.starts_with(kPrefix) || !name.ends_with(kSuffix)) return false;
+  const std::string_view digits =
+      name.substr(kPrefix.size(), name.size() - kPrefix.size() - kSuffix.size());
+  return digits.size() >= 6 &&
+         std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
 
 std::string_view status_name(RunOutcome::Status status) {
   switch (status) {

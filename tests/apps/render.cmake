@@ -140,3 +140,7 @@ dovetail_cli_test(render_scenario_failed_before EXIT 1
 dovetail_cli_test(run_render_every_zero EXIT 2
                   ARGS run ${PROJECT_SOURCE_DIR}/scenarios/04_stacked_bricks.lua --render ${out}/every_zero --every 0
                   STDERR "run: --every must be at least 1")
+# ... but not when the run is refused: the old frames stay.
+add_test(NAME cli.run_render_keeps_old_frames_when_refused
+         COMMAND sh -c "rm -rf \"$1\" && mkdir -p \"$1/report_is_a_folder\" && touch \"$1/frame_009999.png\" && \"$0\" run \"$2\" --render \"$1\" --every 1000 --report \"$1/report_is_a_folder\" --quiet 2> /dev/null; [ $? -eq 1 ] && [ -e \"$1/frame_009999.png\" ]"
+                 $<TARGET_FILE:dovetail> ${out}/render_refused_frames ${PROJECT_SOURCE_DIR}/scenarios/04_stacked_bricks.lua)

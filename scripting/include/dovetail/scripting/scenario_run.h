@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "dovetail/collision/model.h"
@@ -34,6 +35,8 @@ struct RunOptions {
   /// Writes the glove samples the run used here, as a trace.
   std::optional<std::filesystem::path> record{};
   /// Writes PNGs here: every `render_every`-th frame (0: none) and final.png.
+  /// The frame files an earlier run left here are removed first, once the
+  /// scenario has loaded and its outputs are known to be writable.
   std::optional<std::filesystem::path> render_dir{};
   std::uint64_t render_every = 0;
   int render_width = 960;
@@ -60,6 +63,10 @@ struct RunOptions {
   /// fails, before it is an error.
   std::optional<double> picture_at{};
 };
+
+/// Whether `name` is that of a frame file a run writes into its render
+/// folder: frame_NNNNNN.png, six digits or more.
+bool is_frame_file_name(std::string_view name);
 
 /// The version of the scenario report RunOutcome::to_json writes.
 inline constexpr int kScenarioReportVersion = 1;
@@ -122,6 +129,8 @@ struct RunOutcome {
   /// The frame loop alone (simulation, rules, steps, penetration), for benchmarks.
   double loop_seconds = 0;
   std::optional<std::filesystem::path> final_frame{};  ///< the PNG written, if any
+  /// Frame files an earlier run left in RunOptions::render_dir, removed.
+  std::size_t old_frames_removed = 0;
   /// With RunOptions::picture_at: the frame the run stopped at.
   struct Picture {
     engine::RenderScene scene{};  ///< the scenario's camera among its cameras as kScenarioCamera
