@@ -23,17 +23,30 @@ std::string see_help(const std::string& command) {
   return " (see 'dovetail " + command + " --help')";
 }
 
-/// " (did you mean '--report'?)" for a misspelt option, else see_help.
+/// " (did you mean '--report'? see 'dovetail run --help')" for a misspelt
+/// option: one the typed name begins (--baseline-tol), else one within a
+/// few edits of it; none for a one-letter option (-o is no -j).
 std::string option_hint(const std::string& command, const std::string& option,
                         const std::set<std::string>& value_options,
                         const std::set<std::string>& flags) {
+  const std::string typed = option.substr(option.find_first_not_of('-'));
   std::vector<std::string> known;
   for (const std::set<std::string>* names : {&value_options, &flags}) {
-    for (const std::string& n : *names) known.push_back((n.size() == 1 ? "-" : "--") + n);
+    known.insert(known.end(), names->begin(), names->end());
   }
-  known.emplace_back("--help");
-  const std::string hint = scripting::did_you_mean(option, known);
-  return hint.empty() ? see_help(command) : hint;
+  known.emplace_back("help");
+  std::string guess;
+  if (typed.size() >= 3) {
+    for (const std::string& name : known) {
+      if (name.starts_with(typed) && (guess.empty() || name.size() < guess.size())) guess = name;
+    }
+  }
+  if (guess.empty() && typed.size() >= 2) {
+    guess = scripting::nearest_name(typed, known).value_or("");
+  }
+  if (guess.empty()) return see_help(command);
+  return " (did you mean '" + std::string(guess.size() == 1 ? "-" : "--") + guess +
+         "'? see 'dovetail " + command + " --help')";
 }
 
 }  // namespace

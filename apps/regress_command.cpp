@@ -640,14 +640,12 @@ std::vector<Job> shard_jobs(const std::filesystem::path& folder, std::size_t sha
 void print_line(const Job& job) {
   std::string reason = job.status == "passed" ? "" : first_reason(job);
   if (job.without_baseline) reason += reason.empty() ? "(no baseline)" : " (no baseline)";
-  char line[128];
-  std::snprintf(line, sizeof line, "%-7s %-32s %8.2f s",
-                job.status == "passed"    ? "PASS"
-                : job.status == "failed"  ? "FAIL"
-                : job.status == "changed" ? "CHANGED"
-                                          : "ERROR",
-                job.stem.c_str(), job.seconds);
-  std::printf("%s%s%s\n", line, reason.empty() ? "" : "  ", reason.c_str());
+  std::printf("%-7s %-32s %8.2f s%s%s\n",
+              job.status == "passed"    ? "PASS"
+              : job.status == "failed"  ? "FAIL"
+              : job.status == "changed" ? "CHANGED"
+                                        : "ERROR",
+              job.stem.c_str(), job.seconds, reason.empty() ? "" : "  ", reason.c_str());
   std::fflush(stdout);
 }
 

@@ -39,7 +39,7 @@ the picture as PNG.
                  rules' highlights included, as 'dovetail run --render' draws
                  it; --trace replays a glove trace, as 'dovetail replay' does.
                  The camera is the scenario's (--camera scenario) when it
-                 declares one, else auto, fitted to that frame
+                 declares one, else auto, fitted to that frame; or a view
   --out PNG      the image to write
   --width W      image width in pixels, 1 to 16384 (default 1024)
   --height H     image height in pixels, 1 to 16384 (default 768)

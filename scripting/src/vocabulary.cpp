@@ -537,7 +537,8 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
   return row[b.size()];
 }
 
-std::string did_you_mean(std::string_view name, std::span<const std::string> candidates) {
+std::optional<std::string> nearest_name(std::string_view name,
+                                        std::span<const std::string> candidates) {
   const std::size_t limit = std::max<std::size_t>(2, name.size() / 3);
   const std::string* best = nullptr;
   std::size_t best_distance = limit + 1;
@@ -548,6 +549,12 @@ std::string did_you_mean(std::string_view name, std::span<const std::string> can
       best = &candidate;
     }
   }
+  if (best == nullptr) return std::nullopt;
+  return *best;
+}
+
+std::string did_you_mean(std::string_view name, std::span<const std::string> candidates) {
+  const std::optional<std::string> best = nearest_name(name, candidates);
   return best ? " (did you mean '" + *best + "'?)" : "";
 }
 

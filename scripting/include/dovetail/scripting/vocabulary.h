@@ -9,6 +9,7 @@
 /// section of docs/authoring.md (a test compares the two), so the vocabulary,
 /// its checks and its documentation cannot drift apart.
 
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -85,8 +86,11 @@ std::string reference_markdown();
 
 /// Edit distance (insertions, deletions, substitutions) between two names.
 std::size_t edit_distance(std::string_view a, std::string_view b);
-/// " (did you mean 'x'?)" for the closest of `candidates` within a third of
-/// the name's length (at least 2 edits), or "" when none is close.
+/// The closest of `candidates` within a third of the name's length (at
+/// least 2 edits), if one is that close.
+std::optional<std::string> nearest_name(std::string_view name,
+                                        std::span<const std::string> candidates);
+/// " (did you mean 'x'?)" for nearest_name, or "" when none is close.
 std::string did_you_mean(std::string_view name, std::span<const std::string> candidates);
 
 }  // namespace dovetail::scripting
