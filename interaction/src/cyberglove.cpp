@@ -47,8 +47,8 @@ Real finite_field(const LineReader& reader, std::string_view token, std::size_t 
   const auto where = [&] { return std::string(what) + " (field " + std::to_string(f + 1) + ")"; };
   const std::optional<Real> value = parse_number(token);
   if (!value) {
-    if (token.empty()) reader.fail(where() + " is empty");
-    reader.fail(where() + ": " + quoted(token) + " is not a number");
+    if (token.empty()) reader.fail_row(where() + " is empty");
+    reader.fail_row(where() + ": " + quoted(token) + " is not a number");
   }
   if (!std::isfinite(*value)) reader.fail(where() + ": " + quoted(token) + " is not finite");
   return *value;
@@ -170,8 +170,9 @@ std::vector<GloveSample> read_cyberglove_raw(std::istream& in, std::string_view 
       first_line = reader.line();
       first_field_count = fields.size();
     } else if (fields.size() != first_field_count) {
-      reader.fail("found " + std::to_string(fields.size()) + " fields, but the first row (line " +
-                  std::to_string(first_line) + ") has " + std::to_string(first_field_count));
+      reader.fail_row("found " + std::to_string(fields.size()) +
+                      " fields, but the first row (line " + std::to_string(first_line) + ") has " +
+                      std::to_string(first_field_count));
     }
     GloveSample sample = parse_raw_row(reader, fields, calibration);
     if (!samples.empty() && !(sample.t > samples.back().t)) {

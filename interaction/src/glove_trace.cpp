@@ -85,8 +85,8 @@ GloveSample parse_row(const LineReader& reader, std::string_view line,
                       std::vector<std::string_view>& fields) {
   split_commas(line, fields);
   if (fields.size() != kColumnCount) {
-    reader.fail("expected " + std::to_string(kColumnCount) + " fields, found " +
-                std::to_string(fields.size()));
+    reader.fail_row("expected " + std::to_string(kColumnCount) + " fields, found " +
+                    std::to_string(fields.size()));
   }
   std::array<Real, kColumnCount> values{};
   for (std::size_t f = 0; f < fields.size(); ++f) {
@@ -96,8 +96,8 @@ GloveSample parse_row(const LineReader& reader, std::string_view line,
     };
     const std::optional<Real> value = parse_number(fields[f]);
     if (!value) {
-      if (fields[f].empty()) reader.fail(where() + " is empty");
-      reader.fail(where() + ": " + quoted(fields[f]) + " is not a number");
+      if (fields[f].empty()) reader.fail_row(where() + " is empty");
+      reader.fail_row(where() + ": " + quoted(fields[f]) + " is not a number");
     }
     if (!std::isfinite(*value)) reader.fail(where() + ": " + quoted(fields[f]) + " is not finite");
     values[column_of_field[f]] = *value;

@@ -216,18 +216,18 @@ std::vector<GloveSample> read_openxr(std::istream& in, std::string_view name) {
   while (const std::optional<std::string_view> line = reader.next_content()) {
     split_commas(*line, fields);
     if (fields.size() != names.size()) {
-      reader.fail("expected " + std::to_string(names.size()) + " fields, found " +
-                  std::to_string(fields.size()));
+      reader.fail_row("expected " + std::to_string(names.size()) + " fields, found " +
+                      std::to_string(fields.size()));
     }
     for (std::size_t k = 0; k < kColumns; ++k) {
       const std::string_view field = fields[column_of[k]];
       const std::optional<Real> number = parse_number(field);
       if (!number)
-        reader.fail("column " + interaction::quoted(names[column_of[k]]) + ": " + quoted(field) +
-                    " is not a number");
+        reader.fail_row("column " + interaction::quoted(names[column_of[k]]) + ": " +
+                        quoted(field) + " is not a number");
       if (!std::isfinite(*number))
-        reader.fail("column " + interaction::quoted(names[column_of[k]]) + ": " + quoted(field) +
-                    " is not finite");
+        reader.fail_row("column " + interaction::quoted(names[column_of[k]]) + ": " +
+                        quoted(field) + " is not finite");
       v[k] = *number;
     }
     XrHandFrame frame;

@@ -29,7 +29,10 @@ std::optional<std::string_view> LineReader::next() {
   if (in_.bad() || (in_.fail() && extracted == 0 && !in_.eof())) {
     throw TraceError(name_ + ": read error after line " + std::to_string(line_));
   }
-  if (in_.fail() && extracted == 0) return std::nullopt;
+  if (in_.fail() && extracted == 0) {
+    unended_ = false;  // past the end: no line of it is broken
+    return std::nullopt;
+  }
   ++line_;
   // failbit with characters extracted: the buffer filled before the line ended.
   if (in_.fail()) fail("line longer than " + std::to_string(kMaxTraceLineBytes) + " bytes");
@@ -59,11 +62,15 @@ std::optional<std::string_view> LineReader::next_content() {
 }
 
 void LineReader::fail(const std::string& what) const {
+  throw TraceError(name_ + ":" + std::to_string(line_) + ": " + what);
+}
+
+void LineReader::fail_row(const std::string& what) const {
   // A broken last line without a line end: most likely a file cut short.
-  const char* cut = unended_ ? " (the file's last line has no line end: was the file cut short "
-                               "while it was written? Without that line the rest can be read)"
-                             : "";
-  throw TraceError(name_ + ":" + std::to_string(line_) + ": " + what + cut);
+  if (!unended_) fail(what);
+  fail(what +
+       " (the file's last line has no line end: was the file cut short while it was written? "
+       "Without that line the rest can be read)");
 }
 
 bool is_blank_or_comment(std::string_view line) {

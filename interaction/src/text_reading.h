@@ -35,10 +35,12 @@ class LineReader {
   /// 1-based number of the line last returned; 0 before the first.
   std::size_t line() const { return line_; }
   const std::string& name() const { return name_; }
-  /// Throws TraceError `name:line: what` for the line last returned, with a
-  /// hint that the file was cut short when that line is its last and has no
-  /// line end.
+  /// Throws TraceError `name:line: what` for the line last returned.
   [[noreturn]] void fail(const std::string& what) const;
+  /// fail() for a mistake a file cut short makes in its last row (too few
+  /// fields, a number cut off): with a hint that it was cut short when that
+  /// line is the file's last and has no line end.
+  [[noreturn]] void fail_row(const std::string& what) const;
 
  private:
   std::istream& in_;

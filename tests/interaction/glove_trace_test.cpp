@@ -446,6 +446,10 @@ TEST(GloveTrace, AFileCutShortInItsLastLineIsSaidToBe) {
     EXPECT_NE(m.find("expected 30 fields"), std::string::npos) << m;
     EXPECT_EQ(m.find("cut short"), std::string::npos) << m;
   }
+  // Nor is a mistake no cut makes: a header naming too few columns.
+  const std::string header = error_of("t,x,y");
+  EXPECT_NE(header.find("missing columns"), std::string::npos) << header;
+  EXPECT_EQ(header.find("cut short"), std::string::npos) << header;
 }
 
 TEST(GloveTrace, WrittenFileReadsBack) {
