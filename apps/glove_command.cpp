@@ -51,28 +51,6 @@ Bad input gives an error naming the file and the line and exit code 1. Prints a
 one-line JSON summary on standard output.
 )";
 
-/// The time between a trace's samples: the median, and the widest and
-/// where it begins. Needs two samples.
-struct Gaps {
-  double median = 0;
-  double widest = 0;
-  double widest_after = 0;
-};
-
-Gaps gaps_of(const std::vector<GloveSample>& samples) {
-  Gaps g;
-  std::vector<double> gaps;
-  for (std::size_t i = 1; i < samples.size(); ++i) {
-    const double gap = samples[i].t - samples[i - 1].t;
-    gaps.push_back(gap);
-    if (gap > g.widest) g.widest = gap, g.widest_after = samples[i - 1].t;
-  }
-  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2),
-                   gaps.end());
-  g.median = gaps[gaps.size() / 2];
-  return g;
-}
-
 void print_summary(const std::string& action, const std::vector<GloveSample>& samples,
                    const std::string& out) {
   JsonLine json;
@@ -80,7 +58,7 @@ void print_summary(const std::string& action, const std::vector<GloveSample>& sa
   const double duration = samples.empty() ? 0 : samples.back().t - samples.front().t;
   json.add("start", samples.empty() ? 0.0 : samples.front().t).add("duration", duration);
   if (samples.size() >= 2) {
-    const Gaps g = gaps_of(samples);
+    const interaction::TraceGaps g = interaction::trace_gaps(samples);
     // Rounded to a millionth of a hertz: 1 / (1 / 120.0) is not quite 120.
     json.add("rate_hz_median", std::round(1e6 / g.median) / 1e6)
         .add("gap_max_s", g.widest)

@@ -148,13 +148,25 @@ std::vector<GloveSample> read_trace(std::istream& in, std::string_view name) {
   return samples;
 }
 
+TraceGaps trace_gaps(std::span<const GloveSample> samples) {
+  TraceGaps g;
+  if (samples.size() < 2) return g;
+  std::vector<Real> gaps;
+  for (std::size_t i = 1; i < samples.size(); ++i) {
+    const Real gap = samples[i].t - samples[i - 1].t;
+    gaps.push_back(gap);
+    if (gap > g.widest) g.widest = gap, g.widest_after = samples[i - 1].t;
+  }
+  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2),
+                   gaps.end());
+  g.median = gaps[gaps.size() / 2];
+  return g;
+}
+
 std::optional<std::string> sparse_samples(std::span<const GloveSample> samples) {
   // Gloves sample 30 to 200 times a second; under 10 is another time unit.
   if (samples.size() < 3) return std::nullopt;
-  std::vector<Real> gaps;
-  for (std::size_t i = 1; i < samples.size(); ++i) gaps.push_back(samples[i].t - samples[i - 1].t);
-  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
-  const Real median = gaps[gaps.size() / 2];
+  const Real median = trace_gaps(samples).median;
   constexpr Real kSparse = 0.1;  // seconds
   if (!(median > kSparse)) return std::nullopt;
   char text[200];
@@ -192,16 +204,7 @@ std::optional<std::string> radian_angles(std::span<const GloveSample> samples) {
 std::optional<std::string> dropped_samples(std::span<const GloveSample> samples) {
   // A gap of many samples: the hand moves in a straight line across it.
   if (samples.size() < 3) return std::nullopt;
-  std::vector<Real> gaps;
-  Real widest = 0, after = 0;
-  for (std::size_t i = 1; i < samples.size(); ++i) {
-    const Real gap = samples[i].t - samples[i - 1].t;
-    gaps.push_back(gap);
-    if (gap > widest) widest = gap, after = samples[i - 1].t;
-  }
-  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2),
-                   gaps.end());
-  const Real median = gaps[gaps.size() / 2];
+  const auto [median, widest, after] = trace_gaps(samples);
   constexpr Real kDropped = 5;  // times the median gap
   if (!(widest > kDropped * median)) return std::nullopt;
   char text[300];

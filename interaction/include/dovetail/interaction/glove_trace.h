@@ -66,6 +66,15 @@ std::vector<GloveSample> read_trace(const std::filesystem::path& path);
 /// short while written, whose last value may be cut too). For warnings.
 std::vector<std::string> trace_doubts(const std::filesystem::path& path,
                                       std::span<const GloveSample> samples);
+/// The time between a trace's samples: the median gap, the widest and the
+/// time it begins (all 0 with fewer than two samples).
+struct TraceGaps {
+  Real median = 0;
+  Real widest = 0;
+  Real widest_after = 0;
+};
+TraceGaps trace_gaps(std::span<const GloveSample> samples);
+
 /// trace_doubts' first: samples more than 0.1 s apart at the median.
 std::optional<std::string> sparse_samples(std::span<const GloveSample> samples);
 /// trace_doubts' second: the widest gap between samples over 5 times the
