@@ -832,7 +832,7 @@ void Grasping::release(engine::Simulation& simulation, const std::string& reason
 void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
   engine::Scene& scene = simulation.scene();
   // The first mate of the released part's sub-assembly within its tolerances
-  // seats it, moving the whole sub-assembly.
+  // (in the order they were added) seats it, moving the whole sub-assembly.
   const PartId root = carried_root(scene, scene.get(part));
   if (!scene.movable(root)) return;
   for (const Mate& mate : mates_) {
@@ -851,6 +851,18 @@ void Grasping::snap(engine::Simulation& simulation, const std::string& part) {
     scene.set_world_pose(root, X_WR_seated);
     pending_.push_back(
         {EventKind::kMate, simulation.frame(), simulation.time(), mate.part, mate.other});
+    // The sub-assembly's other fits that hold where it is seated are made
+    // too (a shaft carried with its bearing lands in its bore and the bearing
+    // in its seat): each fires, though only the first moved it.
+    for (const Mate& other : mates_) {
+      if (&other == &mate) continue;
+      const auto also = outward_mate(scene, other, root);
+      if (!also) continue;
+      if (within_tolerance(other, scene.world_pose(also->first), scene.world_pose(also->second))) {
+        pending_.push_back(
+            {EventKind::kMate, simulation.frame(), simulation.time(), other.part, other.other});
+      }
+    }
     return;
   }
 }

@@ -605,7 +605,14 @@ void Runner::build() {
     hand_settings.record = options_.record.has_value();
     hand_ = std::make_unique<interaction::Hand>(*sim_, source, hand_settings);
     grasping_ = std::make_unique<interaction::Grasping>(*sim_, *hand_);
-    for (const MateSpec& m : scenario_.mates) grasping_->add_mate(m.mate);
+    // In the file's order: a released sub-assembly is seated by the first
+    // of its mates within tolerance (the scenario's mates are in name order).
+    std::vector<const MateSpec*> in_file_order;
+    for (const MateSpec& m : scenario_.mates) in_file_order.push_back(&m);
+    std::stable_sort(
+        in_file_order.begin(), in_file_order.end(),
+        [](const MateSpec* a, const MateSpec* b) { return a->where.line < b->where.line; });
+    for (const MateSpec* m : in_file_order) grasping_->add_mate(m->mate);
     if (!glove.holding.empty()) grasping_->hold(glove.holding, glove.grasp);
     warn_about_glove(glove, *source);
   }

@@ -1053,6 +1053,41 @@ TEST(ScenarioRun, AMateInsideTheCarriedSubAssemblyNeitherGuidesNorSnapsIt) {
   }
 }
 
+TEST(ScenarioRun, AReleasedSubAssemblyMakesEveryFitThatHoldsWhereItIsSeated) {
+  // The shaft and its collar are carried down together and let go where
+  // both fit the base. The first mate in the file seats them; the other
+  // holds there too and fires. Once, only the first in name order fired,
+  // the other's expectation failed "0 mm from its place", and renaming a
+  // mate changed which one seated the pair.
+  const test::TempDir dir("dovetail_scenario");
+  const auto mates = [](const std::string& first, const std::string& second) {
+    return first +
+           " = mate { part = \"shaft\", point = { 0, 0, 0 }, axis = \"z\", into = \"base\", "
+           "at = { -200, 65, 0 }, along = \"-y\" },\n    " +
+           second +
+           " = mate { part = \"collar\", point = { 0, 0, 0 }, axis = \"z\", into = \"base\", "
+           "at = { -200, 65.5, 0 }, along = \"-y\" }";
+  };
+  const RunOutcome a =
+      run_scenario(collar_on_shaft(dir, "a.lua", mates("shaft_fit", "collar_fit"), ""));
+  const RunOutcome b =
+      run_scenario(collar_on_shaft(dir, "b.lua", mates("z_shaft_fit", "a_collar_fit"), ""));
+  for (const RunOutcome* o : {&a, &b}) {
+    ASSERT_EQ(o->status, RunOutcome::Status::kPassed) << o->failure_summary() << o->error;
+    std::vector<std::string> mated;
+    for (const engine::Event& e : o->report.events) {
+      if (e.kind == engine::EventKind::kMate) mated.push_back(e.a + " " + e.b);
+    }
+    EXPECT_EQ(mated, (std::vector<std::string>{"collar base", "shaft base"}));  // sorted in a frame
+  }
+  // The shaft's fit, first in the file, seated the pair whatever the names.
+  EXPECT_EQ(a.report.state_hash, b.report.state_hash);
+  std::map<std::string, Vec3> at;
+  for (const auto& pose : a.final_poses) at[pose.part] = pose.position;
+  EXPECT_NEAR(at["shaft"].y(), 0.065, 1e-12);
+  EXPECT_NEAR(at["shaft"].x(), 0, 1e-12);
+}
+
 TEST(ScenarioRun, AStillClosedHandWithGloveNoiseGraspsNothing) {
   // The hand closes in the air, then comes down onto a bar and slides along
   // it, closed and still, with 0.5 degrees of noise on every joint. The
