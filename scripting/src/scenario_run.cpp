@@ -952,14 +952,40 @@ std::string Runner::why_not_snapped(const MateSpec& m) const {
   std::string at_release;
   if (i < released_.size() && released_[i].seen) {
     const Closest& r = released_[i];
-    at_release = ": when the hand let it go at t=" + format_time(r.time) + " s it was " +
+    // How it was let go, and what it rested on then (what stopped it).
+    const std::vector<engine::Event>& events = sim_->report().events;
+    std::string how = "the hand let it go";
+    std::map<std::string, double> resting;  // part it slid on -> since when
+    for (const engine::Event& e : events) {
+      if (e.time > r.time + 1e-9) break;
+      if (e.kind == engine::EventKind::kRelease && e.a == m.mate.part &&
+          std::abs(e.time - r.time) < 1e-9 && e.b == "overstretched") {
+        how = "the rubber band overstretched and let it go";
+      }
+      if (e.a != m.mate.part) continue;
+      if (e.kind == engine::EventKind::kSlideBegin) resting.emplace(e.b, e.time);
+      if (e.kind == engine::EventKind::kSlideEnd && e.time < r.time - 1e-9) resting.erase(e.b);
+    }
+    std::string on;
+    for (const auto& [part, since] : resting) {
+      on += (on.empty() ? ", resting against '" : " and '") + part +
+            "' (sliding on it from t=" + format_time(since) + " s)";
+    }
+    at_release = ": when " + how + " at t=" + format_time(r.time) + " s it was " +
                  format_length(r.offset.distance_m, out_) + " from its place, its axis " +
-                 degrees(r.offset) + " off;";
+                 degrees(r.offset) + " off" + on + ";";
   }
+  // An axis turned end for end is most likely a sign: axis = "z" for "-z".
+  const std::string reversed =
+      c.offset.angle_deg > 175
+          ? "; its axis points the opposite way to the other's: is one of the mate's axis and "
+            "along given the wrong way round (\"z\" for \"-z\")?"
+          : "";
   return at_release + (at_release.empty() ? ": the" : " the") + " closest it came was " +
          format_length(c.offset.distance_m, out_) + " from its place, its axis " + angle +
          " off, at t=" + format_time(c.time) + " s (a snap needs the part released within " +
-         format_length(m.mate.position_tolerance, out_) + " and " + tolerance + ")" + never_held;
+         format_length(m.mate.position_tolerance, out_) + " and " + tolerance + ")" + reversed +
+         never_held;
 }
 
 void Runner::watch_mates(double now) {

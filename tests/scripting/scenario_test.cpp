@@ -1320,6 +1320,48 @@ TEST(ScenarioRun, MateMadeSaysWhereThePartWasWhenTheHandLetItGo) {
       << o.expectations[0].detail;
 }
 
+TEST(ScenarioRun, MateMadeSaysWhatStoppedThePartAndAnAxisTheWrongWayRound) {
+  // A shaft 1 mm too thick for its hole rests on the block when the hand
+  // lets it go: the failure says so, not only how far it was. A mate whose
+  // axis points the other way is named as such.
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "shaft.plan",
+        "start -0.070 0.110 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
+        "reach 0.6  -0.030 0.110 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
+        "close 0.4 power\n"
+        "reach 2.0  -0.030 0.025 0.080  0.7071067811865476 0 0 0.7071067811865476\n"
+        "wait 0.2\n"
+        "open 0.3\n"
+        "reach 0.5  -0.070 0.025 0.080  0.7071067811865476 0 0 0.7071067811865476\n");
+  const auto shaft = [&](const std::string& name, double hole, const std::string& axis) {
+    return run_scenario(write(dir, name,
+                              R"(return scenario {
+  name = "shaft", units = "mm",
+  parts = {
+    block = part { shape = block_with_hole { size = { 100, 60, 100 }, hole = )" +
+                                  std::to_string(hole) + R"(, depth = 40 }, fixed = true },
+    shaft = part { shape = cylinder { diameter = 40, length = 130 }, at = { 0, 200, 0 }, turn = { x = 90 } },
+  },
+  mates = { seat = mate { part = "shaft", point = { 0, 0, 130 }, axis = ")" +
+                                  axis +
+                                  R"(", into = "block", at = { 0, -10, 0 }, along = "-y" } },
+  hand = glove { plan = "shaft.plan" },
+  expect = { mate_made "seat" },
+})"));
+  };
+  const RunOutcome thick = shaft("thick.lua", 39, "z");
+  ASSERT_EQ(thick.status, RunOutcome::Status::kFailed) << thick.error;
+  EXPECT_NE(thick.expectations[0].detail.find(", resting against 'block' (sliding on it from t="),
+            std::string::npos)
+      << thick.expectations[0].detail;
+  const RunOutcome reversed = shaft("reversed.lua", 40.5, "-z");
+  ASSERT_EQ(reversed.status, RunOutcome::Status::kFailed) << reversed.error;
+  EXPECT_NE(reversed.expectations[0].detail.find("its axis points the opposite way"),
+            std::string::npos)
+      << reversed.expectations[0].detail;
+  EXPECT_EQ(shaft("right.lua", 40.5, "z").status, RunOutcome::Status::kPassed);
+}
+
 TEST(ScenarioRun, AHeldPartAttachedToAFixedPartIsLetGo) {
   // While carried, a rule attaches the shaft to the fixed base: the hand lets
   // the collar go ("attached"), and the pair stays where it was.
