@@ -28,7 +28,7 @@ bytes per triangle and build time.
   --json       one JSON object on one line instead of the text report
   --method M   only this method (boxtree, dop6, dop14, dop18, dop26, aabb, obb, brute)
   --parts      also list the parts (one per mesh instance of every node), each
-               with its open and wrongly wound edges
+               with its open and wrongly wound edges and its bounds in the file's frame
 )";
 
 std::string json_vec(const collision::Vec3& v) {
@@ -46,6 +46,7 @@ struct PartRow {
   std::size_t vertices = 0;
   std::size_t triangles = 0;
   collision::SurfaceEdges edges{};
+  collision::Bounds bounds{};  ///< in the file's frame and units
 };
 
 }  // namespace
@@ -71,7 +72,7 @@ std::vector<PartRow> part_rows(const std::string& path) {
   try {
     for (const engine::ImportedPart& part : engine::import_file(path, per_part).parts) {
       parts.push_back({part.name, part.mesh.vertex_count(), part.mesh.triangle_count(),
-                       collision::surface_edges(part.mesh)});
+                       collision::surface_edges(part.mesh), collision::mesh_bounds(part.mesh)});
     }
   } catch (const collision::MeshError& e) {
     throw InputError(e.what());
@@ -139,7 +140,9 @@ void print_json(const Inspection& x, bool with_parts) {
           .add("vertices", std::uint64_t{part.vertices})
           .add("triangles", std::uint64_t{part.triangles})
           .add("open_edges", std::uint64_t{part.edges.open})
-          .add("wrongly_wound_edges", std::uint64_t{part.edges.misoriented});
+          .add("wrongly_wound_edges", std::uint64_t{part.edges.misoriented})
+          .add_raw("bounds_min", json_vec(part.bounds.min))
+          .add_raw("bounds_max", json_vec(part.bounds.max));
       part_items.push_back(item.str());
     }
     json.add_raw("parts", json_array(part_items));
@@ -178,11 +181,14 @@ void print_text(const Inspection& x, bool with_parts) {
     std::printf("camera              %s\n", camera.first.c_str());
   }
   if (with_parts) {
-    std::printf("\n%-32s %10s %10s %10s %14s\n", "part", "vertices", "triangles", "open edges",
-                "wrongly wound");
+    std::printf("\n%-32s %10s %10s %10s %14s  %s\n", "part", "vertices", "triangles", "open edges",
+                "wrongly wound", "bounds min .. max (the file's frame and units)");
     for (const PartRow& part : x.parts) {
-      std::printf("%-32s %10zu %10zu %10zu %14zu\n", part.name.c_str(), part.vertices,
-                  part.triangles, part.edges.open, part.edges.misoriented);
+      const collision::Bounds& b = part.bounds;
+      std::printf("%-32s %10zu %10zu %10zu %14zu  %.6g %.6g %.6g .. %.6g %.6g %.6g\n",
+                  part.name.c_str(), part.vertices, part.triangles, part.edges.open,
+                  part.edges.misoriented, b.min.x(), b.min.y(), b.min.z(), b.max.x(), b.max.y(),
+                  b.max.z());
     }
   }
   std::printf("\n%-8s %10s %10s %6s %12s %10s %10s\n", "method", "nodes", "leaves", "depth",

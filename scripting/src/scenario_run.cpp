@@ -1169,6 +1169,15 @@ void Runner::evaluate_expectations() {
                            " at t=" + format_time(out_.max_penetration_time) + " s (allowed " +
                            format_length(args[0].number, out_) + ")"
                      : "no overlap was measured";
+      // A depth against an open or wrongly wound surface may read 0 or far too deep.
+      for (const std::string* part : {&out_.max_penetration_a, &out_.max_penetration_b}) {
+        const PartId p = part->empty() ? PartId{} : sim_->scene().find(*part);
+        if (!p.valid() || !sim_->scene().collision_mesh(p)) continue;
+        if (const auto flaw = interaction::surface_flaw(*sim_->scene().collision_mesh(p))) {
+          e.detail += "; '" + *part + "' is no closed surface (" + *flaw +
+                      "), so this depth is not to be trusted";
+        }
+      }
     } else if (w == "no_contact") {
       const auto it = first_contact_.find(ordered(args[0].text, args[1].text));
       if (it != first_contact_.end()) {

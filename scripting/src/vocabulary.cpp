@@ -257,7 +257,9 @@ std::vector<Word> make_vocabulary() {
   w.push_back({"near",
                WordKind::kState,
                {{"mate", kMate, kRequired, "the mate"}},
-               "The mate's part is within its tolerances: released now, it would snap.",
+               "The mate's part is within its tolerances: released now, it would snap, unless "
+               "in place it would overlap another part (then the snap is refused, with a "
+               "warning).",
                "near \"peg_in_hole\""});
   w.push_back({"done",
                WordKind::kState,
@@ -369,7 +371,8 @@ std::vector<Word> make_vocabulary() {
                "otherwise the deepest point of one's edges inside the other, which misses an "
                "overlap deepest in the middle of a face (check touching with no_contact). The "
                "hand's segments are not counted, nor parts attached to each other while they "
-               "are.",
+               "are. Against a part whose surface is open or wrongly wound the depth may read 0 "
+               "or far too deep, and a failure says so.",
                "max_penetration(0.01)"});
   w.push_back({"no_contact",
                WordKind::kExpectation,

@@ -991,6 +991,25 @@ TEST(ScenarioLoad, AnOpenOrWronglyWoundMeshIsAWarningThatCounts) {
   const Scenario d = check_scenario(declared);
   ASSERT_EQ(d.warnings.size(), 1u);
   EXPECT_NE(d.warnings[0].find("part 'lid'"), std::string::npos) << d.warnings[0];
+
+  // A depth measured against the open box is said not to be trusted, where
+  // the failure gave it alone (and open_surface = true does not change that).
+  const auto moved = write(dir, "moved.lua", R"(return scenario {
+  name = "open", units = "mm", duration = 0.6,
+  parts = {
+    box = part { mesh = "open.obj", fixed = true, open_surface = true },
+    peg = part { mesh = "closed.obj", at = { 0, 0, 60 } },
+  },
+  rules = { rule { when = after(0.1), act = { move("peg", { 5, 5, 5 }, 0.3) } } },
+  expect = { max_penetration(0.01) },
+})");
+  const RunOutcome m = run_scenario(moved);
+  ASSERT_EQ(m.status, RunOutcome::Status::kFailed) << m.failure_summary() << m.error;
+  EXPECT_NE(m.expectations[0].detail.find("'box' is no closed surface (4 open edges"),
+            std::string::npos)
+      << m.expectations[0].detail;
+  EXPECT_NE(m.expectations[0].detail.find("so this depth is not to be trusted"), std::string::npos)
+      << m.expectations[0].detail;
 }
 
 TEST(ScenarioLoad, CheckWarnsOfAPlanInOtherUnitsAsTheRunDoes) {
