@@ -240,6 +240,30 @@ void remove_old_outputs(const Job& job, const std::filesystem::path& out) {
   std::filesystem::remove(out / job.stem / "final.png", ec);
 }
 
+/// The report in the file at `path` when it is a Dovetail scenario report
+/// (any other file, JSON or not, too deep or of odd types: nullopt).
+std::optional<nlohmann::ordered_json> scenario_report_at(const std::filesystem::path& path) {
+  try {
+    nlohmann::ordered_json report = parse_report(read_file(path));
+    if (is_scenario_report(report)) return report;
+  } catch (const std::runtime_error&) {
+    // not JSON, or nested deeper than any report
+  }
+  return std::nullopt;
+}
+
+/// "1 scenario", "3 scenarios".
+std::string scenarios_counted(std::size_t n) {
+  return std::to_string(n) + (n == 1 ? " scenario" : " scenarios");
+}
+
+/// The names joined by ", ".
+std::string comma_list(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text;
+}
+
 /// Removes what an earlier regress of this folder left in `out` of
 /// scenarios no longer in it (deleted or renamed since), so that OUT, kept
 /// as a CI artifact, holds only the outputs of the scenarios there; returns
@@ -262,13 +286,9 @@ std::vector<std::string> remove_stale_outputs(const std::filesystem::path& out,
         !std::filesystem::is_regular_file(out / (stem + ".log"), ec)) {
       continue;
     }
-    std::ifstream in(report, std::ios::binary);
-    const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
-    if (!json.is_object() || json.value("format", "") != "dovetail-scenario-report" ||
-        !json.contains("file") || !json["file"].is_string()) {
-      continue;
-    }
-    const std::filesystem::path scenario = json["file"].get<std::string>();
+    const std::optional<nlohmann::ordered_json> json = scenario_report_at(report);
+    if (!json || !json->contains("file") || !(*json)["file"].is_string()) continue;
+    const std::filesystem::path scenario = (*json)["file"].get<std::string>();
     if (std::filesystem::exists(scenario, ec) ||
         !engine::same_file(scenario.parent_path().empty() ? "." : scenario.parent_path(), folder)) {
       continue;
@@ -911,19 +931,15 @@ void check_baseline(const std::filesystem::path& baseline, const std::filesystem
   for (const auto& entry : std::filesystem::directory_iterator(baseline, ec)) {
     const std::filesystem::path& p = entry.path();
     if (p.extension() != ".json" || stems.count(p.stem().string()) != 0) continue;
-    if (is_scenario_report(nlohmann::ordered_json::parse(read_file(p), nullptr, false))) {
-      gone.push_back(p.stem().string());
-    }
+    if (scenario_report_at(p)) gone.push_back(p.stem().string());
   }
   std::sort(gone.begin(), gone.end());
   if (!gone.empty()) {
-    std::string names;
-    for (const std::string& stem : gone) names += (names.empty() ? "" : ", ") + stem;
     std::fprintf(stderr,
-                 "dovetail: note: regress: the baseline %s has reports of %zu scenario%s not in "
-                 "%s (deleted or renamed since it was made?): %s\n",
-                 baseline.string().c_str(), gone.size(), gone.size() == 1 ? "" : "s",
-                 folder.string().c_str(), names.c_str());
+                 "dovetail: note: regress: the baseline %s has reports of %s not in %s (deleted or "
+                 "renamed since it was made?): %s\n",
+                 baseline.string().c_str(), scenarios_counted(gone.size()).c_str(),
+                 folder.string().c_str(), comma_list(gone).c_str());
   }
 }
 
@@ -971,13 +987,11 @@ int regress_command(std::span<const std::string> argv) {
   if (const std::vector<std::string> stale =
           remove_stale_outputs(out, folder, scenario_files(folder));
       !stale.empty()) {
-    std::string names;
-    for (const std::string& stem : stale) names += (names.empty() ? "" : ", ") + stem;
     std::fprintf(stderr,
-                 "dovetail: note: regress: removed from %s the outputs of %zu scenario%s no "
-                 "longer in %s: %s\n",
-                 out.string().c_str(), stale.size(), stale.size() == 1 ? "" : "s",
-                 folder.string().c_str(), names.c_str());
+                 "dovetail: note: regress: removed from %s the outputs of %s no longer in %s: "
+                 "%s\n",
+                 out.string().c_str(), scenarios_counted(stale.size()).c_str(),
+                 folder.string().c_str(), comma_list(stale).c_str());
   }
 
   const auto begin = std::chrono::steady_clock::now();

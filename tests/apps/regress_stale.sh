@@ -32,6 +32,10 @@ echo 'my log' > "$out/reports/mine.log"
 printf '{\n  "format": "dovetail-scenario-report",\n  "file": "%s/elsewhere/gone.lua"\n}\n' \
   "$out" > "$out/reports/theirs.json"
 echo 'their log' > "$out/reports/theirs.log"
+# JSON of odd types beside a log: no report, left alone (a "format" that is
+# a number once ended regress with the JSON library's type error).
+echo '{"format": 3, "file": 7}' > "$out/reports/odd.json"
+echo 'odd log' > "$out/reports/odd.log"
 # The first of the shipped scenarios only.
 "$program" regress "$scenarios" --out "$out/reports" --shard 1/99 > /dev/null 2> "$out/stderr.txt" ||
   fail "regress failed"
@@ -41,6 +45,6 @@ for gone in gone.json gone.log gone; do
   [ ! -e "$out/reports/$gone" ] || fail "$gone is left"
 done
 for kept in notes.json notes.log kept/final.png kept/other.txt kept.json mine.json mine.log \
-  theirs.json theirs.log 01_peg_in_hole.json; do
+  theirs.json theirs.log odd.json odd.log 01_peg_in_hole.json; do
   [ -e "$out/reports/$kept" ] || fail "$kept was removed"
 done
