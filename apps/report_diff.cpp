@@ -30,41 +30,39 @@ bool path_starts_at(const std::string& text, std::size_t at) {
   return std::string_view(" \t\n\"'([{:=,;").find(before) != std::string_view::npos;
 }
 
-/// `from` read as `to` in every text, where it begins a path.
-void replace_in_strings(json& value, const std::string& from, const std::string& to) {
-  if (from.empty()) return;
+/// Calls `edit` on every text in `value`, at any depth.
+template <typename Edit>
+void for_each_text(json& value, const Edit& edit) {
   if (value.is_string()) {
-    std::string text = value.get<std::string>();
-    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at)) {
-      if (path_starts_at(text, at)) {
-        text.replace(at, from.size(), to);
-        at += to.size();
-      } else {
-        ++at;
-      }
-    }
-    value = std::move(text);
+    edit(value.get_ref<std::string&>());
   } else if (value.is_structured()) {
-    for (json& child : value) replace_in_strings(child, from, to);
+    for (json& child : value) for_each_text(child, edit);
   }
 }
 
-/// `name:LINE` read as `name` in every text: where a clause stands in the
-/// file is no behaviour (a comment added above it moves it).
-void drop_line_numbers(json& value, const std::string& name) {
-  if (name.empty()) return;
-  if (value.is_string()) {
-    std::string text = value.get<std::string>();
-    const std::string with_colon = name + ":";
-    for (std::size_t at = text.find(with_colon); at != std::string::npos;
-         at = text.find(with_colon, at + name.size())) {
-      std::size_t end = at + with_colon.size();
-      while (end < text.size() && text[end] >= '0' && text[end] <= '9') ++end;
-      if (end > at + with_colon.size()) text.erase(at + name.size(), end - at - name.size());
+/// `from` read as `to` in `text`, where it begins a path.
+void replace_paths(std::string& text, const std::string& from, const std::string& to) {
+  if (from.empty()) return;
+  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at)) {
+    if (path_starts_at(text, at)) {
+      text.replace(at, from.size(), to);
+      at += to.size();
+    } else {
+      ++at;
     }
-    value = std::move(text);
-  } else if (value.is_structured()) {
-    for (json& child : value) drop_line_numbers(child, name);
+  }
+}
+
+/// `name:LINE` read as `name` in `text`: where a clause stands in the file
+/// is no behaviour (a comment added above it moves it).
+void drop_line_numbers(std::string& text, const std::string& name) {
+  if (name.empty()) return;
+  const std::string with_colon = name + ":";
+  for (std::size_t at = text.find(with_colon); at != std::string::npos;
+       at = text.find(with_colon, at + name.size())) {
+    std::size_t end = at + with_colon.size();
+    while (end < text.size() && text[end] >= '0' && text[end] <= '9') ++end;
+    if (end > at + with_colon.size()) text.erase(at + name.size(), end - at - name.size());
   }
 }
 
@@ -79,9 +77,12 @@ json normalized(const json& report) {
     const std::filesystem::path file = r["file"].get<std::string>();
     r.erase("file");
     const std::string name = file.filename().string();
-    replace_in_strings(r, file.string(), name);
-    if (file.has_parent_path()) replace_in_strings(r, file.parent_path().string() + "/", "");
-    drop_line_numbers(r, name);
+    const std::string folder = file.has_parent_path() ? file.parent_path().string() + "/" : "";
+    for_each_text(r, [&](std::string& text) {
+      replace_paths(text, file.string(), name);
+      replace_paths(text, folder, "");
+      drop_line_numbers(text, name);
+    });
   }
   // Both first in both reports, null where one has none, so that an error
   // only the baseline had is the first change too.
