@@ -251,9 +251,8 @@ void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
     obstacles.push_back({models_->collision_model(scene.collision_mesh(part)), nullptr,
                          carried_pose(scene, part, X_WH), part.index});
   }
-  auto digit_collides = [&](const JointAngles& q, const DigitJoints& d,
-                            std::span<const SlideObstacle> against) {
-    const HandPose pose = model.forward_kinematics(q);
+  auto posed_digit_collides = [&](const HandPose& pose, const DigitJoints& d,
+                                  std::span<const SlideObstacle> against) {
     for (const Segment s : d.segments) {
       const auto& proxy = models_->collision_model(model.proxy(s));
       const Transform X_WS = engine::compose(X_WH, pose.X_HS[static_cast<std::size_t>(s)]);
@@ -263,6 +262,10 @@ void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
       if (hit) return true;
     }
     return false;
+  };
+  auto digit_collides = [&](const JointAngles& q, const DigitJoints& d,
+                            std::span<const SlideObstacle> against) {
+    return posed_digit_collides(model.forward_kinematics(q), d, against);
   };
   const JointAngles target = angles;
   std::vector<SlideObstacle> others;
@@ -286,8 +289,9 @@ void Grasping::limit_fingers(const HandModel& model, const Transform& X_WH,
       // closes through that part, and stops at the others.
       others.clear();
       bool in_fixed = false;
+      const HandPose where_it_was = model.forward_kinematics(q);
       for (std::size_t i = 0; i < obstacles.size(); ++i) {
-        if (!digit_collides(q, d, std::span(&obstacles[i], 1))) {
+        if (!posed_digit_collides(where_it_was, d, std::span(&obstacles[i], 1))) {
           others.push_back(obstacles[i]);
         } else if (!scene.movable(parts[i])) {
           in_fixed = true;
