@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "bench_util.h"
+#include "convex/convex_internal.h"
 #include "dovetail/collision/convex.h"
 #include "dovetail/collision/primitives.h"
 
@@ -146,23 +147,20 @@ void ccd_first_direction(const void* a, const void* b, ccd_vec3_t* dir) {
 #endif
 
 /// Times compute_convex_hull (median of runs) on generated point sets:
-/// smooth (every point a hull vertex), rounded coplanar, and interior-heavy.
+/// smooth (every point a hull vertex), rounded coplanar, and interior-heavy;
+/// small sets also on each path (qhull, and the exact incremental hull
+/// without it), side by side.
 void hull_build_times(int runs) {
   const Mat3 R = Eigen::Quaternion<double>(0.9, 0.2, 0.3, 0.1).normalized().toRotationMatrix();
   auto turned = [&](std::vector<Vec3> p) {
     for (Vec3& v : p) v = R * v;
     return p;
   };
-  std::vector<std::pair<std::string, std::vector<Vec3>>> sets;
-  sets.emplace_back("sphere, 4 subdivisions", turned(make_sphere(1, 4).vertices));
-  sets.emplace_back("sphere, 6 subdivisions", turned(make_sphere(1, 6).vertices));
-  sets.emplace_back("torus 64 x 32", turned(make_torus(1, 0.3, 64, 32).vertices));
-  sets.emplace_back("cylinder, 1024 sides", turned(make_cylinder(1, 2, 1024).vertices));
-  sets.emplace_back("box, 60 x 60 grid per face", [&] {
+  auto grid_box = [&](int n) {
     std::vector<Vec3> p;
-    for (int i = 0; i <= 60; ++i) {
-      for (int j = 0; j <= 60; ++j) {
-        const double u = -1 + i / 30.0, v = -1 + j / 30.0;
+    for (int i = 0; i <= n; ++i) {
+      for (int j = 0; j <= n; ++j) {
+        const double u = -1 + 2.0 * i / n, v = -1 + 2.0 * j / n;
         for (double s : {-1.0, 1.0}) {
           p.push_back(R * Vec3(u, v, s));
           p.push_back(R * Vec3(u, s, v));
@@ -171,7 +169,56 @@ void hull_build_times(int runs) {
       }
     }
     return p;
-  }());
+  };
+  // A capsule of the hand's model: two rings of 16 and the two pole points.
+  auto capsule = [&] {
+    std::vector<Vec3> p = {R * Vec3(0, 0, -0.008), R * Vec3(0, 0, 0.048)};
+    for (int i = 0; i < 16; ++i) {
+      const double a = 2 * M_PI * i / 16;
+      p.push_back(R * Vec3(0.008 * std::cos(a), 0.008 * std::sin(a), 0));
+      p.push_back(R * Vec3(0.008 * std::cos(a), 0.008 * std::sin(a), 0.04));
+    }
+    return p;
+  };
+  std::vector<std::pair<std::string, std::vector<Vec3>>> small;
+  small.emplace_back("box, 8 corners", turned(make_box(Vec3(1, 2, 3)).vertices));
+  small.emplace_back("capsule, 34 points", capsule());
+  small.emplace_back("sphere, 1 subdivision", turned(make_sphere(1, 1).vertices));
+  small.emplace_back("box, 2 x 2 grid per face", grid_box(2));
+  small.emplace_back("sphere, 2 subdivisions", turned(make_sphere(1, 2).vertices));
+  small.emplace_back("box, 6 x 6 grid per face", grid_box(6));
+  std::printf("Small sets, each path (`kDirectHullPoints` = %zu):\n\n", detail::kDirectHullPoints);
+  std::printf(
+      "| point set | points | hull vertices | qhull us (median) | direct us (median) | "
+      "qhull / direct |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|\n");
+  for (const auto& [name, points] : small) {
+    std::vector<double> qhull_us, direct_us;
+    ConvexHull hull;
+    // Many builds per run: one takes microseconds.
+    constexpr int kBuilds = 200;
+    for (int k = 0; k < runs; ++k) {
+      for (const detail::HullPath path : {detail::HullPath::kQhull, detail::HullPath::kDirect}) {
+        const auto start = Clock::now();
+        for (int b = 0; b < kBuilds; ++b)
+          hull = detail::build_convex_hull(points, name, nullptr, path);
+        const double us =
+            std::chrono::duration<double, std::micro>(Clock::now() - start).count() / kBuilds;
+        (path == detail::HullPath::kQhull ? qhull_us : direct_us).push_back(us);
+      }
+    }
+    std::printf("| %s | %zu | %zu | %.1f | %.1f | %.1f |\n", name.c_str(), points.size(),
+                hull.vertices.size(), median(qhull_us), median(direct_us),
+                median(qhull_us) / median(direct_us));
+  }
+  std::printf("\nLarger sets, compute_convex_hull:\n\n");
+
+  std::vector<std::pair<std::string, std::vector<Vec3>>> sets;
+  sets.emplace_back("sphere, 4 subdivisions", turned(make_sphere(1, 4).vertices));
+  sets.emplace_back("sphere, 6 subdivisions", turned(make_sphere(1, 6).vertices));
+  sets.emplace_back("torus 64 x 32", turned(make_torus(1, 0.3, 64, 32).vertices));
+  sets.emplace_back("cylinder, 1024 sides", turned(make_cylinder(1, 2, 1024).vertices));
+  sets.emplace_back("box, 60 x 60 grid per face", grid_box(60));
   sets.emplace_back("cloud, 200,000 points in a cube", [] {
     Random r(7);
     std::vector<Vec3> p;

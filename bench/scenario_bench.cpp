@@ -8,7 +8,11 @@
 // the first configuration's: status, every expectation's verdict, the events
 // (frame, kind, parts), the contact statistics and the state hash.
 //
-//   build/bench/scenario_bench [--runs R] [--tolerance-m T] [SCENARIO.lua ... | FOLDER]
+//   build/bench/scenario_bench [--runs R] [--slowest K] [--tolerance-m T]
+//                              [SCENARIO.lua ... | FOLDER]
+//
+// --slowest K adds, per scenario, the median collision time of the run's K
+// slowest frames: those that build hulls and hierarchies, as a rule.
 //
 // Without scenarios: every *.lua in scenarios/.
 
@@ -41,6 +45,19 @@ double collision_ms(const scripting::RunOutcome& o) {
   return sum;
 }
 
+/// The collision milliseconds of the run's `count` slowest frames (those
+/// that build hulls and hierarchies, as a rule).
+double slowest_frames_ms(const scripting::RunOutcome& o, std::size_t count) {
+  std::vector<double> ms;
+  for (const auto& t : o.report.timings) ms.push_back(t.collision_ms);
+  count = std::min(count, ms.size());
+  std::partial_sort(ms.begin(), ms.begin() + static_cast<std::ptrdiff_t>(count), ms.end(),
+                    std::greater<>());
+  double sum = 0;
+  for (std::size_t i = 0; i < count; ++i) sum += ms[i];
+  return sum;
+}
+
 /// What must not change when only the collision pipeline's plan does.
 bool same_outcome(const scripting::RunOutcome& x, const scripting::RunOutcome& y) {
   if (x.status != y.status || x.expectations.size() != y.expectations.size()) return false;
@@ -66,17 +83,23 @@ std::vector<fs::path> lua_files(const fs::path& folder) {
 int main(int argc, char** argv) {
   const char* program = "scenario_bench";
   int runs = 5;
+  std::size_t slowest = 0;
   std::optional<double> tolerance;
   std::vector<fs::path> scenarios;
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
     if (!std::strcmp(argv[i], "--runs") && has_value) {
       runs = static_cast<int>(dovetail::bench::whole(program, "--runs", argv[++i], 1, 1000));
+    } else if (!std::strcmp(argv[i], "--slowest") && has_value) {
+      slowest = static_cast<std::size_t>(
+          dovetail::bench::whole(program, "--slowest", argv[++i], 1, 1000000));
     } else if (!std::strcmp(argv[i], "--tolerance-m") && has_value) {
       tolerance = dovetail::bench::real(program, "--tolerance-m", argv[++i], 0);
     } else if (argv[i][0] == '-') {
-      std::fprintf(stderr, "usage: %s [--runs R] [--tolerance-m T] [SCENARIO.lua ... | FOLDER]\n",
-                   program);
+      std::fprintf(
+          stderr,
+          "usage: %s [--runs R] [--slowest K] [--tolerance-m T] [SCENARIO.lua ... | FOLDER]\n",
+          program);
       return 2;
     } else if (fs::is_directory(argv[i])) {
       for (const fs::path& f : lua_files(argv[i])) scenarios.push_back(f);
@@ -104,7 +127,7 @@ int main(int argc, char** argv) {
   std::vector<double> totals(configs.size(), 0);
   bool all_same = true;
   for (const fs::path& file : scenarios) {
-    std::vector<std::vector<double>> ms(configs.size());
+    std::vector<std::vector<double>> ms(configs.size()), slow_ms(configs.size());
     std::vector<scripting::RunOutcome> outcomes(configs.size());
     for (int r = 0; r < runs; ++r) {
       for (std::size_t c = 0; c < configs.size(); ++c) {
@@ -117,6 +140,7 @@ int main(int argc, char** argv) {
           return 1;
         }
         ms[c].push_back(collision_ms(outcomes[c]));
+        if (slowest) slow_ms[c].push_back(slowest_frames_ms(outcomes[c], slowest));
       }
     }
     std::printf("%-32s", file.stem().string().c_str());
@@ -133,6 +157,11 @@ int main(int argc, char** argv) {
                  configs[c].name + ")";
     }
     std::printf("  %s\n", verdict.c_str());
+    if (slowest) {
+      std::printf("%-32s", ("  of which " + std::to_string(slowest) + " slowest frames").c_str());
+      for (std::size_t c = 0; c < configs.size(); ++c) std::printf(" %20.2f", median(slow_ms[c]));
+      std::printf("\n");
+    }
   }
   std::printf("%-32s", "total");
   for (double t : totals) std::printf(" %20.2f", t);

@@ -14,12 +14,14 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "convex/convex_internal.h"
 #include "dovetail/collision/predicates.h"
+#include "dovetail/collision/primitives.h"
 #include "dovetail/collision/tri_tri.h"
 
 namespace dovetail::collision {
@@ -246,7 +248,8 @@ TEST(ConvexHull, ExactOnManyPointSets) {
     ConvexHull h;
     detail::HullBuildStats stats;
     try {
-      h = detail::build_convex_hull(p, "set " + std::to_string(i), &stats, false);
+      h = detail::build_convex_hull(p, "set " + std::to_string(i), &stats,
+                                    detail::HullPath::kQhull);
     } catch (const std::invalid_argument&) {
       continue;  // a degenerate integer set; covered by the degenerate test
     }
@@ -266,6 +269,88 @@ TEST(ConvexHull, ExactOnManyPointSets) {
                 kind_rebuilt[k]);
   }
   EXPECT_GT(total, 280);
+}
+
+TEST(ConvexHull, DirectPathGivesTheCornersOfQhullsHull) {
+  Random r(13);
+  int total = 0, fewer = 0;
+  for (int i = 0; i < 300; ++i) {
+    std::vector<Vec3> p;
+    switch (i % 5) {
+      case 0:
+        p = blob(r, r.integer(4, 64), Vec3(1, r.uniform(0.1, 1), r.uniform(0.01, 1)));
+        break;
+      case 1:  // coplanar points on the faces and edges of a box
+        p = box_with_face_points(r, Vec3(r.uniform(0.1, 2), r.uniform(0.1, 2), r.uniform(0.1, 2)),
+                                 r.integer(0, 56));
+        break;
+      case 2:
+        p = integer_points(r, r.integer(6, 64), r.integer(1, 3));
+        break;
+      case 3:
+        p = rotated_grid_box(r, r.integer(2, 4));
+        break;
+      default:  // the hand's capsules: rings of a cylinder and two caps
+        p = collision::make_sphere(r.uniform(0.005, 0.02), r.integer(0, 1)).vertices;
+        for (Vec3& q : p) q.z() += q.z() > 0 ? r.uniform(0, 0.05) : 0;
+    }
+    ConvexHull direct, qhull;
+    detail::HullBuildStats stats;
+    try {
+      direct = detail::build_convex_hull(p, "direct", &stats, detail::HullPath::kDirect);
+      qhull = detail::build_convex_hull(p, "qhull", nullptr, detail::HullPath::kQhull);
+    } catch (const std::invalid_argument&) {
+      continue;  // a degenerate integer set
+    }
+    ++total;
+    SCOPED_TRACE("set " + std::to_string(i));
+    EXPECT_TRUE(stats.direct);
+    expect_valid_hull(direct, p, "direct " + std::to_string(i));
+    expect_exact_support(direct, r, 20);
+    // Every vertex of the direct hull is one of qhull's (a corner of the
+    // polytope is a vertex of every hull of the points), and the two give
+    // the same support value in every direction.
+    std::set<std::array<Real, 3>> of_qhull;
+    for (const Vec3& v : qhull.vertices) of_qhull.insert({v.x(), v.y(), v.z()});
+    for (const Vec3& v : direct.vertices) EXPECT_TRUE(of_qhull.count({v.x(), v.y(), v.z()}));
+    fewer += direct.vertices.size() < qhull.vertices.size();
+    for (int k = 0; k < 20; ++k) {
+      const Vec3 d = r.direction();
+      EXPECT_EQ(detail::dot_difference_sign(d, direct.vertices[direct.support(d)],
+                                            qhull.vertices[qhull.support(d)]),
+                0);
+    }
+    // No vertex of the direct hull lies inside an edge or a facet: the
+    // faces around each lie in three or more planes.
+    for (std::uint32_t v = 0; v < direct.vertices.size(); ++v) {
+      std::vector<TriangleIndices> planes;
+      for (const TriangleIndices& f : direct.faces) {
+        if (f[0] != v && f[1] != v && f[2] != v) continue;
+        const bool known = std::any_of(planes.begin(), planes.end(), [&](const TriangleIndices& g) {
+          for (std::uint32_t k : f) {
+            if (orient3d(direct.vertices[g[0]], direct.vertices[g[1]], direct.vertices[g[2]],
+                         direct.vertices[k]) != 0)
+              return false;
+          }
+          return true;
+        });
+        if (!known) planes.push_back(f);
+      }
+      EXPECT_GE(planes.size(), 3u) << "vertex " << v << " is not a corner";
+    }
+  }
+  std::printf("[ convex  ] direct hulls %d, with fewer vertices than qhull's: %d\n", total, fewer);
+  EXPECT_GT(total, 250);
+}
+
+TEST(ConvexHull, SmallPointSetsSkipQhull) {
+  detail::HullBuildStats stats;
+  const collision::Mesh capsule = collision::make_sphere(0.01, 1);  // 42 points
+  detail::build_convex_hull(capsule.vertices, "small", &stats, detail::HullPath::kAuto);
+  EXPECT_TRUE(stats.direct);
+  const collision::Mesh larger = collision::make_sphere(0.01, 3);  // 642 points
+  detail::build_convex_hull(larger.vertices, "larger", &stats, detail::HullPath::kAuto);
+  EXPECT_FALSE(stats.direct);
 }
 
 TEST(ConvexHull, AcceptanceTestRejectsWrongSurfaces) {
@@ -310,7 +395,7 @@ TEST(ConvexHull, ExactRebuildPathOnAnyInput) {
                                        : blob(r, 80, Vec3(1, 0.5, 0.2));
     ConvexHull forced, normal;
     try {
-      forced = detail::build_convex_hull(p, "forced", nullptr, true);
+      forced = detail::build_convex_hull(p, "forced", nullptr, detail::HullPath::kRebuild);
       normal = compute_convex_hull(p, "normal");
     } catch (const std::invalid_argument&) {
       continue;

@@ -3,7 +3,8 @@
 /// is accepted only when exact orient3d proves it closed, consistently
 /// oriented, free of zero-area faces, and holding every input point on or
 /// below every face; otherwise an exact incremental hull is built from qhull's
-/// vertices and every point outside it is added (docs/convex.md).
+/// vertices and every point outside it is added. Small point sets skip qhull
+/// and go straight to the exact incremental hull (docs/convex.md).
 
 #include <libqhull_r/qhull_ra.h>
 
@@ -561,6 +562,108 @@ Triangles exact_hull(std::span<const Vec3> points, const Triangles& candidate,
   }
 }
 
+/// Whether every corner of triangle u lies in the plane of triangle t (exact).
+bool coplanar(std::span<const Vec3> p, const TriangleIndices& t, const TriangleIndices& u) {
+  for (const std::uint32_t k : u) {
+    if (orient3d(p[t[0]], p[t[1]], p[t[2]], p[k]) != 0) return false;
+  }
+  return true;
+}
+
+/// The vertices of an exact hull's triangles that are corners of the
+/// polytope, ascending. A corner has three or more facets, so the triangles
+/// around it lie in three or more planes; a vertex that lies inside an edge
+/// of the polytope has two, inside a facet one (decided exactly).
+std::vector<std::uint32_t> corners(std::span<const Vec3> p, const Triangles& triangles) {
+  std::vector<std::vector<std::uint32_t>> around(p.size());
+  for (std::uint32_t f = 0; f < triangles.size(); ++f) {
+    for (const std::uint32_t v : triangles[f]) around[v].push_back(f);
+  }
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t v = 0; v < p.size(); ++v) {
+    std::vector<std::uint32_t> planes;  // one triangle per plane met so far
+    for (const std::uint32_t f : around[v]) {
+      const bool known = std::any_of(planes.begin(), planes.end(), [&](std::uint32_t g) {
+        return coplanar(p, triangles[g], triangles[f]);
+      });
+      if (!known) planes.push_back(f);
+      if (planes.size() == 3) break;
+    }
+    if (planes.size() == 3) out.push_back(v);
+  }
+  return out;
+}
+
+/// The hull's width: over its faces, the least largest depth of a vertex
+/// below the face's plane (rounded; used only against kThinnest). A sliver
+/// face whose rounded normal vanishes is passed over: its neighbours, in
+/// nearly the same plane, measure the width there.
+Real width(std::span<const Vec3> p, const Triangles& triangles) {
+  std::vector<std::uint32_t> vertices;
+  for (const TriangleIndices& t : triangles) vertices.insert(vertices.end(), t.begin(), t.end());
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  Real least = std::numeric_limits<Real>::infinity();
+  for (const TriangleIndices& t : triangles) {
+    const Vec3 n = (p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[0]]);
+    const Real length = n.norm();
+    if (!(length > 0)) continue;  // a sliver the rounded normal misses: no width of its own
+    Real deepest = 0;
+    for (const std::uint32_t k : vertices) deepest = std::max(deepest, -n.dot(p[k] - p[t[0]]));
+    least = std::min(least, deepest / length);
+  }
+  return least;
+}
+
+/// The diagonal of the points' bounding box.
+Real diagonal(std::span<const Vec3> p) {
+  Vec3 lo = p[0], hi = p[0];
+  for (const Vec3& q : p) {
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  return (hi - lo).norm();
+}
+
+/// Point sets thinner than this fraction of their size are flat parts.
+constexpr Real kThinnest = 1e-14;
+
+/// The exact incremental hull of every point, without qhull: for small point
+/// sets, where starting qhull costs more than the whole hull (docs/convex.md).
+/// Points go in farthest from the seed tetrahedron's centre first, so that
+/// the polytope's corners mostly come before the points on its edges and
+/// facets; a beneath-beyond hull keeps such a point as a vertex when it came
+/// first, so the hull is built a second time from the corners alone.
+Triangles direct_hull(std::span<const Vec3> points, const std::array<std::uint32_t, 4>& simplex) {
+  const auto build = [](std::span<const Vec3> p, const std::array<std::uint32_t, 4>& s) {
+    ExactHull hull(p, s);
+    const Vec3 c = (p[s[0]] + p[s[1]] + p[s[2]] + p[s[3]]) / 4;
+    std::vector<std::pair<Real, std::uint32_t>> order(p.size());
+    for (std::uint32_t i = 0; i < p.size(); ++i) order[i] = {-(p[i] - c).squaredNorm(), i};
+    std::sort(order.begin(), order.end());
+    for (const auto& [far, i] : order) hull.insert(i);
+    return hull.triangles();
+  };
+  const Triangles first = build(points, simplex);
+  const std::vector<std::uint32_t> keep = corners(points, first);
+  std::vector<std::uint32_t> on_hull;
+  for (const TriangleIndices& t : first) on_hull.insert(on_hull.end(), t.begin(), t.end());
+  std::sort(on_hull.begin(), on_hull.end());
+  on_hull.erase(std::unique(on_hull.begin(), on_hull.end()), on_hull.end());
+  if (keep.size() == on_hull.size()) return first;
+  // Corners of a polytope are in convex position: the second hull has each
+  // of them as a vertex and nothing else.
+  std::vector<Vec3> corner_points;
+  for (const std::uint32_t i : keep) corner_points.push_back(points[i]);
+  std::array<std::uint32_t, 4> s;
+  if (!find_simplex(corner_points, s)) throw HullInternalError("corners are flat");
+  Triangles second = build(corner_points, s);
+  for (TriangleIndices& t : second) {
+    for (std::uint32_t& i : t) i = keep[i];
+  }
+  return second;
+}
+
 /// Compacts the vertices, builds the adjacency and the bounds.
 ConvexHull finish(std::span<const Vec3> points, const Triangles& triangles) {
   ConvexHull hull;
@@ -610,7 +713,7 @@ ConvexHull finish(std::span<const Vec3> points, const Triangles& triangles) {
 namespace detail {
 
 ConvexHull build_convex_hull(std::span<const Vec3> points, const std::string& source,
-                             HullBuildStats* stats, bool force_rebuild) {
+                             HullBuildStats* stats, HullPath path) {
   // Validate the input.
   if (points.empty()) fail(source, "no points");
   if (points.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()) / 3) {
@@ -623,10 +726,29 @@ ConvexHull build_convex_hull(std::span<const Vec3> points, const std::string& so
   if (!find_simplex(points, simplex)) {
     fail(source, "fewer than 4 affinely independent points (flat or degenerate part)");
   }
+  if (path == HullPath::kAuto) {
+    path = points.size() <= kDirectHullPoints ? HullPath::kDirect : HullPath::kQhull;
+  }
+  if (stats) stats->direct = path == HullPath::kDirect;
+  if (path == HullPath::kDirect) {
+    Triangles triangles;
+    try {
+      triangles = direct_hull(points, simplex);
+    } catch (const HullInternalError& e) {
+      fail(source, std::string("internal error: ") + e.what());
+    }
+    // qhull refuses a set thinner than about 1e-14 of its size; so does this
+    // path, so that whether a part is flat does not depend on its size.
+    if (width(points, triangles) < kThinnest * diagonal(points)) {
+      fail(source, "thinner than 1e-14 of its size (flat or degenerate part)");
+    }
+    return finish(points, triangles);
+  }
   // qhull's triangulated hull, accepted when exactly right.
   const Triangles candidate = run_qhull(points, source);
   bool proven = false;
-  const bool exact = !force_rebuild && points_outside(points, candidate, proven).empty() && proven;
+  const bool exact =
+      path != HullPath::kRebuild && points_outside(points, candidate, proven).empty() && proven;
   if (stats) {
     std::vector<std::uint32_t> ids;
     for (const TriangleIndices& t : candidate) ids.insert(ids.end(), t.begin(), t.end());
@@ -694,7 +816,7 @@ bool surface_on_hull(const ConvexHull& hull, std::span<const Vec3> points,
 }
 
 ConvexHull compute_convex_hull(std::span<const Vec3> points, const std::string& source) {
-  return detail::build_convex_hull(points, source, nullptr, false);
+  return detail::build_convex_hull(points, source, nullptr, detail::HullPath::kAuto);
 }
 
 }  // namespace dovetail::collision

@@ -30,12 +30,28 @@ namespace dovetail::collision::detail {
 struct HullBuildStats {
   std::size_t qhull_vertices = 0;  ///< vertices of qhull's hull
   bool rebuilt_exactly = false;    ///< qhull's hull failed the exact check
+  bool direct = false;             ///< built without qhull (HullPath::kDirect)
 };
 
-/// compute_convex_hull with statistics; `force_rebuild` always takes the exact
-/// incremental path (tests use it to exercise that path on any input).
+/// How a hull is built.
+enum class HullPath {
+  kAuto,     ///< kDirect up to kDirectHullPoints points, else kQhull
+  kQhull,    ///< qhull's hull when proven exact, else kRebuild from its vertices
+  kRebuild,  ///< qhull, then always the exact incremental hull from its vertices
+  kDirect,   ///< the exact incremental hull of every point, without qhull
+};
+
+/// Up to this many points a hull is built without qhull: starting qhull costs
+/// more than the exact incremental hull of a few dozen points (a 34-point
+/// capsule of the hand: 10 times as fast, `convex_bench --hull-build`); for
+/// hundreds of points on the flat facets of CAD parts, where most points are
+/// coplanar and each exact decision on them is slow, qhull wins.
+inline constexpr std::size_t kDirectHullPoints = 64;
+
+/// compute_convex_hull with statistics and a choice of path (tests use it to
+/// exercise every path on any input).
 ConvexHull build_convex_hull(std::span<const Vec3> points, const std::string& source,
-                             HullBuildStats* stats, bool force_rebuild);
+                             HullBuildStats* stats, HullPath path);
 
 /// True when `triangles` (indices into `points`) are proven, exactly, to bound
 /// a convex polytope holding every point: the acceptance test of qhull's hull.
