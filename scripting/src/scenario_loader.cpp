@@ -816,6 +816,38 @@ class Loader {
     return arg;
   }
 
+  /// A part's mesh file read (whole, or the nodes selected), in metres.
+  std::shared_ptr<const collision::Mesh> read_mesh_file(const std::filesystem::path& path,
+                                                        const Arg& nodes, const Arg& without,
+                                                        const SourceLocation& where,
+                                                        const std::string& what) {
+    collision::Mesh loaded;
+    try {
+      if (nodes.given || without.given) {
+        loaded =
+            select_nodes(path, nodes.given ? nodes.names : without.names, nodes.given, where, what);
+      } else {
+        auto [it, fresh] = whole_imports_.try_emplace(path.string());
+        if (fresh) {
+          try {
+            it->second = engine::import_file(path, {});
+          } catch (...) {
+            whole_imports_.erase(it);
+            throw;
+          }
+        }
+        for (const std::string& f : it->second.files) note_file(f);
+        loaded = it->second.parts.front().mesh;
+      }
+    } catch (const ScenarioError&) {
+      throw;
+    } catch (const std::exception& e) {
+      fail(where, what + ": " + e.what());
+    }
+    for (Vec3& v : loaded.vertices) v *= scenario_.metres_per_unit;
+    return std::make_shared<const collision::Mesh>(std::move(loaded));
+  }
+
   /// The named nodes of a mesh file (or all but them) as one mesh in the file's frame.
   collision::Mesh select_nodes(const std::filesystem::path& path,
                                const std::vector<std::string>& names, bool keep,
@@ -923,6 +955,8 @@ class Loader {
   /// Mesh files read whole, once however many parts name them (each read is
   /// a process of its own).
   std::map<std::string, engine::ImportReport> whole_imports_;
+  /// The mesh of every file and node selection read so far.
+  std::map<std::string, std::shared_ptr<const collision::Mesh>> meshes_;
 };
 
 Scenario Loader::load() {
@@ -1110,33 +1144,23 @@ void Loader::read_part(int map, PartSpec& part) {
     if (nodes.given && without.given) fail(part.where, what + ": give either nodes or without");
     if (mesh.given) {
       const std::filesystem::path path = folder_ / mesh.text;
-      collision::Mesh loaded;
       note_file(path);  // named by the scenario, read or not: never to be overwritten
-      try {
-        if (nodes.given || without.given) {
-          loaded = select_nodes(path, nodes.given ? nodes.names : without.names, nodes.given,
-                                part.where, what);
-        } else {
-          auto [it, fresh] = whole_imports_.try_emplace(path.string());
-          if (fresh) {
-            try {
-              it->second = engine::import_file(path, {});
-            } catch (...) {
-              whole_imports_.erase(it);
-              throw;
-            }
-          }
-          for (const std::string& f : it->second.files) note_file(f);
-          loaded = it->second.parts.front().mesh;
-        }
-      } catch (const ScenarioError&) {
-        throw;
-      } catch (const std::exception& e) {
-        fail(part.where, what + ": " + e.what());
-      }
-      for (Vec3& v : loaded.vertices) v *= scenario_.metres_per_unit;
-      part.mesh = std::make_shared<const collision::Mesh>(std::move(loaded));
       part.file = mesh.text;
+      // Parts that name the same file and the same nodes share one mesh, so
+      // that its hull, hierarchies and distance models are built once.
+      std::string key = path.lexically_normal().string();
+      for (const auto& [which, arg] :
+           {std::pair{"\nnodes", &nodes}, std::pair{"\nwithout", &without}}) {
+        if (!arg->given) continue;
+        key += which;
+        for (const std::string& node : arg->names) key += '\n' + node;
+      }
+      if (const auto known = meshes_.find(key); known != meshes_.end()) {
+        part.mesh = known->second;  // its files were noted when it was read
+      } else {
+        part.mesh = read_mesh_file(path, nodes, without, part.where, what);
+        meshes_.emplace(key, part.mesh);
+      }
     }
     if (const Arg at = field(t, word, "at", part.where, what); at.given) part.X_WP.t = at.vector;
     if (const Arg turn = field(t, word, "turn", part.where, what); turn.given) {

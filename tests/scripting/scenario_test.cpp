@@ -1579,6 +1579,8 @@ TEST(ScenarioLoad, NodesOfAMeshFileBecomeTheirOwnParts) {
   const auto& whole = *s.parts[2].mesh;
   EXPECT_GT(piston.triangles.size(), 100u);
   EXPECT_EQ(block.triangles.size() + piston.triangles.size(), whole.triangles.size());
+  EXPECT_NE(s.parts[0].mesh, s.parts[1].mesh);  // one file, other nodes: meshes of their own
+  EXPECT_NE(s.parts[1].mesh, s.parts[2].mesh);
   const std::string typo =
       load_error(write(dir, "typo.lua",
                        "return scenario { name = \"n\", parts = { p = part { mesh = \"" + engine +
@@ -1586,6 +1588,35 @@ TEST(ScenarioLoad, NodesOfAMeshFileBecomeTheirOwnParts) {
   EXPECT_NE(typo.find("2CylinderEngine.glb has no node 'node[5]' (did you mean 'nodes[5]'?)"),
             std::string::npos)
       << typo;
+}
+
+TEST(ScenarioLoad, PartsOfTheSameFileAndNodesShareOneMesh) {
+  // Three bricks from one file share one mesh (so the pipeline builds its
+  // hull and hierarchy once); the same file's nodes, or another file, do not.
+  const test::TempDir dir("dovetail_scenario");
+  const std::string cube =
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+      "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\n"
+      "f 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+  std::ofstream(dir / "cube.obj") << cube;
+  std::ofstream(dir / "other.obj") << cube;
+  std::filesystem::create_directory(dir / "sub");
+  LuaHost host({}, 1);
+  const Scenario s = load_scenario(host, write(dir, "bricks.lua", R"(return scenario {
+  name = "n",
+  parts = {
+    a = part { mesh = "cube.obj" },
+    b = part { mesh = "cube.obj", at = { 2, 0, 0 } },
+    c = part { mesh = "sub/../cube.obj", at = { 4, 0, 0 } },
+    d = part { mesh = "other.obj", at = { 6, 0, 0 } },
+  },
+})"));
+  ASSERT_EQ(s.parts.size(), 4u);
+  EXPECT_EQ(s.parts[0].mesh, s.parts[1].mesh);
+  EXPECT_EQ(s.parts[0].mesh, s.parts[2].mesh);
+  EXPECT_NE(s.parts[0].mesh, s.parts[3].mesh);
+  EXPECT_EQ(s.parts[1].file, "cube.obj");
+  EXPECT_EQ(s.parts[2].file, "sub/../cube.obj");
 }
 
 TEST(ScenarioRun, AGraspIsCheckedByItsType) {
