@@ -48,22 +48,75 @@ TEST(SurfaceOnHull, BoxCylinderAndSphereAreConvexHolesTorusAndDentsAreNot) {
   EXPECT_FALSE(convex(dented));
 }
 
-TEST(PairPlan, ExactPairsGoToObbTreesWithAFrontAfterTheSeparatingPlane) {
+TEST(PairPlan, ExactPairsGoToObbTreesWithAFrontAndTheSeparatingPlaneOnceItPays) {
+  // A ball hopping round a fixed torus, apart from it but inside its box: the
+  // polygon level answers "apart" every step. The pair's separating-plane
+  // test waits until those answers have cost as much work as the two hulls;
+  // then the hulls are built, the pair is planned again, and the plane
+  // separates it. Every verdict equals a brute-force query's.
+  const auto torus = share(make_torus(0.5, 0.15, 12, 6));
+  const auto ball = share(make_sphere(0.2, 1));
   CollisionWorld world;
-  const PartId a =
-      world.add_part({.mesh = share(make_box(Vec3(1, 1, 1))), .X_WP = {}, .movable = false});
-  const PartId b =
-      world.add_part({.mesh = share(make_torus(0.5, 0.15, 24, 12)), .X_WP = at(Vec3(0, 0, 1.1))});
+  const PartId a = world.add_part({.mesh = torus, .X_WP = {}, .movable = false});
+  const PartId b = world.add_part({.mesh = ball, .X_WP = at(Vec3(0.62, 0.62, 0))});
+  const auto brute_torus = build_model(Method::kBrute, torus);
+  const auto brute_ball = build_model(Method::kBrute, ball);
   world.step();
-  const std::vector<PairPlan> plans = world.plans();
+  std::vector<PairPlan> plans = world.plans();
   ASSERT_EQ(plans.size(), 1u);
   EXPECT_EQ(plans[0].pair, (PartPair{a, b}));
   EXPECT_EQ(plans[0].level, LevelOfDetail::kExact);
   EXPECT_EQ(plans[0].method, Method::kObb);
   EXPECT_TRUE(plans[0].front);
-  EXPECT_TRUE(plans[0].convex_level);
+  EXPECT_FALSE(plans[0].convex_level);
   EXPECT_EQ(plans[0].max_size, 0);
   EXPECT_NE(plans[0].reason.find("OBB"), std::string::npos) << plans[0].reason;
+  EXPECT_NE(plans[0].reason.find("once the answers 'apart' have cost as much work as building "
+                                 "the hulls"),
+            std::string::npos)
+      << plans[0].reason;
+  const std::uint64_t version = world.plans_version();
+  int turned_on_at = -1;
+  std::size_t separated = 0;
+  for (int step = 1; step < 400; ++step) {
+    // Hops between 26 and 66 degrees, 0.88 from the centre: the boxes
+    // overlap, the ball is 0.03 off the torus; the front finds little to keep.
+    const double angle = 0.8 + 0.35 * std::sin(1.7 * step);
+    const Transform X = at(Vec3(0.88 * std::cos(angle), 0.88 * std::sin(angle), 0));
+    world.set_pose(b, X);
+    const StepResult& r = world.step();
+    ASSERT_EQ(r.colliding.size(), brute_torus->collide(*brute_ball, X).colliding ? 1u : 0u)
+        << "step " << step;
+    separated += r.stats.convex_separated;
+    if (turned_on_at < 0 && world.plans()[0].convex_level) turned_on_at = step;
+  }
+  ASSERT_GT(turned_on_at, 1) << "the test came at once, before any work was spent";
+  EXPECT_GT(world.plans_version(), version);
+  plans = world.plans_since(version);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_TRUE(plans[0].convex_level);
+  EXPECT_NE(plans[0].reason.find("after the separating-plane test, turned on at step"),
+            std::string::npos)
+      << plans[0].reason;
+  EXPECT_GT(separated, 0u);
+  std::printf("[ plan     ] separating-plane test turned on at step %d, then separated %zu\n",
+              turned_on_at, separated);
+}
+
+TEST(PairPlan, APreparedWorldOrOneGivenAMethodTestsTheSeparatingPlaneAtOnce) {
+  // Hulls built beforehand cost the pair nothing: its test runs from the
+  // first step. A world given a method builds them when it plans the pair.
+  for (const bool given_method : {false, true}) {
+    CollisionWorld world(given_method ? WorldSettings{.method = Method::kObb} : WorldSettings{});
+    world.add_part({.mesh = share(make_box(Vec3(1, 1, 1))), .X_WP = {}, .movable = false});
+    world.add_part({.mesh = share(make_torus(0.5, 0.15, 24, 12)), .X_WP = at(Vec3(0, 0, 1.1))});
+    if (!given_method) world.prepare();
+    world.step();
+    ASSERT_EQ(world.plans().size(), 1u);
+    EXPECT_TRUE(world.plans()[0].convex_level) << world.plans()[0].reason;
+    EXPECT_EQ(world.plans()[0].reason.find("once the answers"), std::string::npos)
+        << world.plans()[0].reason;
+  }
 }
 
 TEST(PairPlan, AGivenMethodIsUsedWithoutAFront) {
@@ -161,19 +214,22 @@ TEST(PairPlan, APartNobodyComesNearGetsNeitherHullNorHierarchy) {
   world.step();
   EXPECT_TRUE(world.plans().empty());
   EXPECT_EQ(world.model_bytes(), 0u);
-  // Boxes overlapping, hulls apart (the box's nearest corner is 1.06 from
-  // the centre): hulls, no hierarchies.
+  // Boxes overlapping, parts apart (the box's nearest corner is 1.06 from
+  // the centre): the polygon level decides the pair on its hierarchies; the
+  // hulls wait until its answers "apart" have cost as much as they would.
   world.set_pose(small, at(Vec3(0.85, 0.85, 0)));
   world.step();
   ASSERT_EQ(world.plans().size(), 1u);
+  EXPECT_FALSE(world.plans()[0].convex_level);
   EXPECT_TRUE(world.last_step().colliding.empty());
-  const std::size_t hulls_only = world.model_bytes();
-  EXPECT_GT(hulls_only, 0u);
-  // In contact: now the polygon level builds its hierarchies.
+  EXPECT_EQ(world.last_step().stats.polygon_pairs, 1u);
+  const std::size_t hierarchies = world.model_bytes();
+  EXPECT_GT(hierarchies, 0u);
+  // In contact: decided on the same hierarchies, nothing more built.
   world.set_pose(small, at(Vec3(0.7, 0.7, 0)));
   world.step();
   EXPECT_EQ(world.last_step().colliding.size(), 1u);
-  EXPECT_GT(world.model_bytes(), hulls_only);
+  EXPECT_EQ(world.model_bytes(), hierarchies);
 }
 
 /// A ball in a ring's hole, 0.05 from its inner side: apart, but the hulls

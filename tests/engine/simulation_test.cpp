@@ -345,7 +345,7 @@ TEST(Report, JsonFieldsAndTimingsApart) {
         "\"parts\": 4", "\"state_hash\": \"0x", "\"events\": [", "\"contacts\": [",
         "\"frames_in_contact\": 5", "\"kind\": \"timer\", \"a\": \"later\"",
         "\"collision_plans\": [\n    {\"a\": \"block\", \"b\": \"slider\", \"level\": \"exact\", "
-        "\"method\": \"obb\", \"convex_level\": true, \"front\": true, \"reason\": \"the polygon "
+        "\"method\": \"obb\", \"convex_level\": false, \"front\": true, \"reason\": \"the polygon "
         "level on OBB trees"}) {
     EXPECT_NE(json.find(field), std::string::npos) << field << "\n" << json;
   }

@@ -31,8 +31,8 @@ struct Shape {
   std::shared_ptr<const CollisionModel> check_model;
   /// Distance hierarchy, built for the first exact distance query.
   std::shared_ptr<const DistanceModel> distance_model;
-  /// Convex level and tight world boxes of moving parts: built when a pair
-  /// of the part is first tested, not before.
+  /// Convex level and tight world boxes of moving parts: built when a pair's
+  /// plan first needs it (Impl::defers_convex_level), not before.
   std::shared_ptr<const ConvexHull> hull;
   /// A small hull's vertices by coordinate (every x, then every y, then
   /// every z), for its world boxes; empty for a large hull.
@@ -107,6 +107,13 @@ struct PairState {
   std::uint64_t plan_version = 0;    ///< plans_version right after the plan was made
   std::unique_ptr<PairCache> cache;  ///< null until tested, and once forgotten
   std::uint64_t tested_at = 0;       ///< `steps` at its last test
+  /// A planned pair whose separating-plane test waits for its hulls
+  /// (Impl::defer_convex_level): the work the polygon level has spent on
+  /// answers of "apart" (volume and triangle tests), and the work building
+  /// the missing hulls is reckoned to cost.
+  bool convex_deferred = false;
+  std::uint64_t apart_work = 0;
+  std::uint64_t hull_work = 0;
 };
 
 void sort_by_pair(std::vector<PairPlan>& plans) {
@@ -316,7 +323,11 @@ struct CollisionWorld::Impl {
     state.planned = true;
     state.plan_version = ++plans_version;
     plan_log.emplace_back(plans_version, pair_key(a.id.index, b.id.index));
-    PairPlan plan = plan_for(a, b);
+    std::uint64_t deferred_hull_work = 0;
+    PairPlan plan = plan_for(a, b, deferred_hull_work);
+    state.convex_deferred = deferred_hull_work > 0;
+    state.hull_work = deferred_hull_work;
+    state.apart_work = 0;
     state.plan = {.pair = plan.pair,
                   .level = plan.level,
                   .convex_level = plan.convex_level,
@@ -343,8 +354,69 @@ struct CollisionWorld::Impl {
             .reason = *reasons[p.reason]};
   }
 
-  /// The plan of a pair of parts a and b.
-  PairPlan plan_for(const Part& a, const Part& b) {
+  /// Work, in volume and triangle tests of the polygon level, that building a
+  /// hull of n points is reckoned to cost: measured, a hull costs 0.7 to 5 µs
+  /// a point (the exact incremental hull of a capsule, qhull's on CAD parts,
+  /// the first build in a run) and a test about 50 ns (docs/pipeline.md).
+  static constexpr std::uint64_t kHullWorkPerPoint = 64;
+
+  /// The reckoned work of building the hulls of a and b not built yet.
+  static std::uint64_t missing_hull_work(const Part& a, const Part& b) {
+    std::uint64_t work = 0;
+    const auto add = [&](const Shape& shape) {
+      if (!shape.hull && !shape.hull_failed)
+        work += kHullWorkPerPoint * shape.mesh->vertices.size();
+    };
+    add(*a.shape);
+    if (b.shape != a.shape) add(*b.shape);
+    return work;
+  }
+
+  /// Whether a pair planned at level `asked` waits for its convex level: in
+  /// an exact world that plans its pairs itself, a separating-plane test
+  /// pays only where it separates pairs the polygon level would otherwise
+  /// spend work on; until the answers "apart" have cost as much as the
+  /// missing hulls, they are not built (ski rental: at most twice the
+  /// better of the two choices). A world given a method keeps the former
+  /// behaviour (hulls at once), as do tolerances and the hull level, which
+  /// decide by the hulls.
+  bool defers_convex_level(LevelOfDetail asked) const {
+    return !settings.method && settings.tolerance == 0 && asked == LevelOfDetail::kExact &&
+           settings.convex_level;
+  }
+
+  /// Turns on a deferred pair's separating-plane test once its answers
+  /// "apart" have cost the polygon level as much work as its hulls would
+  /// (serially: it builds the hulls). Planned again: plans() shows it.
+  void count_apart_work(const PairWork& w) {
+    PairState& state = *w.state;
+    if (!state.convex_deferred || !w.polygon || w.colliding) return;
+    state.apart_work += w.result.stats.volume_tests + w.result.stats.triangle_tests +
+                        w.result.stats.triangle_volume_tests;
+    Part& a = parts[w.a];
+    Part& b = parts[w.b];
+    // Hulls built meanwhile for other pairs cost this one nothing.
+    state.hull_work = std::min(state.hull_work, missing_hull_work(a, b));
+    if (state.apart_work < state.hull_work) return;
+    ensure_hull(*a.shape);
+    ensure_hull(*b.shape);
+    state.convex_deferred = false;
+    PairPlan plan = to_plan(state.plan);
+    plan.convex_level = a.shape->hull && b.shape->hull;
+    std::string why = plan.reason.substr(0, plan.reason.find("; the separating-plane test once"));
+    why += plan.convex_level
+               ? ", after the separating-plane test, turned on at step " + std::to_string(steps) +
+                     " once the answers 'apart' had cost as much work as building the hulls"
+               : "; a part is flat (no hull), so no convex level";
+    state.plan.convex_level = plan.convex_level;
+    state.plan.reason = intern_reason(std::move(why));
+    state.plan_version = ++plans_version;
+    plan_log.emplace_back(plans_version, pair_key(a.id.index, b.id.index));
+  }
+
+  /// The plan of a pair of parts a and b; sets deferred_hull_work when the
+  /// pair's separating-plane test waits for its hulls (defers_convex_level).
+  PairPlan plan_for(const Part& a, const Part& b, std::uint64_t& deferred_hull_work) {
     PairPlan plan{.pair = {a.id, b.id}};
     const LevelOfDetail asked = level_of(a, b);
     if (asked == LevelOfDetail::kBox) {
@@ -352,8 +424,12 @@ struct CollisionWorld::Impl {
       plan.reason = "the scene asks for the box level: boxes that overlap are in contact";
       return plan;
     }
-    ensure_hull(*a.shape);
-    ensure_hull(*b.shape);
+    const std::uint64_t hull_work = missing_hull_work(a, b);
+    const bool defer = defers_convex_level(asked) && hull_work > 0;
+    if (!defer) {
+      ensure_hull(*a.shape);
+      ensure_hull(*b.shape);
+    }
     const bool hulls = a.shape->hull && b.shape->hull;
     if (asked == LevelOfDetail::kHull && hulls) {
       plan.level = LevelOfDetail::kHull;
@@ -375,6 +451,7 @@ struct CollisionWorld::Impl {
     }
     plan.level = LevelOfDetail::kExact;
     plan.convex_level = hulls && settings.convex_level;
+    if (defer) deferred_hull_work = hull_work;
     plan.method = polygon_method();
     plan.front = !settings.method;
     const bool cuts = *plan.method == Method::kObb || *plan.method == Method::kAabb;
@@ -382,7 +459,7 @@ struct CollisionWorld::Impl {
     std::string why;
     if (asked == LevelOfDetail::kHull)
       why = "the scene asks for the hull level, but a part is flat (no hull): ";
-    else if (!hulls)
+    else if (!hulls && !defer)
       why = "a part is flat (no hull), so no convex level: ";
     why += settings.method ? "the polygon level on the hierarchy the world was given (" +
                                  std::string(method_name(*plan.method)) + ")"
@@ -390,6 +467,12 @@ struct CollisionWorld::Impl {
                                  "the polygon level on OBB trees, the fastest exact hierarchy "
                                  "measured, keeping the box pairs found apart from step to step");
     if (plan.convex_level) why += ", after the separating-plane test";
+    if (defer) {
+      why +=
+          "; the separating-plane test once the answers 'apart' have cost as much work as "
+          "building the hulls it needs (" +
+          std::to_string(hull_work) + " volume and triangle tests)";
+    }
     if (settings.tolerance > 0) {
       why += cuts ? "; a part is not convex, so its hull would not keep the tolerance: box pairs "
                     "smaller than the tolerance count as contact"
@@ -900,6 +983,7 @@ struct CollisionWorld::Impl {
 
     // 4. Gather in pair order: contacts sorted by (a, b, triangle_a, triangle_b).
     for (const PairWork& w : work) {
+      count_apart_work(w);
       StepStats& s = next.stats;
       s.convex_tests += w.convex_tested;
       s.convex_separated += w.convex_separated;

@@ -73,7 +73,9 @@ enum class ContactDetail : std::uint8_t {
 struct WorldSettings {
   /// The polygon-level hierarchy of every pair. Unset (the default): the
   /// world plans each pair itself (PairPlan): the OBB tree, the fastest exact
-  /// hierarchy measured, with a SeparationFront kept per pair across steps.
+  /// hierarchy measured, with a SeparationFront kept per pair across steps,
+  /// and the separating-plane test once it pays. Given: that hierarchy, no
+  /// front, and every pair's hulls built when it is planned.
   std::optional<Method> method{};
   /// The accuracy the world must keep, in the meshes' units. 0 (the default):
   /// exact, a pair is in contact exactly when its triangles intersect. A
@@ -131,7 +133,12 @@ struct PartPair {
 /// convex parts under a tolerance are decided on their hulls; everything
 /// else at the polygon level, which keeps, per pair, what the last step
 /// learned (the separating plane, the triangle pair in contact, the box
-/// pairs found apart).
+/// pairs found apart). An exact pair's separating-plane test, and the hulls
+/// it needs, wait until the pair's answers of "apart" have cost the polygon
+/// level as much counted work as building those hulls would; the pair is
+/// then planned again (docs/pipeline.md, "The separating-plane test on
+/// need"). Hulls built already (prepare(), or for another pair) cost
+/// nothing: the test then runs at once.
 struct PairPlan {
   PartPair pair;
   LevelOfDetail level = LevelOfDetail::kExact;  ///< the level that decides the pair
@@ -249,8 +256,10 @@ class CollisionWorld {
   /// the polygon-level hierarchies of all parts that can reach an exact pair
   /// (by their own level, a pair level, or a flat partner), instead of on
   /// first need during step(). Optional: results are the same either way; it
-  /// keeps one-off set-up cost out of the stepping loop. Parts added, or
-  /// levels changed, afterwards are built on first need again.
+  /// keeps one-off set-up cost out of the stepping loop, and with every hull
+  /// built each exact pair's separating-plane test runs from its first step
+  /// (PairPlan). Parts added, or levels changed, afterwards are built on
+  /// first need again.
   void prepare();
 
   /// Runs the pipeline on the current poses.
