@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <memory>
+#include <random>
 #include <tuple>
 #include <vector>
 
@@ -170,6 +172,50 @@ TEST(Containment, PointInsideBoxSphereAndTorus) {
   EXPECT_TRUE(point_inside(torus, Vec3(2, 0, 0)));   // the tube
   EXPECT_TRUE(point_inside(torus, Vec3(0, -2, 0.2)));
   EXPECT_FALSE(point_inside(torus, Vec3(2, 0, 0.6)));
+}
+
+TEST(Containment, ALocatorAgreesWithEveryTriangleTestedOnItsHardestPoints) {
+  // PointLocator's rays skip the triangles whose boxes they miss; the
+  // location must be the one a ray tested against every triangle gives
+  // (locate_point), also for points on the surface, on the planes of far
+  // faces, on edges and vertices, and one ulp off them, in a turned frame.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<Real> unit(-1, 1);
+  Transform X;
+  X.R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  X.t = Vec3(0.3, -12, 40);
+  int checked = 0, on_surface = 0, inside = 0;
+  for (const Mesh& mesh : {make_block_with_hole(Vec3(1, 0.5, 1), 0.4, 0.5, 16),
+                           make_torus(2, 0.5, 32, 16), make_box(Vec3(1, 2, 3))}) {
+    const PointLocator locator(mesh, X);
+    Mesh placed = mesh;
+    for (Vec3& v : placed.vertices) v = X.apply(v);
+    std::vector<Vec3> points;
+    for (const Vec3& v : placed.vertices) {
+      points.push_back(v);
+      points.push_back(Vec3(std::nextafter(v.x(), 1e9), v.y(), v.z()));
+    }
+    for (const TriangleIndices& f : placed.triangles) {
+      const Vec3 a = placed.vertices[f[0]], b = placed.vertices[f[1]], c = placed.vertices[f[2]];
+      points.push_back((a + b) / 2);                // on an edge (rounded: near it)
+      points.push_back((a + b + c) / 3);            // on the face (rounded: near it)
+      points.push_back(a + 3 * (b - a));            // on the edge's line, far along it
+      points.push_back(a + 2 * (b - a) + (c - a));  // on the face's plane, outside it
+    }
+    for (int i = 0; i < 300; ++i)
+      points.push_back(X.apply(3 * Vec3(unit(random), unit(random), unit(random))));
+    for (const Vec3& p : points) {
+      const PointLocation expected = locate_point(placed, p);
+      ASSERT_EQ(locator.locate(p), expected) << p.transpose();
+      ++checked;
+      on_surface += expected == PointLocation::kOnSurface;
+      inside += expected == PointLocation::kInside;
+    }
+  }
+  std::printf("[ locate   ] %d points, %d on the surface, %d inside\n", checked, on_surface,
+              inside);
+  EXPECT_GT(on_surface, 100);
+  EXPECT_GT(inside, 100);
 }
 
 TEST(Containment, SmallSphereInsideLargeSphere) {

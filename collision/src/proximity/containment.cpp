@@ -14,6 +14,14 @@
 
 namespace dovetail::collision {
 
+/// The triangles' bounding boxes and their union: a ray skips the triangles
+/// whose box it misses (PointLocator builds them once for many points).
+struct TriangleBoxes {
+  std::vector<Vec3> lo, hi;
+  Vec3 all_lo, all_hi;
+  Real magnitude = 0;  ///< the largest |coordinate|
+};
+
 namespace {
 
 /// A directed edge of a triangle, between welded vertices.
@@ -74,15 +82,43 @@ bool same_closed_side(int e1, int e2, int e3) {
   return (e1 >= 0 && e2 >= 0 && e3 >= 0) || (e1 <= 0 && e2 <= 0 && e3 <= 0);
 }
 
+/// Whether segment p -> p + d may meet the box [lo, hi]: a slab test on the
+/// box widened by `margin`, far above the rounding of the test, so that it
+/// never rejects a box the segment meets.
+bool segment_may_meet(const Vec3& p, const Vec3& d, const Vec3& lo, const Vec3& hi, Real margin) {
+  Real t0 = 0, t1 = 1;
+  for (int k = 0; k < 3; ++k) {
+    const Real a = lo[k] - margin - p[k], b = hi[k] + margin - p[k];
+    if (d[k] == 0) {
+      if (a > 0 || b < 0) return false;
+      continue;
+    }
+    Real u = a / d[k], v = b / d[k];
+    if (u > v) std::swap(u, v);
+    t0 = std::max(t0, u);
+    t1 = std::min(t1, v);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
 /// Crossings of segment p -> q (q outside the mesh's bounds) with every
 /// triangle, decided by exact signs. Degenerate when the segment meets an
-/// edge or vertex, or lies in a triangle's plane.
+/// edge or vertex, or lies in a triangle's plane. With `boxes`, the
+/// triangles whose box the segment misses are skipped: they add no crossing
+/// and cannot hold p, so only the choice of direction can change (a
+/// segment in the plane of a far triangle is no longer degenerate), never
+/// the location.
 RayOutcome cast(const std::vector<Vec3>& vertices, const std::vector<TriangleIndices>& triangles,
                 const std::vector<std::uint32_t>& shell, std::size_t shell_count, const Vec3& p,
-                const Vec3& q) {
+                const Vec3& q, const TriangleBoxes* boxes) {
   RayOutcome out;
   out.winding.assign(shell_count, 0);
+  const Vec3 d = q - p;
+  const Real margin =
+      boxes ? 1e-9 * (boxes->magnitude + p.cwiseAbs().maxCoeff() + d.cwiseAbs().maxCoeff()) : 0;
   for (std::size_t t = 0; t < triangles.size(); ++t) {
+    if (boxes && !segment_may_meet(p, d, boxes->lo[t], boxes->hi[t], margin)) continue;
     const Vec3& a = vertices[triangles[t][0]];
     const Vec3& b = vertices[triangles[t][1]];
     const Vec3& c = vertices[triangles[t][2]];
@@ -143,20 +179,26 @@ struct Located {
 };
 
 Located locate(const std::vector<Vec3>& vertices, const std::vector<TriangleIndices>& triangles,
-               const std::vector<std::uint32_t>& shell, std::size_t shell_count, const Vec3& p) {
-  Vec3 lo = vertices[triangles[0][0]];
-  Vec3 hi = lo;
-  for (const TriangleIndices& f : triangles) {
-    for (std::uint32_t i : f) {
-      lo = lo.cwiseMin(vertices[i]);
-      hi = hi.cwiseMax(vertices[i]);
+               const std::vector<std::uint32_t>& shell, std::size_t shell_count, const Vec3& p,
+               const TriangleBoxes* boxes = nullptr) {
+  Vec3 lo, hi;
+  if (boxes) {
+    lo = boxes->all_lo;
+    hi = boxes->all_hi;
+  } else {
+    lo = hi = vertices[triangles[0][0]];
+    for (const TriangleIndices& f : triangles) {
+      for (std::uint32_t i : f) {
+        lo = lo.cwiseMin(vertices[i]);
+        hi = hi.cwiseMax(vertices[i]);
+      }
     }
   }
   const Real reach = 4 * ((hi - lo).norm() + (p - 0.5 * (lo + hi)).norm()) + 1;
   constexpr int kDirections = 64;
   for (int k = 0; k < kDirections; ++k) {
     const Vec3 q = p + reach * ray_direction(k).normalized();
-    const RayOutcome r = cast(vertices, triangles, shell, shell_count, p, q);
+    const RayOutcome r = cast(vertices, triangles, shell, shell_count, p, q, boxes);
     if (r.status == RayOutcome::kOnSurface) return {PointLocation::kOnSurface, true};
     if (r.status == RayOutcome::kDegenerate) continue;
     // Inside where the surfaces wind around p: one body or more (bodies
@@ -291,10 +333,27 @@ PointLocator::PointLocator(const Mesh& mesh, const Transform& X_FM)
   // location does not report, so every triangle counts as one shell.
   shell_.assign(mesh.triangles.size(), 0);
   shell_count_ = 1;
+  // The triangles' boxes, for the rays of many points to skip most triangles.
+  auto boxes = std::make_shared<TriangleBoxes>();
+  boxes->lo.reserve(mesh.triangles.size());
+  boxes->hi.reserve(mesh.triangles.size());
+  boxes->all_lo = boxes->all_hi = vertices_F_.empty() ? Vec3::Zero() : vertices_F_.front();
+  for (const TriangleIndices& f : mesh.triangles) {
+    const Vec3 &a = vertices_F_[f[0]], &b = vertices_F_[f[1]], &c = vertices_F_[f[2]];
+    boxes->lo.push_back(a.cwiseMin(b).cwiseMin(c));
+    boxes->hi.push_back(a.cwiseMax(b).cwiseMax(c));
+    boxes->all_lo = boxes->all_lo.cwiseMin(boxes->lo.back());
+    boxes->all_hi = boxes->all_hi.cwiseMax(boxes->hi.back());
+  }
+  boxes->magnitude =
+      std::max(boxes->all_lo.cwiseAbs().maxCoeff(), boxes->all_hi.cwiseAbs().maxCoeff());
+  boxes_ = std::move(boxes);
 }
 
 PointLocation PointLocator::locate(const Vec3& p_F) const {
-  return dovetail::collision::locate(vertices_F_, mesh_.triangles, shell_, shell_count_, p_F)
+  if (mesh_.triangles.empty()) return PointLocation::kOutside;
+  return dovetail::collision::locate(vertices_F_, mesh_.triangles, shell_, shell_count_, p_F,
+                                     boxes_.get())
       .location;
 }
 

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "dovetail/collision/mesh.h"
@@ -69,6 +70,8 @@ bool point_inside(const Mesh& mesh, const Vec3& p_M);
 /// F by X_FM (its vertices mapped by X_FM.apply, as the collision query maps
 /// B's), and points are given in F, so a point and the surface it is tested
 /// against are rounded the same way the collision query rounded them.
+struct TriangleBoxes;  // containment.cpp
+
 class PointLocator {
  public:
   explicit PointLocator(const Mesh& mesh, const Transform& X_FM = {});
@@ -83,6 +86,9 @@ class PointLocator {
   bool closed_ = false;
   std::vector<std::uint32_t> shell_;  ///< all 0: a location needs no shells
   std::size_t shell_count_ = 0;
+  /// The placed triangles' bounding boxes: a ray tests only the triangles
+  /// whose box it meets (exact all the same: the others cannot be crossed).
+  std::shared_ptr<const TriangleBoxes> boxes_;
 };
 
 /// Three-valued answer: an open mesh has no inside.
