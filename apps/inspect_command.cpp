@@ -1,5 +1,6 @@
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,7 +29,8 @@ bytes per triangle and build time.
   --json       one JSON object on one line instead of the text report
   --method M   only this method (boxtree, dop6, dop14, dop18, dop26, aabb, obb, brute)
   --parts      also list the parts (one per mesh instance of every node), each
-               with its open and wrongly wound edges and its bounds in the file's frame
+               with its node and group (what a scenario's nodes = { ... } takes),
+               its open and wrongly wound edges and its bounds in the file's frame
 )";
 
 std::string json_vec(const collision::Vec3& v) {
@@ -43,6 +45,10 @@ struct MethodRow {
 
 struct PartRow {
   std::string name;
+  /// The name that selects the part's whole node (a scenario's `nodes`):
+  /// the first of its meshes' names; another mesh of the node has its own.
+  std::string node;
+  std::vector<std::string> groups;  ///< the nodes above it, from the root down
   std::size_t vertices = 0;
   std::size_t triangles = 0;
   collision::SurfaceEdges edges{};
@@ -70,9 +76,12 @@ std::vector<PartRow> part_rows(const std::string& path) {
   engine::ImportOptions per_part;
   per_part.merge = false;
   try {
+    std::map<std::size_t, std::string> node_names;  // node -> its first mesh's part name
     for (const engine::ImportedPart& part : engine::import_file(path, per_part).parts) {
-      parts.push_back({part.name, part.mesh.vertex_count(), part.mesh.triangle_count(),
-                       collision::surface_edges(part.mesh), collision::mesh_bounds(part.mesh)});
+      const std::string& node = node_names.try_emplace(part.node, part.name).first->second;
+      parts.push_back({part.name, node, part.groups, part.mesh.vertex_count(),
+                       part.mesh.triangle_count(), collision::surface_edges(part.mesh),
+                       collision::mesh_bounds(part.mesh)});
     }
   } catch (const collision::MeshError& e) {
     throw InputError(e.what());
@@ -136,7 +145,11 @@ void print_json(const Inspection& x, bool with_parts) {
     std::vector<std::string> part_items;
     for (const PartRow& part : x.parts) {
       JsonLine item;
+      std::vector<std::string> groups;
+      for (const std::string& g : part.groups) groups.push_back(json_string(g));
       item.add("name", part.name)
+          .add("node", part.node)
+          .add_raw("groups", json_array(groups))
           .add("vertices", std::uint64_t{part.vertices})
           .add("triangles", std::uint64_t{part.triangles})
           .add("open_edges", std::uint64_t{part.edges.open})
@@ -181,15 +194,20 @@ void print_text(const Inspection& x, bool with_parts) {
     std::printf("camera              %s\n", camera.first.c_str());
   }
   if (with_parts) {
-    std::printf("\n%-32s %10s %10s %10s %14s  %s\n", "part", "vertices", "triangles", "open edges",
-                "wrongly wound", "bounds min .. max (the file's frame and units)");
+    std::printf("\n%-24s %-24s %-24s %10s %10s %10s %14s  %s\n", "part", "of node", "in group",
+                "vertices", "triangles", "open edges", "wrongly wound",
+                "bounds min .. max (the file's frame and units)");
     for (const PartRow& part : x.parts) {
       const collision::Bounds& b = part.bounds;
-      std::printf("%-32s %10zu %10zu %10zu %14zu  %.6g %.6g %.6g .. %.6g %.6g %.6g\n",
-                  part.name.c_str(), part.vertices, part.triangles, part.edges.open,
-                  part.edges.misoriented, b.min.x(), b.min.y(), b.min.z(), b.max.x(), b.max.y(),
-                  b.max.z());
+      const std::string group = part.groups.empty() ? "-" : part.groups.back();
+      std::printf("%-24s %-24s %-24s %10zu %10zu %10zu %14zu  %.6g %.6g %.6g .. %.6g %.6g %.6g\n",
+                  part.name.c_str(), part.node.c_str(), group.c_str(), part.vertices,
+                  part.triangles, part.edges.open, part.edges.misoriented, b.min.x(), b.min.y(),
+                  b.min.z(), b.max.x(), b.max.y(), b.max.z());
     }
+    std::printf(
+        "\nA scenario's nodes = { ... } takes a node whole (every part of it) by any of its "
+        "parts' names, and a group by its name (every part in it).\n");
   }
   std::printf("\n%-8s %10s %10s %6s %12s %10s %10s\n", "method", "nodes", "leaves", "depth",
               "bytes", "bytes/tri", "build ms");

@@ -230,6 +230,9 @@ std::string encode_report(const ImportReport& report) {
   w.count(report.parts.size());
   for (const ImportedPart& part : report.parts) {
     w.text(part.name);
+    w.count(part.node);
+    w.count(part.groups.size());
+    for (const std::string& group : part.groups) w.text(group);
     w.text(part.mesh.source);
     w.count(part.mesh.vertices.size());
     for (const collision::Vec3& v : part.mesh.vertices) w.vec(v);
@@ -267,6 +270,9 @@ ImportReport decode_report(std::string_view bytes) {
   report.parts.resize(r.count(1));
   for (ImportedPart& part : report.parts) {
     part.name = r.text();
+    part.node = r.count(0);
+    part.groups.resize(r.count(1));
+    for (std::string& group : part.groups) group = r.text();
     part.mesh.source = r.text();
     part.mesh.vertices.resize(r.count(3 * sizeof(double)));
     for (collision::Vec3& v : part.mesh.vertices) v = r.vec();

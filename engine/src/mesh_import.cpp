@@ -91,6 +91,7 @@ Vec3 apply(const Affine& X, const aiVector3D& v) {
 /// One use of a mesh by a node, with the node's transform to the file's root.
 struct Instance {
   const aiNode* node = nullptr;
+  std::size_t node_number = 0;  ///< the node's place in depth-first order
   unsigned mesh = 0;
   Affine X_RN;
 };
@@ -111,6 +112,7 @@ std::vector<Instance> collect_instances(const fs::path& path, const aiScene& sce
     if (top.node == nullptr) continue;
     if (!visited.insert(top.node).second)
       fail(path, "node hierarchy contains a cycle or a shared node");
+    const std::size_t node_number = visited.size() - 1;
     const Affine X_RN = compose(top.X_RQ, to_affine(top.node->mTransformation));
     for (unsigned k = 0; k < top.node->mNumMeshes; ++k) {
       const unsigned mesh = top.node->mMeshes[k];
@@ -118,7 +120,7 @@ std::vector<Instance> collect_instances(const fs::path& path, const aiScene& sce
         fail(path, "node '" + std::string(top.node->mName.C_Str()) + "' refers to mesh " +
                        std::to_string(mesh) + " of " + std::to_string(scene.mNumMeshes));
       }
-      instances.push_back({top.node, mesh, X_RN});
+      instances.push_back({top.node, node_number, mesh, X_RN});
     }
     for (unsigned k = top.node->mNumChildren; k > 0; --k) {
       stack.push_back({top.node->mChildren[k - 1], X_RN});
@@ -468,6 +470,10 @@ ImportReport import_scene(const fs::path& path, const aiScene& scene, const Impo
     if (options.part_frames) X_geometry = split_rigid(instance->X_RN, part.X_RP);
     append(path, *scene.mMeshes[instance->mesh], X_geometry, geometry);
     part.name = name;
+    part.node = instance->node_number;
+    for (const aiNode* up = instance->node->mParent; up != nullptr; up = up->mParent) {
+      part.groups.insert(part.groups.begin(), up->mName.C_Str());
+    }
     part.mesh =
         validate(std::move(geometry), path.string() + "#" + name, options.limits, part.validation);
     report.parts.push_back(std::move(part));

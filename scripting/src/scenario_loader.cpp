@@ -865,19 +865,40 @@ class Loader {
       for (const std::string& f : it->second.files) note_file(f);
     }
     const engine::ImportReport& report = it->second;
-    std::vector<std::string> known;
-    for (const engine::ImportedPart& p : report.parts) known.push_back(p.name);
+    // A name takes its node whole (all its meshes: a glTF node's primitives
+    // are imported as parts `name`, `name_2`, ...), and a group's name every
+    // part below the group (a sub-assembly).
+    std::vector<char> listed(report.parts.size(), 0);
     for (const std::string& name : names) {
-      if (std::find(known.begin(), known.end(), name) == known.end()) {
+      std::set<std::size_t> nodes;
+      for (const engine::ImportedPart& p : report.parts) {
+        if (p.name == name) nodes.insert(p.node);
+      }
+      bool found = false;
+      for (std::size_t i = 0; i < report.parts.size(); ++i) {
+        const engine::ImportedPart& p = report.parts[i];
+        if (nodes.count(p.node) != 0 ||
+            std::find(p.groups.begin(), p.groups.end(), name) != p.groups.end()) {
+          listed[i] = 1;
+          found = true;
+        }
+      }
+      if (!found) {
+        std::set<std::string> known;
+        for (const engine::ImportedPart& p : report.parts) {
+          known.insert(p.name);
+          known.insert(p.groups.begin(), p.groups.end());
+        }
+        const std::vector<std::string> candidates(known.begin(), known.end());
         fail(where, what + ": " + path.filename().string() + " has no node '" + name + "'" +
-                        did_you_mean(name, known));
+                        did_you_mean(name, candidates));
       }
     }
     std::vector<Vec3> vertices;
     std::vector<collision::TriangleIndices> triangles;
-    for (const engine::ImportedPart& p : report.parts) {
-      const bool listed = std::find(names.begin(), names.end(), p.name) != names.end();
-      if (listed != keep) continue;
+    for (std::size_t i = 0; i < report.parts.size(); ++i) {
+      const engine::ImportedPart& p = report.parts[i];
+      if ((listed[i] != 0) != keep) continue;
       const auto base = static_cast<std::uint32_t>(vertices.size());
       vertices.insert(vertices.end(), p.mesh.vertices.begin(), p.mesh.vertices.end());
       for (collision::TriangleIndices tri : p.mesh.triangles) {

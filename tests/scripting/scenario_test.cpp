@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
@@ -12,6 +14,7 @@
 #include <regex>
 
 #include "../support/temp_dir.h"
+#include "dovetail/engine/mesh_import.h"
 #include "dovetail/scripting/lua_host.h"
 #include "dovetail/scripting/scenario_run.h"
 
@@ -1588,6 +1591,66 @@ TEST(ScenarioLoad, NodesOfAMeshFileBecomeTheirOwnParts) {
   EXPECT_NE(typo.find("2CylinderEngine.glb has no node 'node[5]' (did you mean 'nodes[5]'?)"),
             std::string::npos)
       << typo;
+}
+
+TEST(ScenarioLoad, ANodeIsTakenWholeAndAGroupWithEverythingInIt) {
+  // In the glTF engine, node 78 holds one mesh of two primitives, imported
+  // as parts nodes[78] (141 triangles) and nodes[78]_2 (721): either name
+  // takes the whole node. Node 13 is a group of meshes: its name takes
+  // every part below it.
+  const std::string engine =
+      "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+  if (!std::filesystem::exists(engine))
+    GTEST_SKIP() << engine << " (assimp-testmodels) is not installed";
+  engine::ImportOptions per_part;
+  per_part.merge = false;
+  const engine::ImportReport file = engine::import_file(engine, per_part);
+  std::size_t node_78 = 0, in_13 = 0, parts_in_13 = 0;
+  for (const engine::ImportedPart& p : file.parts) {
+    if (p.name == "nodes[78]" || p.name == "nodes[78]_2") node_78 += p.mesh.triangles.size();
+    if (std::find(p.groups.begin(), p.groups.end(), "nodes[13]") != p.groups.end()) {
+      in_13 += p.mesh.triangles.size();
+      ++parts_in_13;
+    }
+  }
+  ASSERT_EQ(node_78, 862u);
+  ASSERT_GT(parts_in_13, 2u);
+  const test::TempDir dir("dovetail_scenario");
+  LuaHost host({}, 1);
+  const Scenario s = load_scenario(host, write(dir, "nodes.lua",
+                                               "return scenario {\n  name = \"n\",\n  parts = {\n"
+                                               "    first = part { mesh = \"" +
+                                                   engine +
+                                                   "\", nodes = { \"nodes[78]\" } },\n"
+                                                   "    second = part { mesh = \"" +
+                                                   engine +
+                                                   "\", nodes = { \"nodes[78]_2\" } },\n"
+                                                   "    group = part { mesh = \"" +
+                                                   engine +
+                                                   "\", nodes = { \"nodes[13]\" } },\n"
+                                                   "    rest = part { mesh = \"" +
+                                                   engine +
+                                                   "\", without = { \"nodes[13]\" } },\n"
+                                                   "  },\n}\n"));
+  ASSERT_EQ(s.parts.size(), 4u);
+  const auto triangles = [&](const std::string& name) {
+    for (const PartSpec& p : s.parts) {
+      if (p.name == name) return p.mesh->triangles.size();
+    }
+    ADD_FAILURE() << "no part " << name;
+    return std::size_t{0};
+  };
+  EXPECT_EQ(triangles("first"), 862u);
+  EXPECT_EQ(triangles("second"), 862u);
+  EXPECT_EQ(triangles("group"), in_13);
+  std::size_t all = 0;
+  for (const engine::ImportedPart& p : file.parts) all += p.mesh.triangles.size();
+  EXPECT_EQ(triangles("rest"), all - in_13);
+  const std::string typo =
+      load_error(write(dir, "typo.lua",
+                       "return scenario { name = \"n\", parts = { p = part { mesh = \"" + engine +
+                           "\", nodes = { \"nodes[133]\" } } } }\n"));
+  EXPECT_NE(typo.find("has no node 'nodes[133]' (did you mean"), std::string::npos) << typo;
 }
 
 TEST(ScenarioLoad, PartsOfTheSameFileAndNodesShareOneMesh) {

@@ -55,6 +55,12 @@ struct ImportedPart {
   /// unique within the file by a suffix `_2`, `_3`, ... in depth-first order.
   /// For a merged import: the file name without folder.
   std::string name;
+  /// The node it comes from, numbered in depth-first order: the meshes of
+  /// one node (a glTF node's primitives) are parts of the same node.
+  std::size_t node = 0;
+  /// The names of the nodes above that node (the groups it belongs to: a
+  /// sub-assembly), from the root down, as the file names them.
+  std::vector<std::string> groups;
   collision::Mesh mesh;
   collision::MeshValidation validation;
   /// Pose of the part's frame in the file's root frame: identity unless
