@@ -1169,12 +1169,17 @@ void Loader::read_part(int map, PartSpec& part) {
       part.file = mesh.text;
       // Parts that name the same file and the same nodes share one mesh, so
       // that its hull, hierarchies and distance models are built once.
-      std::string key = path.lexically_normal().string();
+      std::error_code ec;
+      const std::filesystem::path where_on_disk = std::filesystem::weakly_canonical(path, ec);
+      std::string key = (ec ? path.lexically_normal() : where_on_disk).string();
       for (const auto& [which, arg] :
-           {std::pair{"\nnodes", &nodes}, std::pair{"\nwithout", &without}}) {
+           {std::pair{"nodes", &nodes}, std::pair{"without", &without}}) {
         if (!arg->given) continue;
+        std::vector<std::string> names = arg->names;  // in any order: the same selection
+        std::sort(names.begin(), names.end());
+        key += '\0';
         key += which;
-        for (const std::string& node : arg->names) key += '\n' + node;
+        for (const std::string& node : names) (key += '\0') += node;
       }
       if (const auto known = meshes_.find(key); known != meshes_.end()) {
         part.mesh = known->second;  // its files were noted when it was read

@@ -296,12 +296,20 @@ TEST(ConvexHull, DirectPathGivesTheCornersOfQhullsHull) {
     }
     ConvexHull direct, qhull;
     detail::HullBuildStats stats;
+    bool direct_refused = false, qhull_refused = false;
     try {
       direct = detail::build_convex_hull(p, "direct", &stats, detail::HullPath::kDirect);
+    } catch (const std::invalid_argument&) {
+      direct_refused = true;
+    }
+    try {
       qhull = detail::build_convex_hull(p, "qhull", nullptr, detail::HullPath::kQhull);
     } catch (const std::invalid_argument&) {
-      continue;  // a degenerate integer set
+      qhull_refused = true;
     }
+    // A degenerate (flat) set is refused by both paths, or by neither.
+    ASSERT_EQ(direct_refused, qhull_refused) << "set " << i;
+    if (direct_refused) continue;
     ++total;
     SCOPED_TRACE("set " + std::to_string(i));
     EXPECT_TRUE(stats.direct);
@@ -341,6 +349,31 @@ TEST(ConvexHull, DirectPathGivesTheCornersOfQhullsHull) {
   }
   std::printf("[ convex  ] direct hulls %d, with fewer vertices than qhull's: %d\n", total, fewer);
   EXPECT_GT(total, 250);
+}
+
+TEST(ConvexHull, TheDirectPathJudgesThinnessAtAnyScale) {
+  // The same tetrahedra scaled by 1e-90 and 1e90 (the exact predicates
+  // hold while products of three coordinates neither underflow nor
+  // overflow) and moved far away: a width of 1e-12 of the size is a hull,
+  // 1e-16 is flat, at every scale.
+  for (const Real scale : {1e-90, 1e-3, 1.0, 1e3, 1e90}) {
+    for (const Real offset : {0.0, 1e6}) {
+      const auto set = [&](Real thickness) {
+        std::vector<Vec3> p = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0),
+                               Vec3(0.3, 0.3, thickness)};
+        for (Vec3& q : p) q = (q + Vec3::Constant(offset)) * scale;
+        return p;
+      };
+      SCOPED_TRACE("scale " + std::to_string(scale) + " offset " + std::to_string(offset));
+      if (offset == 0) {
+        EXPECT_NO_THROW(
+            detail::build_convex_hull(set(1e-12), "thin", nullptr, detail::HullPath::kDirect));
+      }
+      EXPECT_THROW(
+          detail::build_convex_hull(set(1e-16), "flat", nullptr, detail::HullPath::kDirect),
+          std::invalid_argument);
+    }
+  }
 }
 
 TEST(ConvexHull, SmallPointSetsSkipQhull) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -95,12 +96,53 @@ TEST(PairPlan, ExactPairsGoToObbTreesWithAFrontAndTheSeparatingPlaneOnceItPays) 
   plans = world.plans_since(version);
   ASSERT_EQ(plans.size(), 1u);
   EXPECT_TRUE(plans[0].convex_level);
-  EXPECT_NE(plans[0].reason.find("after the separating-plane test, turned on at step"),
+  EXPECT_NE(plans[0].reason.find("after the separating-plane test, turned on once the answers "
+                                 "'apart' had cost as much work as building the hulls"),
             std::string::npos)
       << plans[0].reason;
   EXPECT_GT(separated, 0u);
   std::printf("[ plan     ] separating-plane test turned on at step %d, then separated %zu\n",
               turned_on_at, separated);
+}
+
+TEST(PairPlan, DeferredPlansAndTheirWorkAreTheSameAtAnyThreadCount) {
+  // A light pair (deferred) and a heavy one (split over the threads, so not
+  // deferred: its work differs with the threads) circling one another for
+  // 300 steps: the plans, their versions and every step's counters are the
+  // same at 1, 2 and 8 threads.
+  const auto torus = share(make_torus(0.5, 0.15, 32, 16));  // 1,024 triangles
+  const auto big = share(make_sphere(0.2, 3));              // 1,280: heavy with the torus
+  const auto small = share(make_sphere(0.2, 1));            // 80
+  std::vector<std::vector<PairPlan>> plans;
+  std::vector<std::vector<std::array<std::size_t, 5>>> counters;
+  for (const int threads : {1, 2, 8}) {
+    CollisionWorld world({.threads = threads});
+    world.add_part({.mesh = torus, .X_WP = {}, .movable = false});
+    const PartId a = world.add_part({.mesh = small, .X_WP = at(Vec3(0.88, 0, 0))});
+    const PartId b = world.add_part({.mesh = big, .X_WP = at(Vec3(-0.88, 0, 0))});
+    counters.emplace_back();
+    for (int step = 0; step < 300; ++step) {
+      const double angle = 0.8 + 0.35 * std::sin(1.7 * step);
+      const double r = step % 7 == 0 ? 0.7 : 0.88;  // now and then in contact
+      world.set_pose(a, at(Vec3(r * std::cos(angle), r * std::sin(angle), 0)));
+      world.set_pose(b, at(Vec3(-r * std::cos(angle), -r * std::sin(angle), 0)));
+      const StepStats& st = world.step().stats;
+      counters.back().push_back({st.convex_tests, st.convex_separated, st.polygon_pairs,
+                                 st.colliding_pairs, world.plans_version()});
+    }
+    plans.push_back(world.plans());
+  }
+  ASSERT_EQ(plans[0].size(), 2u);
+  EXPECT_TRUE(plans[0][0].convex_level) << plans[0][0].reason;  // paid for its hulls
+  EXPECT_TRUE(plans[0][1].convex_level) << plans[0][1].reason;  // heavy: at once
+  for (std::size_t k = 1; k < plans.size(); ++k) {
+    EXPECT_EQ(counters[k], counters[0]) << "thread run " << k;
+    ASSERT_EQ(plans[k].size(), plans[0].size());
+    for (std::size_t i = 0; i < plans[0].size(); ++i) {
+      EXPECT_EQ(plans[k][i].convex_level, plans[0][i].convex_level);
+      EXPECT_EQ(plans[k][i].reason, plans[0][i].reason);
+    }
+  }
 }
 
 TEST(PairPlan, APreparedWorldOrOneGivenAMethodTestsTheSeparatingPlaneAtOnce) {

@@ -596,8 +596,10 @@ std::vector<std::uint32_t> corners(std::span<const Vec3> p, const Triangles& tri
 
 /// The hull's width: over its faces, the least largest depth of a vertex
 /// below the face's plane (rounded; used only against kThinnest). A sliver
-/// face whose rounded normal vanishes is passed over: its neighbours, in
-/// nearly the same plane, measure the width there.
+/// face, whose rounded normal may point anywhere (its sine of the angle
+/// between its edges under 1e-6), is passed over: its neighbours, in nearly
+/// the same plane, measure the width there, and a flat set's two large
+/// faces always do.
 Real width(std::span<const Vec3> p, const Triangles& triangles) {
   std::vector<std::uint32_t> vertices;
   for (const TriangleIndices& t : triangles) vertices.insert(vertices.end(), t.begin(), t.end());
@@ -605,9 +607,10 @@ Real width(std::span<const Vec3> p, const Triangles& triangles) {
   vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
   Real least = std::numeric_limits<Real>::infinity();
   for (const TriangleIndices& t : triangles) {
-    const Vec3 n = (p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[0]]);
+    const Vec3 u = p[t[1]] - p[t[0]], v = p[t[2]] - p[t[0]];
+    const Vec3 n = u.cross(v);
     const Real length = n.norm();
-    if (!(length > 0)) continue;  // a sliver the rounded normal misses: no width of its own
+    if (!(length > 1e-6 * u.norm() * v.norm())) continue;  // a sliver: no width of its own
     Real deepest = 0;
     for (const std::uint32_t k : vertices) deepest = std::max(deepest, -n.dot(p[k] - p[t[0]]));
     least = std::min(least, deepest / length);
@@ -627,6 +630,28 @@ Real diagonal(std::span<const Vec3> p) {
 
 /// Point sets thinner than this fraction of their size are flat parts.
 constexpr Real kThinnest = 1e-14;
+
+/// Whether the hull's width is below `fraction` of its bounding box's
+/// diagonal. Measured on the points moved to the box's centre and scaled by
+/// a power of two to a diagonal near 1, so that neither underflow (a set of
+/// size 1e-200) nor overflow (1e200) decides.
+bool thinner_than(Real fraction, std::span<const Vec3> points, const Triangles& triangles) {
+  Vec3 lo = points[0], hi = points[0];
+  for (const Vec3& q : points) {
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  int exponent = 0;
+  std::frexp((hi / 2 - lo / 2).maxCoeff(), &exponent);  // halves: no overflow near 1e308
+  const Vec3 centre = lo / 2 + hi / 2;
+  std::vector<Vec3> scaled(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3 d = points[i] - centre;
+    scaled[i] = Vec3(std::ldexp(d.x(), -exponent), std::ldexp(d.y(), -exponent),
+                     std::ldexp(d.z(), -exponent));
+  }
+  return width(scaled, triangles) < fraction * diagonal(scaled);
+}
 
 /// The exact incremental hull of every point, without qhull: for small point
 /// sets, where starting qhull costs more than the whole hull (docs/convex.md).
@@ -739,7 +764,7 @@ ConvexHull build_convex_hull(std::span<const Vec3> points, const std::string& so
     }
     // qhull refuses a set thinner than about 1e-14 of its size; so does this
     // path, so that whether a part is flat does not depend on its size.
-    if (width(points, triangles) < kThinnest * diagonal(points)) {
+    if (thinner_than(kThinnest, points, triangles)) {
       fail(source, "thinner than 1e-14 of its size (flat or degenerate part)");
     }
     return finish(points, triangles);

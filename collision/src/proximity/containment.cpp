@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <tuple>
@@ -14,6 +15,8 @@
 
 namespace dovetail::collision {
 
+namespace {
+
 /// The triangles' bounding boxes and their union: a ray skips the triangles
 /// whose box it misses (PointLocator builds them once for many points).
 struct TriangleBoxes {
@@ -21,8 +24,6 @@ struct TriangleBoxes {
   Vec3 all_lo, all_hi;
   Real magnitude = 0;  ///< the largest |coordinate|
 };
-
-namespace {
 
 /// A directed edge of a triangle, between welded vertices.
 struct Edge {
@@ -116,7 +117,9 @@ RayOutcome cast(const std::vector<Vec3>& vertices, const std::vector<TriangleInd
   out.winding.assign(shell_count, 0);
   const Vec3 d = q - p;
   const Real margin =
-      boxes ? 1e-9 * (boxes->magnitude + p.cwiseAbs().maxCoeff() + d.cwiseAbs().maxCoeff()) : 0;
+      boxes ? 1e-9 * (boxes->magnitude + p.cwiseAbs().maxCoeff() + d.cwiseAbs().maxCoeff()) +
+                  std::numeric_limits<Real>::min()
+            : 0;
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     if (boxes && !segment_may_meet(p, d, boxes->lo[t], boxes->hi[t], margin)) continue;
     const Vec3& a = vertices[triangles[t][0]];
@@ -317,12 +320,15 @@ SurfaceEdges surface_edges(const Mesh& mesh) {
 }
 
 PointLocation locate_point(const Mesh& mesh, const Vec3& p_M) {
+  if (mesh.triangles.empty()) return PointLocation::kOutside;
   return locate_in(mesh, mesh.vertices, p_M).location;
 }
 
 bool point_inside(const Mesh& mesh, const Vec3& p_M) {
   return locate_point(mesh, p_M) != PointLocation::kOutside;
 }
+
+struct PointLocator::Boxes : TriangleBoxes {};
 
 PointLocator::PointLocator(const Mesh& mesh, const Transform& X_FM)
     : mesh_(mesh), closed_(is_closed(mesh)) {
@@ -334,10 +340,11 @@ PointLocator::PointLocator(const Mesh& mesh, const Transform& X_FM)
   shell_.assign(mesh.triangles.size(), 0);
   shell_count_ = 1;
   // The triangles' boxes, for the rays of many points to skip most triangles.
-  auto boxes = std::make_shared<TriangleBoxes>();
+  auto boxes = std::make_shared<Boxes>();
   boxes->lo.reserve(mesh.triangles.size());
   boxes->hi.reserve(mesh.triangles.size());
-  boxes->all_lo = boxes->all_hi = vertices_F_.empty() ? Vec3::Zero() : vertices_F_.front();
+  boxes->all_lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
+  boxes->all_hi = -boxes->all_lo;
   for (const TriangleIndices& f : mesh.triangles) {
     const Vec3 &a = vertices_F_[f[0]], &b = vertices_F_[f[1]], &c = vertices_F_[f[2]];
     boxes->lo.push_back(a.cwiseMin(b).cwiseMin(c));

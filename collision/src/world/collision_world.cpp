@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <utility>
 
@@ -108,7 +109,7 @@ struct PairState {
   std::unique_ptr<PairCache> cache;  ///< null until tested, and once forgotten
   std::uint64_t tested_at = 0;       ///< `steps` at its last test
   /// A planned pair whose separating-plane test waits for its hulls
-  /// (Impl::defer_convex_level): the work the polygon level has spent on
+  /// (Impl::defers_convex_level): the work the polygon level has spent on
   /// answers of "apart" (volume and triangle tests), and the work building
   /// the missing hulls is reckoned to cost.
   bool convex_deferred = false;
@@ -372,47 +373,68 @@ struct CollisionWorld::Impl {
     return work;
   }
 
-  /// Whether a pair planned at level `asked` waits for its convex level: in
-  /// an exact world that plans its pairs itself, a separating-plane test
-  /// pays only where it separates pairs the polygon level would otherwise
-  /// spend work on; until the answers "apart" have cost as much as the
-  /// missing hulls, they are not built (ski rental: at most twice the
-  /// better of the two choices). A world given a method keeps the former
-  /// behaviour (hulls at once), as do tolerances and the hull level, which
-  /// decide by the hulls.
-  bool defers_convex_level(LevelOfDetail asked) const {
+  /// Whether the pair of a and b, planned at level `asked`, waits for its
+  /// convex level: in an exact world that plans its pairs itself, a
+  /// separating-plane test pays only where it separates pairs the polygon
+  /// level would otherwise spend work on; until the answers "apart" have cost
+  /// as much as the missing hulls, they are not built (ski rental: at most
+  /// twice the better of the two choices). A world given a method keeps the
+  /// former behaviour (hulls at once), as do tolerances and the hull level,
+  /// which decide by the hulls. Not deferred either: a pair with a part
+  /// known to be flat (it has no convex level), and a heavy pair, whose
+  /// queries are split over the threads without the separation front
+  /// (evaluate_split), so that the work it counted would depend on the
+  /// number of threads.
+  bool defers_convex_level(const Part& a, const Part& b, LevelOfDetail asked) const {
     return !settings.method && settings.tolerance == 0 && asked == LevelOfDetail::kExact &&
-           settings.convex_level;
+           settings.convex_level && !a.shape->hull_failed && !b.shape->hull_failed && !heavy(a, b);
   }
 
-  /// Turns on a deferred pair's separating-plane test once its answers
-  /// "apart" have cost the polygon level as much work as its hulls would
-  /// (serially: it builds the hulls). Planned again: plans() shows it.
-  void count_apart_work(const PairWork& w) {
+  /// Counts the work of a deferred pair's answer of "apart" at the polygon
+  /// level; true once the answers have paid for the pair's missing hulls
+  /// (or those were built meanwhile, for other pairs).
+  bool apart_work_paid(const PairWork& w) {
     PairState& state = *w.state;
-    if (!state.convex_deferred || !w.polygon || w.colliding) return;
+    if (!state.convex_deferred || !w.polygon || w.colliding) return false;
     state.apart_work += w.result.stats.volume_tests + w.result.stats.triangle_tests +
                         w.result.stats.triangle_volume_tests;
+    state.hull_work = std::min(state.hull_work, missing_hull_work(parts[w.a], parts[w.b]));
+    return state.apart_work >= state.hull_work;
+  }
+
+  /// Builds a deferred pair's hulls (serially), turns its separating-plane
+  /// test on and plans it again (plans_since() has it).
+  void upgrade_deferred_plan(const PairWork& w) {
+    PairState& state = *w.state;
     Part& a = parts[w.a];
     Part& b = parts[w.b];
-    // Hulls built meanwhile for other pairs cost this one nothing.
-    state.hull_work = std::min(state.hull_work, missing_hull_work(a, b));
-    if (state.apart_work < state.hull_work) return;
+    const bool paid = state.hull_work > 0;
     ensure_hull(*a.shape);
     ensure_hull(*b.shape);
     state.convex_deferred = false;
-    PairPlan plan = to_plan(state.plan);
-    plan.convex_level = a.shape->hull && b.shape->hull;
-    std::string why = plan.reason.substr(0, plan.reason.find("; the separating-plane test once"));
-    why += plan.convex_level
-               ? ", after the separating-plane test, turned on at step " + std::to_string(steps) +
-                     " once the answers 'apart' had cost as much work as building the hulls"
-               : "; a part is flat (no hull), so no convex level";
-    state.plan.convex_level = plan.convex_level;
+    state.plan.convex_level = a.shape->hull && b.shape->hull;
+    const std::string& old = *reasons[state.plan.reason];
+    std::string why = old.substr(0, old.find(kDeferredReason));
+    if (!state.plan.convex_level) {
+      why += "; a part is flat (no hull), so no convex level";
+    } else if (paid) {
+      why +=
+          ", after the separating-plane test, turned on once the answers 'apart' had cost as "
+          "much work as building the hulls";
+    } else {
+      why +=
+          ", after the separating-plane test, turned on once the hulls had been built for "
+          "other pairs";
+    }
     state.plan.reason = intern_reason(std::move(why));
     state.plan_version = ++plans_version;
     plan_log.emplace_back(plans_version, pair_key(a.id.index, b.id.index));
   }
+
+  /// How a deferred pair's reason ends (upgrade_deferred_plan replaces it).
+  static constexpr std::string_view kDeferredReason =
+      "; the separating-plane test once the answers 'apart' have cost as much work as building "
+      "the hulls it needs";
 
   /// The plan of a pair of parts a and b; sets deferred_hull_work when the
   /// pair's separating-plane test waits for its hulls (defers_convex_level).
@@ -425,7 +447,7 @@ struct CollisionWorld::Impl {
       return plan;
     }
     const std::uint64_t hull_work = missing_hull_work(a, b);
-    const bool defer = defers_convex_level(asked) && hull_work > 0;
+    const bool defer = defers_convex_level(a, b, asked) && hull_work > 0;
     if (!defer) {
       ensure_hull(*a.shape);
       ensure_hull(*b.shape);
@@ -467,12 +489,7 @@ struct CollisionWorld::Impl {
                                  "the polygon level on OBB trees, the fastest exact hierarchy "
                                  "measured, keeping the box pairs found apart from step to step");
     if (plan.convex_level) why += ", after the separating-plane test";
-    if (defer) {
-      why +=
-          "; the separating-plane test once the answers 'apart' have cost as much work as "
-          "building the hulls it needs (" +
-          std::to_string(hull_work) + " volume and triangle tests)";
-    }
+    if (defer) why += kDeferredReason;
     if (settings.tolerance > 0) {
       why += cuts ? "; a part is not convex, so its hull would not keep the tolerance: box pairs "
                     "smaller than the tolerance count as contact"
@@ -730,11 +747,11 @@ struct CollisionWorld::Impl {
   }
 
   /// A pair worth splitting over the threads: both parts large.
-  bool heavy(const PairWork& w) const {
+  static bool heavy(const Part& a, const Part& b) {
     constexpr std::size_t kHeavyProduct = std::size_t{1} << 20;
-    return parts[w.a].shape->mesh->triangle_count() * parts[w.b].shape->mesh->triangle_count() >=
-           kHeavyProduct;
+    return a.shape->mesh->triangle_count() * b.shape->mesh->triangle_count() >= kHeavyProduct;
   }
+  bool heavy(const PairWork& w) const { return heavy(parts[w.a], parts[w.b]); }
 
   /// Distance of parts a and b, computed with the smaller index as A (the
   /// orientation of the pair's caches, as in step()) and returned in the
@@ -983,7 +1000,7 @@ struct CollisionWorld::Impl {
 
     // 4. Gather in pair order: contacts sorted by (a, b, triangle_a, triangle_b).
     for (const PairWork& w : work) {
-      count_apart_work(w);
+      if (apart_work_paid(w)) upgrade_deferred_plan(w);
       StepStats& s = next.stats;
       s.convex_tests += w.convex_tested;
       s.convex_separated += w.convex_separated;

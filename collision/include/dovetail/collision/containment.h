@@ -70,8 +70,6 @@ bool point_inside(const Mesh& mesh, const Vec3& p_M);
 /// F by X_FM (its vertices mapped by X_FM.apply, as the collision query maps
 /// B's), and points are given in F, so a point and the surface it is tested
 /// against are rounded the same way the collision query rounded them.
-struct TriangleBoxes;  // containment.cpp
-
 class PointLocator {
  public:
   explicit PointLocator(const Mesh& mesh, const Transform& X_FM = {});
@@ -88,7 +86,8 @@ class PointLocator {
   std::size_t shell_count_ = 0;
   /// The placed triangles' bounding boxes: a ray tests only the triangles
   /// whose box it meets (exact all the same: the others cannot be crossed).
-  std::shared_ptr<const TriangleBoxes> boxes_;
+  struct Boxes;
+  std::shared_ptr<const Boxes> boxes_;
 };
 
 /// Three-valued answer: an open mesh has no inside.
