@@ -106,10 +106,11 @@ TEST(PairPlan, ExactPairsGoToObbTreesWithAFrontAndTheSeparatingPlaneOnceItPays) 
 }
 
 TEST(PairPlan, DeferredPlansAndTheirWorkAreTheSameAtAnyThreadCount) {
-  // A light pair (deferred) and a heavy one (split over the threads, so not
-  // deferred: its work differs with the threads) circling one another for
-  // 300 steps: the plans, their versions and every step's counters are the
-  // same at 1, 2 and 8 threads.
+  // A light pair and a heavy one, both deferred, circling the torus for 300
+  // steps: the heavy pair's queries would be split over the threads, which
+  // does other work than one query with a front, so a deferred pair is
+  // decided whole. The plans, their versions and every step's counters are
+  // the same at 1, 2 and 8 threads.
   const auto torus = share(make_torus(0.5, 0.15, 32, 16));  // 1,024 triangles
   const auto big = share(make_sphere(0.2, 3));              // 1,280: heavy with the torus
   const auto small = share(make_sphere(0.2, 1));            // 80
@@ -134,7 +135,7 @@ TEST(PairPlan, DeferredPlansAndTheirWorkAreTheSameAtAnyThreadCount) {
   }
   ASSERT_EQ(plans[0].size(), 2u);
   EXPECT_TRUE(plans[0][0].convex_level) << plans[0][0].reason;  // paid for its hulls
-  EXPECT_TRUE(plans[0][1].convex_level) << plans[0][1].reason;  // heavy: at once
+  EXPECT_TRUE(plans[0][1].convex_level) << plans[0][1].reason;  // and so for its hulls
   for (std::size_t k = 1; k < plans.size(); ++k) {
     EXPECT_EQ(counters[k], counters[0]) << "thread run " << k;
     ASSERT_EQ(plans[k].size(), plans[0].size());

@@ -380,14 +380,14 @@ struct CollisionWorld::Impl {
   /// as much as the missing hulls, they are not built (ski rental: at most
   /// twice the better of the two choices). A world given a method keeps the
   /// former behaviour (hulls at once), as do tolerances and the hull level,
-  /// which decide by the hulls. Not deferred either: a pair with a part
-  /// known to be flat (it has no convex level), and a heavy pair, whose
-  /// queries are split over the threads without the separation front
-  /// (evaluate_split), so that the work it counted would depend on the
-  /// number of threads.
+  /// which decide by the hulls, and a pair with a part known to be flat (it
+  /// has no convex level). A deferred pair is decided in one piece at any
+  /// number of threads, never split (evaluate_split, which keeps no
+  /// separation front, does other work), so that the work it counts, and
+  /// with it the step its test turns on, is the same however many threads.
   bool defers_convex_level(const Part& a, const Part& b, LevelOfDetail asked) const {
     return !settings.method && settings.tolerance == 0 && asked == LevelOfDetail::kExact &&
-           settings.convex_level && !a.shape->hull_failed && !b.shape->hull_failed && !heavy(a, b);
+           settings.convex_level && !a.shape->hull_failed && !b.shape->hull_failed;
   }
 
   /// Counts the work of a deferred pair's answer of "apart" at the polygon
@@ -747,11 +747,11 @@ struct CollisionWorld::Impl {
   }
 
   /// A pair worth splitting over the threads: both parts large.
-  static bool heavy(const Part& a, const Part& b) {
+  bool heavy(const PairWork& w) const {
     constexpr std::size_t kHeavyProduct = std::size_t{1} << 20;
-    return a.shape->mesh->triangle_count() * b.shape->mesh->triangle_count() >= kHeavyProduct;
+    return parts[w.a].shape->mesh->triangle_count() * parts[w.b].shape->mesh->triangle_count() >=
+           kHeavyProduct;
   }
-  bool heavy(const PairWork& w) const { return heavy(parts[w.a], parts[w.b]); }
 
   /// Distance of parts a and b, computed with the smaller index as A (the
   /// orientation of the pair's caches, as in step()) and returned in the
@@ -987,7 +987,8 @@ struct CollisionWorld::Impl {
     std::vector<std::size_t> polygon_pairs, heavy_pairs;
     for (std::size_t i = 0; i < work.size(); ++i) {
       if (!work[i].polygon || work[i].by_witness) continue;
-      (split_heavy && heavy(work[i]) ? heavy_pairs : polygon_pairs).push_back(i);
+      const bool split = split_heavy && heavy(work[i]) && !work[i].state->convex_deferred;
+      (split ? heavy_pairs : polygon_pairs).push_back(i);
     }
     tasks->parallel_for(polygon_pairs.size(), 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) evaluate_polygon(work[polygon_pairs[i]]);
