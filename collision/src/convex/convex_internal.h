@@ -43,7 +43,7 @@ enum class HullPath {
 
 /// Up to this many points a hull is built without qhull: starting qhull costs
 /// more than the exact incremental hull of a few dozen points (a 34-point
-/// capsule of the hand: 10 times as fast, `convex_bench --hull-build`); for
+/// capsule of the hand: 4.8 times as fast, `convex_bench --hull-build`); for
 /// hundreds of points on the flat facets of CAD parts, where most points are
 /// coplanar and each exact decision on them is slow, qhull wins.
 inline constexpr std::size_t kDirectHullPoints = 64;
