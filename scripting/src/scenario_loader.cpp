@@ -203,6 +203,7 @@ class Loader {
   void warn_about_mesh_sizes();
   void warn_about_parts_beside_the_hand();
   void warn_about_open_surfaces();
+  void warn_about_overlapping_parts();
 
  private:
   /// Sets a flag for its lifetime.
@@ -1650,6 +1651,53 @@ void Loader::warn_about_open_surfaces() {
   }
 }
 
+/// Parts that overlap where the scenario places them: a shaft started
+/// through a housing's wall goes unnoticed otherwise (nothing moves it, and
+/// only a max_penetration expectation would measure it). Parts attached to
+/// each other, directly or through others, are put together so (a press
+/// fit) and are left out. Measured as max_penetration measures
+/// (interaction::OverlapGauge), only for parts whose boxes overlap.
+void Loader::warn_about_overlapping_parts() {
+  const auto spec = [&](const std::string& name) -> const PartSpec* {
+    for (const PartSpec& p : scenario_.parts) {
+      if (p.name == name) return &p;
+    }
+    return nullptr;
+  };
+  const auto root = [&](const PartSpec& p) {
+    const PartSpec* at = &p;
+    for (std::size_t k = 0; k < scenario_.parts.size() && !at->attached_to.empty(); ++k) {
+      const PartSpec* up = spec(at->attached_to);
+      if (!up) break;
+      at = up;
+    }
+    return at;
+  };
+  const auto world_box = [](const PartSpec& p) {
+    Eigen::AlignedBox<double, 3> box;
+    for (const Vec3& v : p.mesh->vertices) box.extend(p.X_WP.apply(v));
+    return box;
+  };
+  constexpr double kDeepest = 1e-6;  // metres: touching parts read 0, or rounding
+  interaction::OverlapGauge gauge;
+  const std::vector<PartSpec>& parts = scenario_.parts;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (!parts[i].mesh) continue;
+    const auto box_i = world_box(parts[i]);
+    for (std::size_t j = i + 1; j < parts.size(); ++j) {
+      if (!parts[j].mesh || root(parts[i]) == root(parts[j])) continue;
+      if (!box_i.intersects(world_box(parts[j]))) continue;
+      const double depth = gauge.depth(parts[i].mesh, parts[i].X_WP, parts[j].mesh, parts[j].X_WP);
+      if (!(depth > kDeepest)) continue;
+      scenario_.warnings.push_back(
+          parts[j].where.str() + ": parts '" + parts[i].name + "' and '" + parts[j].name +
+          "' overlap by " + brief(depth / scenario_.metres_per_unit) + " " + scenario_.units +
+          " where the scenario places them: one starts inside the other (attach them with "
+          "attached_to if they are pressed together)");
+    }
+  }
+}
+
 void Loader::resolve() {
   Names names;
   for (const PartSpec& p : scenario_.parts) names.parts.push_back(p.name);
@@ -1711,6 +1759,7 @@ void Loader::resolve() {
   warn_about_mesh_sizes();
   warn_about_parts_beside_the_hand();
   warn_about_open_surfaces();
+  if (noted_.empty()) warn_about_overlapping_parts();
   if (scenario_.glove && !scenario_.glove->holding.empty()) {
     check_part(scenario_.glove->holding, scenario_.glove->where, "glove: holding");
     if (fixed(scenario_.glove->holding)) {

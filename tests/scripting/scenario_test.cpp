@@ -931,7 +931,8 @@ TEST(ScenarioLoad, PartsFromMeshFilesFarFromTheHandsSizeAreAWarning) {
     return write(dir, std::string(units) + ".lua",
                  "return scenario {\n  name = \"units\", units = \"" + std::string(units) +
                      "\",\n  parts = { a = part { mesh = \"small.obj\" }, b = part { mesh = "
-                     "\"large.obj\" } },\n  hand = glove { plan = \"hand.plan\" },\n}\n");
+                     "\"large.obj\", at = { 1, 0, 0 } } },\n  hand = glove { plan = "
+                     "\"hand.plan\" },\n}\n");
   };
   const Scenario mm = check_scenario(scenario("mm"));
   ASSERT_EQ(mm.warnings.size(), 1u);
@@ -1651,6 +1652,29 @@ TEST(ScenarioLoad, ANodeIsTakenWholeAndAGroupWithEverythingInIt) {
                        "return scenario { name = \"n\", parts = { p = part { mesh = \"" + engine +
                            "\", nodes = { \"nodes[133]\" } } } }\n"));
   EXPECT_NE(typo.find("has no node 'nodes[133]' (did you mean"), std::string::npos) << typo;
+}
+
+TEST(ScenarioLoad, PartsThatStartInsideEachOtherAreWarnedOf) {
+  // A shaft through a housing's wall: warned of, with the depth. A pin
+  // attached to the housing (pressed in), and a lid resting exactly on it,
+  // are not.
+  const test::TempDir dir("dovetail_scenario");
+  LuaHost host({}, 1);
+  const Scenario s = load_scenario(host, write(dir, "inside.lua", R"(return scenario {
+  name = "n", units = "mm",
+  parts = {
+    housing = part { shape = box { size = { 40, 40, 40 } }, fixed = true },
+    shaft = part { shape = cylinder { diameter = 10, length = 60 }, at = { 15, 0, -50 } },
+    pin = part { shape = cylinder { diameter = 4, length = 10 }, at = { 0, 0, 5 },
+                 attached_to = "housing" },
+    lid = part { shape = box { size = { 40, 40, 4 } }, at = { 0, 0, 22 } },
+  },
+})"));
+  ASSERT_EQ(s.warnings.size(), 1u) << s.warnings[1];
+  EXPECT_NE(s.warnings[0].find("inside.lua:5: parts 'housing' and 'shaft' overlap by 10 mm where "
+                               "the scenario places them"),
+            std::string::npos)
+      << s.warnings[0];
 }
 
 TEST(ScenarioLoad, PartsOfTheSameFileAndNodesShareOneMesh) {
