@@ -1089,23 +1089,31 @@ void Loader::read_scenario_fields(int table, const SourceLocation& where) {
   with_field("rules", [&](int i) { read_rules(i, where); });
   with_field("expect", [&](int i) { read_expectations(i, where); });
   with_field("camera", [&](int i) {
+    const SourceLocation camera_at = at("camera");
     if (lua_type(L_, i) != LUA_TTABLE)
-      fail(where, "scenario: camera must be { from = {x, y, z}, to = {x, y, z} }");
+      fail(camera_at, "scenario: camera must be { from = {x, y, z}, to = {x, y, z} }");
     std::vector<std::string> keys;
     std::vector<lua_Integer> positions;
-    keys_of(i, keys, positions, where, "camera");
+    keys_of(i, keys, positions, camera_at, "camera");
+    for (const std::string& key : keys) {
+      if (key != "from" && key != "to") {
+        const std::vector<std::string> known = {"from", "to"};
+        fail(camera_at, "scenario: camera has no field '" + key + "'" + did_you_mean(key, known) +
+                            ": it is { from = {x, y, z}, to = {x, y, z} }");
+      }
+    }
     if (keys != std::vector<std::string>{"from", "to"} || !positions.empty()) {
-      fail(where, "scenario: camera must be { from = {x, y, z}, to = {x, y, z} }");
+      fail(camera_at, "scenario: camera must be { from = {x, y, z}, to = {x, y, z} }");
     }
     engine::Camera camera;
     raw_getfield(i, "from");
-    camera.eye = vector_at(lua_gettop(L_), where, "camera 'from'") * scenario_.metres_per_unit;
+    camera.eye = vector_at(lua_gettop(L_), camera_at, "camera 'from'") * scenario_.metres_per_unit;
     lua_pop(L_, 1);
     raw_getfield(i, "to");
-    camera.target = vector_at(lua_gettop(L_), where, "camera 'to'") * scenario_.metres_per_unit;
+    camera.target = vector_at(lua_gettop(L_), camera_at, "camera 'to'") * scenario_.metres_per_unit;
     lua_pop(L_, 1);
     if (!((camera.eye - camera.target).norm() > 0))
-      fail(where, "scenario: camera 'from' and 'to' are the same point");
+      fail(camera_at, "scenario: camera 'from' and 'to' are the same point");
     // Straight down (or up) the y axis, up on the picture is -z, as for
     // `render --camera top`: y, the usual up, is along the view.
     const Vec3 view = (camera.target - camera.eye).normalized();

@@ -81,6 +81,29 @@ std::string format_length(double metres, double metres_per_unit, const std::stri
 /// unit, or a column misnamed); a trace (read from `trace`) sampled too
 /// sparsely or cut short; times on a device's clock; a hand that holds a
 /// part it starts far from (the part keeps that offset).
+/// Frames at t = 0, dt, 2 dt, ... up to the first at or after the end, so
+/// that a rule at the end time (after(duration)) has its frame.
+std::uint64_t frame_count(const Scenario& scenario, double end_time) {
+  return static_cast<std::uint64_t>(std::ceil(end_time / scenario.time_step - 1e-9)) + 1;
+}
+
+/// Steps and rules waiting for after(t) with t past the run's last frame,
+/// which never comes: they can never happen.
+std::vector<std::string> never_after(const Scenario& scenario, double last_time) {
+  std::vector<std::string> out;
+  const auto check = [&](const Clause& c, const std::string& context) {
+    if (c.word->name == "after" && c.args[0].number > last_time + 1e-9) {
+      out.push_back(c.where.str() + ": " + context + c.text +
+                    " can never happen: the run ends at t=" + format_time(last_time) + " s");
+    }
+  };
+  for (const StepSpec& step : scenario.steps) {
+    if (step.done) check(*step.done, "step '" + step.name + "': ");
+  }
+  for (const RuleSpec& rule : scenario.rules) check(rule.when, "rule: ");
+  return out;
+}
+
 std::vector<std::string> glove_warnings(const Scenario& scenario, const GloveSpec& glove,
                                         const interaction::GloveSource& source,
                                         const std::string& who,
@@ -1315,23 +1338,9 @@ void Runner::run() {
                            (options_.trace || !scenario_.glove->trace.empty() ? 0 : 1)
                      : 1;
   }
-  // Frames at t = 0, dt, 2 dt, ... up to the first at or after the end, so
-  // that a rule at the end time (after(duration)) has its frame.
-  const auto frames =
-      static_cast<std::uint64_t>(std::ceil(end_time / scenario_.time_step - 1e-9)) + 1;
-  // A time past the last frame never comes: after(t) there can never fire.
+  const std::uint64_t frames = frame_count(scenario_, end_time);
   const double last_time = static_cast<double>(frames - 1) * scenario_.time_step;
-  const auto never_after = [&](const Clause& c, const std::string& context) {
-    if (c.word->name == "after" && c.args[0].number > last_time + 1e-9) {
-      out_.warnings.push_back(c.where.str() + ": " + context + c.text +
-                              " can never happen: the run ends at t=" + format_time(last_time) +
-                              " s");
-    }
-  };
-  for (const StepSpec& step : scenario_.steps) {
-    if (step.done) never_after(*step.done, "step '" + step.name + "': ");
-  }
-  for (const RuleSpec& rule : scenario_.rules) never_after(rule.when, "rule: ");
+  for (std::string& w : never_after(scenario_, last_time)) out_.warnings.push_back(std::move(w));
   if (options_.picture_at && *options_.picture_at > last_time + 1e-9) {
     out_.status = RunOutcome::Status::kError;
     out_.error = file_.string() + ": no frame at t=" + format_time(*options_.picture_at) +
@@ -1599,6 +1608,7 @@ RunOutcome run_scenario(const std::filesystem::path& file, const RunOptions& opt
 Scenario check_scenario(const std::filesystem::path& file, const SandboxLimits& limits) {
   LuaHost host(limits, 1);
   Scenario scenario = load_scenario(host, file);
+  std::shared_ptr<const interaction::GloveSource> read;
   // The glove's plan or trace is read when the run starts (unless it replays
   // another trace); a check reads it now, and names it missing or wrong.
   if (scenario.glove) {
@@ -1615,12 +1625,19 @@ Scenario check_scenario(const std::filesystem::path& file, const SandboxLimits& 
           (std::filesystem::exists(source, ec) ? ": not a file" : ": file not found"));
     }
     // Read as the run reads it, and doubted as the run doubts it.
-    const auto read = glove_source(scenario, std::nullopt);
+    read = glove_source(scenario, std::nullopt);
     for (std::string& w :
          glove_warnings(scenario, glove, *read, glove.where.str() + ": glove", glove.trace)) {
       scenario.warnings.push_back(std::move(w));
     }
   }
+  // The run's end, as the run finds it: rules that wait past it.
+  double end_time = scenario.duration.value_or(1);
+  if (!scenario.duration && read)
+    end_time = read->end_time() + (scenario.glove->trace.empty() ? 1 : 0);
+  const double last_time =
+      static_cast<double>(frame_count(scenario, end_time) - 1) * scenario.time_step;
+  for (std::string& w : never_after(scenario, last_time)) scenario.warnings.push_back(std::move(w));
   return scenario;
 }
 

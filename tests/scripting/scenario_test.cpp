@@ -132,6 +132,46 @@ TEST(ScenarioLoad, TheScenarioTablesOwnFieldsAreNamedAtTheirLines) {
       << what;
 }
 
+TEST(ScenarioLoad, ACheckWarnsOfARuleAfterTheRunsEndAsTheRunDoes) {
+  // A plan of 0.5 s: the run ends a second after it, at t=1.5 s.
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "short.plan", "start 0 0.2 0  1 0 0 0\nwait 0.5\n");
+  const std::string file = write(dir, "late.lua", R"(return scenario {
+  name = "late",
+  parts = { a = part { shape = box { size = { 0.1, 0.1, 0.1 } } } },
+  hand = glove { plan = "short.plan" },
+  rules = { rule { when = after(99), act = warn("late") } },
+})");
+  const Scenario checked = check_scenario(file);
+  const RunOutcome run = run_scenario(file, {});
+  const auto late = [](const std::vector<std::string>& warnings) {
+    return std::count_if(warnings.begin(), warnings.end(), [](const std::string& w) {
+      return w.find("late.lua:5: rule: after(99) can never happen: the run ends at t=1.500 s") !=
+             std::string::npos;
+    });
+  };
+  EXPECT_EQ(late(checked.warnings), 1);
+  EXPECT_EQ(late(run.warnings), 1);
+}
+
+TEST(ScenarioLoad, ACamerasMistakeIsNamedAtItsLine) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto camera = [&](const std::string& name, const std::string& value) {
+    return load_error(write(dir, name,
+                            "return scenario {\n  name = \"c\",\n  parts = { a = part { shape = "
+                            "box { size = { 1, 1, 1 } } } },\n\n  camera = " +
+                                value + ",\n}\n"));
+  };
+  std::string what = camera("same.lua", "{ from = { 0, 5, 0 }, to = { 0, 5, 0 } }");
+  EXPECT_NE(what.find("same.lua:5: scenario: camera 'from' and 'to' are the same point"),
+            std::string::npos)
+      << what;
+  what = camera("up.lua", "{ from = { 0, 5, 5 }, to = { 0, 0, 0 }, up = { 0, 1, 0 } }");
+  EXPECT_NE(what.find("up.lua:5: scenario: camera has no field 'up' (did you mean 'to'?)"),
+            std::string::npos)
+      << what;
+}
+
 TEST(ScenarioLoad, AMistakeInAFieldIsNamedAtTheFieldsLine) {
   // Lua keeps no line for a table's fields: the loader finds the line that
   // assigns the field, below the line its declaration opens.
