@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <stdexcept>
 #include <string_view>
@@ -14,11 +15,24 @@ namespace {
 using json = nlohmann::ordered_json;
 
 /// A value as the change shows it: JSON, long texts cut.
-std::string shown(const json& value) {
+std::string shown(const json& value, std::size_t from = 0) {
   constexpr std::size_t kLongest = 160;
   std::string text = value.dump(-1, ' ', false, json::error_handler_t::replace);
+  if (from > 0 && from < text.size()) text = "..." + text.substr(from);
   if (text.size() > kLongest) text = text.substr(0, kLongest) + "...";
   return text;
+}
+
+/// Where two long texts' JSON forms should be shown from so that their
+/// first difference is in view: a little before it, or 0 when it comes
+/// early enough to be seen anyway.
+std::size_t shown_from(const json& a, const json& b) {
+  const std::string x = a.dump(-1, ' ', false, json::error_handler_t::replace);
+  const std::string y = b.dump(-1, ' ', false, json::error_handler_t::replace);
+  const auto [at, unused] = std::mismatch(x.begin(), x.end(), y.begin(), y.end());
+  const auto first = static_cast<std::size_t>(at - x.begin());
+  constexpr std::size_t kBefore = 40;
+  return first > 120 ? first - kBefore : 0;
 }
 
 /// Whether a path may begin at `at` of `text`: at its start, or after a
@@ -173,6 +187,10 @@ class Differ {
       }
       return;
     }
+    if (was.is_array() && now.is_array() && !labelled(was) && !labelled(now)) {
+      align(was, now, where);
+      return;
+    }
     if (was.is_array() && now.is_array()) {
       const std::size_t common = std::min(was.size(), now.size());
       for (std::size_t i = 0; i < common; ++i) {
@@ -203,13 +221,92 @@ class Differ {
         alike_texts(was.get<std::string>(), now.get<std::string>())) {
       return;
     }
-    if (was != now) add(where, shown(now), shown(was));
+    if (was != now) {
+      const std::size_t from = was.is_string() && now.is_string() ? shown_from(was, now) : 0;
+      add(where, shown(now, from), shown(was, from));
+    }
   }
 
   std::vector<ReportChange> changes;
   std::size_t total = 0;
 
  private:
+  /// Whether some entry of the list has a name (label_of): such lists are
+  /// compared entry by entry, by name.
+  static bool labelled(const json& list) {
+    return std::any_of(list.begin(), list.end(),
+                       [](const json& entry) { return !label_of(entry).empty(); });
+  }
+
+  /// Whether walk would find no difference between two values.
+  bool same(const json& was, const json& now) const {
+    Differ probe(0, tolerance_);
+    probe.walk(was, now, "");
+    return probe.total == 0;
+  }
+
+  /// A list without names (the events, the messages): entries the two have
+  /// alike in the same order are matched (the longest such sequence, after
+  /// the common start and end), so that one event more or less is one
+  /// difference, not a shift of every later one. Between matches, the
+  /// entries left over are compared in pairs, and the surplus are added or
+  /// gone. Lists too long to align (over 4 million pairs of entries left
+  /// after the common start and end) are compared by position.
+  void align(const json& was, const json& now, const std::string& where) {
+    std::size_t head = 0;
+    while (head < was.size() && head < now.size() && same(was[head], now[head])) ++head;
+    std::size_t tail = 0;
+    while (tail < was.size() - head && tail < now.size() - head &&
+           same(was[was.size() - 1 - tail], now[now.size() - 1 - tail])) {
+      ++tail;
+    }
+    const std::size_t n = was.size() - head - tail, m = now.size() - head - tail;
+    // Matched pairs (index in was, index in now), in order.
+    std::vector<std::pair<std::size_t, std::size_t>> matched;
+    constexpr std::size_t kMostPairs = std::size_t{4} << 20;
+    if (n > 0 && m > 0 && n * m <= kMostPairs) {
+      // Longest common subsequence of the middles, by dynamic programming.
+      std::vector<std::uint32_t> length((n + 1) * (m + 1), 0);
+      const auto at = [&](std::size_t i, std::size_t j) -> std::uint32_t& {
+        return length[i * (m + 1) + j];
+      };
+      for (std::size_t i = n; i-- > 0;) {
+        for (std::size_t j = m; j-- > 0;) {
+          at(i, j) = same(was[head + i], now[head + j]) ? at(i + 1, j + 1) + 1
+                                                        : std::max(at(i + 1, j), at(i, j + 1));
+        }
+      }
+      for (std::size_t i = 0, j = 0; i < n && j < m;) {
+        if (same(was[head + i], now[head + j])) {
+          matched.emplace_back(head + i, head + j);
+          ++i;
+          ++j;
+        } else if (at(i + 1, j) >= at(i, j + 1)) {
+          ++i;
+        } else {
+          ++j;
+        }
+      }
+    }
+    matched.emplace_back(was.size() - tail, now.size() - tail);  // the common end
+    if (was.size() != now.size()) {
+      add(where + " entries", std::to_string(now.size()), std::to_string(was.size()));
+    }
+    std::size_t i = head, j = head;
+    for (const auto& [mi, mj] : matched) {
+      // The entries between the last match and this one: in pairs, then the rest.
+      for (; i < mi && j < mj; ++i, ++j) {
+        walk(was[i], now[j], where + "[" + std::to_string(j) + "]");
+      }
+      for (; j < mj; ++j) add(where + "[" + std::to_string(j) + "]", shown(now[j]), "null");
+      for (; i < mi; ++i) {
+        add(where + "[" + std::to_string(i) + "] of the baseline", "gone", shown(was[i]));
+      }
+      i = mi + 1;
+      j = mj + 1;
+    }
+  }
+
   bool alike(double a, double b) const {
     return std::abs(a - b) <= tolerance_ * std::max({1.0, std::abs(a), std::abs(b)});
   }

@@ -57,6 +57,44 @@ TEST(ReportDiff, AnEventMoreIsCountedAndShown) {
                 R"(simulation.events[1]: {"frame":9,"kind":"released","a":"peg"}, was null)"}));
 }
 
+TEST(ReportDiff, AnEventInsertedInTheTimelineIsOneChangeNotAShift) {
+  // Ten events; the new run has one more in the middle, one fewer near the
+  // end, and one whose frame moved: three differences, the later events
+  // matched again rather than each compared with its neighbour.
+  json was = report("peg.lua", 1);
+  json& events = was["simulation"]["events"];
+  events = json::array();
+  for (int k = 0; k < 10; ++k) {
+    events.push_back({{"frame", 10 * k},
+                      {"kind", k % 2 ? "contact_begin" : "contact_end"},
+                      {"a", "peg"},
+                      {"b", "block"}});
+  }
+  json now = was;
+  json& later = now["simulation"]["events"];
+  later.insert(later.begin() + 4, json{{"frame", 35}, {"kind", "released"}, {"a", "peg"}});
+  later.erase(later.begin() + 9);  // the baseline's events[8]
+  later[2]["frame"] = 21;          // the baseline's events[2], moved a frame
+  EXPECT_EQ(
+      changes(was, now),
+      (std::vector<std::string>{
+          "simulation.events[2].frame: 21, was 20",
+          R"(simulation.events[4]: {"frame":35,"kind":"released","a":"peg"}, was null)",
+          R"(simulation.events[8] of the baseline: gone, was {"frame":80,"kind":"contact_end","a":"peg","b":"block"})"}));
+}
+
+TEST(ReportDiff, TwoLongTextsAreShownWhereTheyDiffer) {
+  json was = report("peg.lua", 1);
+  json now = was;
+  const std::string start(300, 'a');
+  was["note"] = start + " then one ending";
+  now["note"] = start + " then another ending";
+  const std::vector<std::string> found = changes(was, now);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_NE(found[0].find("then another ending\", was ...a"), std::string::npos) << found[0];
+  EXPECT_NE(found[0].find("then one ending\""), std::string::npos) << found[0];
+}
+
 TEST(ReportDiff, AnotherEntryInAListsPlaceIsOneChange) {
   json was = report("peg.lua", 1);
   json now = was;
