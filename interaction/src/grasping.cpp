@@ -902,8 +902,10 @@ Grasping::Overlap Grasping::deepest_overlap(const engine::Scene& scene, PartId p
 
 MateOffset mate_offset(const Mate& mate, const Transform& X_WP, const Transform& X_WO) {
   const Vec3 a_W = (X_WP.R * mate.axis_P).normalized(), b_W = (X_WO.R * mate.axis_O).normalized();
-  return {(X_WP.apply(mate.p_PF) - X_WO.apply(mate.p_OF)).norm(),
-          std::atan2(a_W.cross(b_W).norm(), a_W.dot(b_W)) / kDegree};
+  const Vec3 d_W = X_WP.apply(mate.p_PF) - X_WO.apply(mate.p_OF);
+  const Real along = -d_W.dot(b_W);  // the axis points in, along the way the part goes
+  return {d_W.norm(), std::atan2(a_W.cross(b_W).norm(), a_W.dot(b_W)) / kDegree, along,
+          (d_W + along * b_W).norm()};
 }
 
 bool within_tolerance(const Mate& mate, const Transform& X_WP, const Transform& X_WO) {

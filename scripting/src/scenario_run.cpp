@@ -970,6 +970,22 @@ std::string Runner::why_not_snapped(const MateSpec& m) const {
     return std::string(text);
   };
   const std::string angle = degrees(c.offset);
+  // How far, and which way: short of its place along the axis, or off it.
+  const auto placed = [&](const interaction::MateOffset& offset) {
+    std::string text = format_length(offset.distance_m, out_) + " from its place";
+    if (!(offset.distance_m > 0)) return text;
+    // Below a nanometre is rounding (a part moved exactly along its axis).
+    constexpr double kRounding = 1e-9;
+    const std::string along = std::abs(offset.along_m) <= kRounding
+                                  ? "level with it along the axis"
+                                  : format_length(std::abs(offset.along_m), out_) +
+                                        (offset.along_m > 0 ? " short of it" : " past it") +
+                                        " along the axis";
+    const std::string across = offset.across_m <= kRounding
+                                   ? "on the axis"
+                                   : format_length(offset.across_m, out_) + " off the axis";
+    return text + " (" + along + ", " + across + ")";
+  };
   char tolerance[64];
   std::snprintf(tolerance, sizeof tolerance, "%.3g degrees", m.mate.angle_tolerance_deg);
   std::string at_release;
@@ -978,25 +994,40 @@ std::string Runner::why_not_snapped(const MateSpec& m) const {
     // How it was let go, and what it rested on then (what stopped it).
     const std::vector<engine::Event>& events = sim_->report().events;
     std::string how = "the hand let it go";
-    std::map<std::string, double> resting;  // part it slid on -> since when
+    // What the part, or a part attached to it and carried with it, slid on
+    // then: (its part, the part it slid on) -> since when.
+    const engine::Scene& scene = sim_->scene();
+    const PartId carried = scene.find(m.mate.part);
+    const auto moved_with = [&](const std::string& name) {
+      const PartId q = scene.find(name);
+      return name == m.mate.part ||
+             (carried.valid() && q.valid() && scene.descends_from(q, carried));
+    };
+    std::map<std::pair<std::string, std::string>, double> resting;
     for (const engine::Event& e : events) {
       if (e.time > r.time + 1e-9) break;
       if (e.kind == engine::EventKind::kRelease && e.a == m.mate.part &&
           std::abs(e.time - r.time) < 1e-9 && e.b == "overstretched") {
         how = "the rubber band overstretched and let it go";
       }
-      if (e.a != m.mate.part) continue;
-      if (e.kind == engine::EventKind::kSlideBegin) resting.emplace(e.b, e.time);
-      if (e.kind == engine::EventKind::kSlideEnd && e.time < r.time - 1e-9) resting.erase(e.b);
+      if (e.kind != engine::EventKind::kSlideBegin && e.kind != engine::EventKind::kSlideEnd) {
+        continue;
+      }
+      const bool a_moved = moved_with(e.a), b_moved = moved_with(e.b);
+      if (a_moved == b_moved) continue;
+      const auto key = a_moved ? std::pair(e.a, e.b) : std::pair(e.b, e.a);
+      if (e.kind == engine::EventKind::kSlideBegin) resting.emplace(key, e.time);
+      if (e.kind == engine::EventKind::kSlideEnd && e.time < r.time - 1e-9) resting.erase(key);
     }
     std::string on;
-    for (const auto& [part, since] : resting) {
-      on += (on.empty() ? ", resting against '" : " and '") + part +
-            "' (sliding on it from t=" + format_time(since) + " s)";
+    for (const auto& [pair, since] : resting) {
+      const auto& [mine, other] = pair;
+      on += (on.empty() ? ", resting against '" : " and '") + other + "' (" +
+            (mine == m.mate.part ? "" : "'" + mine + "', moved with it, ") +
+            "sliding on it from t=" + format_time(since) + " s)";
     }
     at_release = ": when " + how + " at t=" + format_time(r.time) + " s it was " +
-                 format_length(r.offset.distance_m, out_) + " from its place, its axis " +
-                 degrees(r.offset) + " off" + on + ";";
+                 placed(r.offset) + ", its axis " + degrees(r.offset) + " off" + on + ";";
   }
   // An axis turned end for end is most likely a sign: axis = "z" for "-z".
   const std::string reversed =
@@ -1005,8 +1036,8 @@ std::string Runner::why_not_snapped(const MateSpec& m) const {
             "along given the wrong way round (\"z\" for \"-z\")?"
           : "";
   return at_release + (at_release.empty() ? ": the" : " the") + " closest it came was " +
-         format_length(c.offset.distance_m, out_) + " from its place, its axis " + angle +
-         " off, at t=" + format_time(c.time) + " s (a snap needs the part released within " +
+         placed(c.offset) + ", its axis " + angle + " off, at t=" + format_time(c.time) +
+         " s (a snap needs the part released within " +
          format_length(m.mate.position_tolerance, out_) + " and " + tolerance + ")" + reversed +
          never_held;
 }

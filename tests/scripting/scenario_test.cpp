@@ -1539,8 +1539,9 @@ TEST(ScenarioRun, AMateNeverMadeSaysHowCloseItsPartCame) {
   ASSERT_EQ(o.status, RunOutcome::Status::kFailed) << o.error;
   const std::string summary = o.failure_summary();
   EXPECT_NE(summary.find("'peg' never snapped into 'block': the closest it came was 12 mm from its "
-                         "place, its axis 0 degrees off, at t=0.311 s (a snap needs the part "
-                         "released within 2 mm and 5 degrees)"),
+                         "place (12 mm short of it along the axis, on the axis), its axis 0 "
+                         "degrees off, at t=0.311 s (a snap needs the part released within 2 mm "
+                         "and 5 degrees)"),
             std::string::npos)
       << summary;
 }

@@ -110,6 +110,10 @@ struct Mate {
 struct MateOffset {
   Real distance_m = 0;
   Real angle_deg = 0;
+  /// The distance split along the other part's axis (positive: the part's
+  /// point is still out along it, short of its place) and across it.
+  Real along_m = 0;
+  Real across_m = 0;
 };
 /// The offset with the part at X_WP and the other at X_WO.
 MateOffset mate_offset(const Mate& mate, const Transform& X_WP, const Transform& X_WO);
