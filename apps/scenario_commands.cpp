@@ -308,9 +308,16 @@ int check_command(std::span<const std::string> argv) {
   if (!std::filesystem::exists(file)) throw InputError(file.string() + ": no such file");
   const scripting::Scenario s = scripting::check_scenario(file);
   for (const std::string& w : s.warnings) std::fprintf(stderr, "warning: %s\n", shown(w).c_str());
-  std::printf("%s: ok: '%s', %zu parts, %zu mates, %zu steps, %zu rules, %zu expectations%s\n",
-              file.string().c_str(), shown(s.name).c_str(), s.parts.size(), s.mates.size(),
-              s.steps.size(), s.rules.size(), s.expectations.size(), s.glove ? ", a hand" : "");
+  const auto count = [](std::size_t n, const char* one, const char* many) {
+    return std::to_string(n) + " " + (n == 1 ? one : many);
+  };
+  std::printf("%s: ok: '%s', %s, %s, %s, %s, %s%s\n", file.string().c_str(), shown(s.name).c_str(),
+              count(s.parts.size(), "part", "parts").c_str(),
+              count(s.mates.size(), "mate", "mates").c_str(),
+              count(s.steps.size(), "step", "steps").c_str(),
+              count(s.rules.size(), "rule", "rules").c_str(),
+              count(s.expectations.size(), "expectation", "expectations").c_str(),
+              s.glove ? ", a hand" : "");
   return kExitOk;
 }
 
@@ -336,8 +343,16 @@ int new_command(std::span<const std::string> argv) {
                                        out.string());
   file.flush();
   if (!file) throw InputError(out.string() + ": cannot be written: " + std::strerror(errno));
+  // A name a shell would split or expand is quoted, so the hint can be pasted.
+  std::string name_in_shell = out.string();
+  if (name_in_shell.find_first_not_of(
+          "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-/+,:@%") !=
+      std::string::npos) {
+    name_in_shell.insert(name_in_shell.begin(), '"');
+    name_in_shell.push_back('"');
+  }
   std::printf("wrote %s; try 'dovetail check %s', then 'dovetail run %s'\n", out.string().c_str(),
-              out.string().c_str(), out.string().c_str());
+              name_in_shell.c_str(), name_in_shell.c_str());
   return kExitOk;
 }
 

@@ -43,13 +43,16 @@ dovetail_cli_test(run_missing_scenario EXIT 1 ARGS run ${out}/no_such.lua --repo
 
 # check and new
 dovetail_cli_test(check_shipped EXIT 0 ARGS check ${scenarios}/01_peg_in_hole.lua
-                  STDOUT "ok: 'Peg in hole', 2 parts, 1 mates, 1 steps, 3 rules, 5 expectations, a hand")
+                  STDOUT "ok: 'Peg in hole', 2 parts, 1 mate, 1 step, 3 rules, 5 expectations, a hand")
 dovetail_cli_test(check_syntax_error EXIT 1 ARGS check ${scenario_data}/hostile/syntax_error.lua
                   STDERR "syntax_error.lua:2: ")
 dovetail_cli_test(check_missing EXIT 1 ARGS check ${out}/no_such.lua STDERR "no_such.lua: no such file")
 dovetail_cli_test(new_scenario EXIT 0 ARGS new my_first --out ${out}/my_first.lua
                   STDOUT "wrote .*my_first.lua" REMOVE ${out}/my_first.lua)
 set_tests_properties(cli.new_scenario PROPERTIES FIXTURES_SETUP new_scenario)
+dovetail_cli_test(new_scenario_name_with_a_blank EXIT 0 ARGS new "my part" --out "${out}/my part.lua"
+                  STDOUT "try 'dovetail check \"[^\"]*my part.lua\"', then 'dovetail run \""
+                  REMOVE "${out}/my part.lua")
 dovetail_cli_test(new_folder_name EXIT 2 ARGS new ${out}/a_folder/ STDERR "new: the name .*a_folder/. names no file")
 string(REPEAT "x" 300 long_name)
 dovetail_cli_test(new_name_too_long EXIT 1 ARGS new ${out}/${long_name}
