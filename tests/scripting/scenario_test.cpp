@@ -1528,6 +1528,49 @@ TEST(ScenarioRun, AMovedPartArrivesOnceInTheFrameItGetsThere) {
   EXPECT_LE(logged[1].first, 0.5 + 3.0 / 90);
 }
 
+TEST(ScenarioRun, AFailedMateNamesWhatAPartCarriedWithItRestedAgainst) {
+  // A shaft with a ring pressed on its end lies on a stand; carried into a
+  // housing, the ring catches on the stand and holds it back 15 mm short.
+  // The reason names the ring's slide on the stand, not only the shaft's.
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "push.plan",
+        "start 0.090 0.150 0.065  1 0 0 0 open\nreach 1.0  0.090 0.0855 0.065  1 0 0 0\n"
+        "close 0.5 fist\nwait 0.2\nreach 2.0  -0.035 0.0855 0.065  1 0 0 0\nwait 0.2\n"
+        "open 0.3\nreach 0.5  -0.035 0.150 0.065  1 0 0 0\n");
+  const auto file = write(dir, "ring.lua", R"(return scenario {
+  name = "ring", units = "mm",
+  parts = {
+    housing = part {
+      shape = block_with_hole { size = { 120, 60, 80 }, hole = 30.5, depth = 45 },
+      at = { -100, 60, 0 }, turn = { z = -90 }, fixed = true,
+    },
+    stand = part { shape = box { size = { 30, 45, 50 } }, at = { 25, 22.5, 0 }, fixed = true },
+    shaft = part {
+      shape = cylinder { diameter = 30, length = 160 }, at = { 170, 60, 0 }, turn = { y = -90 },
+    },
+    ring = part {
+      shape = tube { outer = 60, inner = 30.5, length = 20 }, at = { 150, 60, 0 },
+      turn = { y = 90 }, attached_to = "shaft",
+    },
+  },
+  mates = {
+    shaft_in_housing = mate {
+      part = "shaft", point = { 0, 0, 160 }, axis = "z",
+      into = "housing", at = { 0, -15, 0 }, along = "-y",
+    },
+  },
+  hand = glove { plan = "push.plan" },
+  expect = { mate_made "shaft_in_housing" },
+})");
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed) << o.error;
+  const std::string& why = o.expectations[0].detail;
+  EXPECT_NE(why.find("short of it along the axis"), std::string::npos) << why;
+  EXPECT_NE(why.find("resting against 'stand' ('ring', moved with it, sliding on it from t="),
+            std::string::npos)
+      << why;
+}
+
 TEST(ScenarioRun, AMateNeverMadeSaysHowCloseItsPartCame) {
   // The peg moved to 12 mm above its place in the hole and left there.
   const test::TempDir dir("dovetail_scenario");
