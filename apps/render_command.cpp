@@ -25,9 +25,9 @@ namespace {
 constexpr const char* kHelp =
     R"(usage: dovetail render INPUT --out PNG [--width W] [--height H] [--camera NAME|auto]
                        [--trace TRACE | --plan PLAN] [--time T] [--hand-size S]
-                       [--hand-length M] [--units mm|cm|m]
+                       [--hand-length M] [--units mm|cm|m] [--quiet]
        dovetail render SCENARIO.lua --out PNG [--time T] [--trace TRACE]
-                       [--width W] [--height H] [--camera NAME|scenario|auto]
+                       [--width W] [--height H] [--camera NAME|scenario|auto] [--quiet]
 
 Draws a mesh or assembly file, or a scenario's frame, off-screen and writes
 the picture as PNG.
@@ -55,10 +55,11 @@ the picture as PNG.
   --hand-length M  scale the size to this hand length in metres (0: its own)
   --units U      with a hand: the unit of INPUT's numbers, mm, cm or m (default:
                  millimetres when its box is more than 100 across, else metres)
+  --quiet        no summary on standard output
 
 Flat shading with a light at the camera, depth-tested, no anti-aliasing; the
 same input and options give the same PNG bytes. Prints a one-line JSON summary
-on standard output.
+on standard output (unless --quiet).
 )";
 
 /// The parts of a mesh or assembly file, in file units; `files` gets every
@@ -222,7 +223,7 @@ int render_command(std::span<const std::string> argv) {
   const Args args("render", argv,
                   {"out", "width", "height", "camera", "trace", "plan", "time", "hand-size",
                    "hand-length", "units"},
-                  {});
+                  {"quiet"});
   if (args.help()) {
     std::fputs(kHelp, stdout);
     return kExitOk;
@@ -282,7 +283,7 @@ int render_command(std::span<const std::string> argv) {
       .add("hand", with_hand)
       .add("triangles", triangles)
       .add("render_ms", std::round(render_ms * 1000.0) / 1000.0);
-  std::fputs((json.str() + "\n").c_str(), stdout);
+  if (!args.flag("quiet")) std::fputs((json.str() + "\n").c_str(), stdout);
   return kExitOk;
 }
 

@@ -144,3 +144,5 @@ dovetail_cli_test(run_render_every_zero EXIT 2
 add_test(NAME cli.run_render_keeps_old_frames_when_refused
          COMMAND sh -c "rm -rf \"$1\" && mkdir -p \"$1/report_is_a_folder\" && touch \"$1/frame_009999.png\" && \"$0\" run \"$2\" --render \"$1\" --every 1000 --report \"$1/report_is_a_folder\" --quiet 2> /dev/null; [ $? -eq 1 ] && [ -e \"$1/frame_009999.png\" ]"
                  $<TARGET_FILE:dovetail> ${out}/render_refused_frames ${PROJECT_SOURCE_DIR}/scenarios/04_stacked_bricks.lua)
+dovetail_cli_test(render_quiet EXIT 0 ARGS render ${cube} --out ${out}/render_quiet.png --width 16 --height 12 --quiet
+                  REJECT_STDOUT ".")
