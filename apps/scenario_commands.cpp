@@ -165,7 +165,9 @@ void print_summary(const scripting::RunOutcome& outcome) {
   std::printf("%s: %s (%s%llu frames, %.2f s wall)\n", shown(outcome.name).c_str(),
               std::string(scripting::status_name(outcome.status)).c_str(), judged.c_str(),
               static_cast<unsigned long long>(outcome.report.frames), outcome.wall_seconds);
-  for (const auto& s : outcome.steps) {
+  // A run that ran no frame did no step: its steps are not listed.
+  for (const auto& s :
+       outcome.report.frames > 0 ? outcome.steps : std::vector<scripting::StepOutcome>{}) {
     if (s.done_at) {
       std::printf("  step %-20s done at t=%.3f s%s\n", shown(s.name).c_str(), *s.done_at,
                   s.out_of_order ? " (out of order)" : "");
