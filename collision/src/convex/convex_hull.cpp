@@ -59,6 +59,16 @@ namespace {
 
 using Triangles = std::vector<TriangleIndices>;
 
+/// The points the triangles use, ascending, each once.
+std::vector<std::uint32_t> vertex_ids(const Triangles& triangles) {
+  std::vector<std::uint32_t> ids;
+  ids.reserve(3 * triangles.size());
+  for (const TriangleIndices& t : triangles) ids.insert(ids.end(), t.begin(), t.end());
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
+}
+
 /// An inconsistency inside the exact hull (a bug, never expected).
 struct HullInternalError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -184,15 +194,10 @@ bool closed_surface(std::span<const Vec3> points, const Triangles& triangles,
   };
   std::vector<Edge> edges;
   edges.reserve(triangles.size() * 3);
-  std::vector<std::uint32_t> used;
-  used.reserve(triangles.size() * 3);
   for (std::uint32_t f = 0; f < triangles.size(); ++f) {
     const TriangleIndices& t = triangles[f];
     if (is_degenerate_triangle(points[t[0]], points[t[1]], points[t[2]])) return false;
-    for (std::uint32_t k = 0; k < 3; ++k) {
-      edges.push_back({t[k], t[(k + 1) % 3], f, k});
-      used.push_back(t[k]);
-    }
+    for (std::uint32_t k = 0; k < 3; ++k) edges.push_back({t[k], t[(k + 1) % 3], f, k});
   }
   auto less = [](const Edge& x, const Edge& y) { return x.u != y.u ? x.u < y.u : x.v < y.v; };
   std::sort(edges.begin(), edges.end(), less);
@@ -206,9 +211,7 @@ bool closed_surface(std::span<const Vec3> points, const Triangles& triangles,
     if (it == edges.end() || it->u != reverse.u || it->v != reverse.v) return false;
     across[edges[i].face][edges[i].k] = it->face;
   }
-  std::sort(used.begin(), used.end());
-  const auto vertex_count =
-      static_cast<long long>(std::unique(used.begin(), used.end()) - used.begin());
+  const auto vertex_count = static_cast<long long>(vertex_ids(triangles).size());
   const auto face_count = static_cast<long long>(triangles.size());
   return vertex_count - face_count * 3 / 2 + face_count == 2;
 }
@@ -546,11 +549,7 @@ std::vector<std::uint32_t> points_outside_by_scan(std::span<const Vec3> points,
 Triangles exact_hull(std::span<const Vec3> points, const Triangles& candidate,
                      const std::array<std::uint32_t, 4>& simplex) {
   ExactHull hull(points, simplex);
-  std::vector<std::uint32_t> seeds;
-  for (const TriangleIndices& t : candidate) seeds.insert(seeds.end(), t.begin(), t.end());
-  std::sort(seeds.begin(), seeds.end());
-  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
-  for (std::uint32_t i : seeds) hull.insert(i);
+  for (std::uint32_t i : vertex_ids(candidate)) hull.insert(i);
   Triangles triangles = hull.triangles();
   for (;;) {
     bool proven = false;
@@ -601,10 +600,7 @@ std::vector<std::uint32_t> corners(std::span<const Vec3> p, const Triangles& tri
 /// the same plane, measure the width there, and a flat set's two large
 /// faces always do.
 Real width(std::span<const Vec3> p, const Triangles& triangles) {
-  std::vector<std::uint32_t> vertices;
-  for (const TriangleIndices& t : triangles) vertices.insert(vertices.end(), t.begin(), t.end());
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  const std::vector<std::uint32_t> vertices = vertex_ids(triangles);
   Real least = std::numeric_limits<Real>::infinity();
   for (const TriangleIndices& t : triangles) {
     const Vec3 u = p[t[1]] - p[t[0]], v = p[t[2]] - p[t[0]];
@@ -616,16 +612,6 @@ Real width(std::span<const Vec3> p, const Triangles& triangles) {
     least = std::min(least, deepest / length);
   }
   return least;
-}
-
-/// The diagonal of the points' bounding box.
-Real diagonal(std::span<const Vec3> p) {
-  Vec3 lo = p[0], hi = p[0];
-  for (const Vec3& q : p) {
-    lo = lo.cwiseMin(q);
-    hi = hi.cwiseMax(q);
-  }
-  return (hi - lo).norm();
 }
 
 /// Point sets thinner than this fraction of their size are flat parts.
@@ -641,8 +627,9 @@ bool thinner_than(Real fraction, std::span<const Vec3> points, const Triangles& 
     lo = lo.cwiseMin(q);
     hi = hi.cwiseMax(q);
   }
+  const Vec3 half = hi / 2 - lo / 2;  // halves: no overflow near 1e308
   int exponent = 0;
-  std::frexp((hi / 2 - lo / 2).maxCoeff(), &exponent);  // halves: no overflow near 1e308
+  std::frexp(half.maxCoeff(), &exponent);
   const Vec3 centre = lo / 2 + hi / 2;
   std::vector<Vec3> scaled(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -650,7 +637,9 @@ bool thinner_than(Real fraction, std::span<const Vec3> points, const Triangles& 
     scaled[i] = Vec3(std::ldexp(d.x(), -exponent), std::ldexp(d.y(), -exponent),
                      std::ldexp(d.z(), -exponent));
   }
-  return width(scaled, triangles) < fraction * diagonal(scaled);
+  // The scaled box's diagonal: twice its half, scaled as the points are.
+  const Real diagonal = 2 * std::ldexp(half.norm(), -exponent);
+  return width(scaled, triangles) < fraction * diagonal;
 }
 
 /// The exact incremental hull of every point, without qhull: for small point
@@ -671,11 +660,7 @@ Triangles direct_hull(std::span<const Vec3> points, const std::array<std::uint32
   };
   const Triangles first = build(points, simplex);
   const std::vector<std::uint32_t> keep = corners(points, first);
-  std::vector<std::uint32_t> on_hull;
-  for (const TriangleIndices& t : first) on_hull.insert(on_hull.end(), t.begin(), t.end());
-  std::sort(on_hull.begin(), on_hull.end());
-  on_hull.erase(std::unique(on_hull.begin(), on_hull.end()), on_hull.end());
-  if (keep.size() == on_hull.size()) return first;
+  if (keep.size() == vertex_ids(first).size()) return first;
   // Corners of a polytope are in convex position: the second hull has each
   // of them as a vertex and nothing else.
   std::vector<Vec3> corner_points;
@@ -693,11 +678,7 @@ Triangles direct_hull(std::span<const Vec3> points, const std::array<std::uint32
 ConvexHull finish(std::span<const Vec3> points, const Triangles& triangles) {
   ConvexHull hull;
   std::vector<std::uint32_t> index(points.size(), std::numeric_limits<std::uint32_t>::max());
-  std::vector<std::uint32_t> order;
-  for (const TriangleIndices& t : triangles) order.insert(order.end(), t.begin(), t.end());
-  std::sort(order.begin(), order.end());
-  order.erase(std::unique(order.begin(), order.end()), order.end());
-  for (std::uint32_t i : order) {
+  for (std::uint32_t i : vertex_ids(triangles)) {
     index[i] = static_cast<std::uint32_t>(hull.vertices.size());
     hull.vertices.push_back(points[i]);
   }
@@ -775,11 +756,7 @@ ConvexHull build_convex_hull(std::span<const Vec3> points, const std::string& so
   const bool exact =
       path != HullPath::kRebuild && points_outside(points, candidate, proven).empty() && proven;
   if (stats) {
-    std::vector<std::uint32_t> ids;
-    for (const TriangleIndices& t : candidate) ids.insert(ids.end(), t.begin(), t.end());
-    std::sort(ids.begin(), ids.end());
-    stats->qhull_vertices =
-        static_cast<std::size_t>(std::unique(ids.begin(), ids.end()) - ids.begin());
+    stats->qhull_vertices = vertex_ids(candidate).size();
     stats->rebuilt_exactly = !exact;
   }
   if (exact) return finish(points, candidate);
