@@ -204,6 +204,13 @@ class Loader {
   void warn_about_parts_beside_the_hand();
   void warn_about_open_surfaces();
   void warn_about_overlapping_parts();
+  /// The part of that name, or null.
+  const PartSpec* part_named(const std::string& name) const {
+    for (const PartSpec& p : scenario_.parts) {
+      if (p.name == name) return &p;
+    }
+    return nullptr;
+  }
 
  private:
   /// Sets a flag for its lifetime.
@@ -1666,35 +1673,31 @@ void Loader::warn_about_open_surfaces() {
 /// fit) and are left out. Measured as max_penetration measures
 /// (interaction::OverlapGauge), only for parts whose boxes overlap.
 void Loader::warn_about_overlapping_parts() {
-  const auto spec = [&](const std::string& name) -> const PartSpec* {
-    for (const PartSpec& p : scenario_.parts) {
-      if (p.name == name) return &p;
-    }
-    return nullptr;
-  };
   const auto root = [&](const PartSpec& p) {
     const PartSpec* at = &p;
     for (std::size_t k = 0; k < scenario_.parts.size() && !at->attached_to.empty(); ++k) {
-      const PartSpec* up = spec(at->attached_to);
+      const PartSpec* up = part_named(at->attached_to);
       if (!up) break;
       at = up;
     }
     return at;
   };
-  const auto world_box = [](const PartSpec& p) {
-    Eigen::AlignedBox<double, 3> box;
-    for (const Vec3& v : p.mesh->vertices) box.extend(p.X_WP.apply(v));
-    return box;
-  };
-  constexpr double kDeepest = 1e-6;  // metres: touching parts read 0, or rounding
-  interaction::OverlapGauge gauge;
   const std::vector<PartSpec>& parts = scenario_.parts;
+  // Each part's box in the world, once: the box of its local box's corners.
+  std::vector<Eigen::AlignedBox<double, 3>> boxes(parts.size());
   for (std::size_t i = 0; i < parts.size(); ++i) {
     if (!parts[i].mesh) continue;
-    const auto box_i = world_box(parts[i]);
+    const collision::Bounds b =
+        collision::transformed_bounds(collision::mesh_bounds(*parts[i].mesh), parts[i].X_WP);
+    boxes[i] = Eigen::AlignedBox<double, 3>(b.min, b.max);
+  }
+  constexpr double kDeepest = 1e-6;  // metres: touching parts read 0, or rounding
+  interaction::OverlapGauge gauge;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (!parts[i].mesh) continue;
     for (std::size_t j = i + 1; j < parts.size(); ++j) {
       if (!parts[j].mesh || root(parts[i]) == root(parts[j])) continue;
-      if (!box_i.intersects(world_box(parts[j]))) continue;
+      if (!boxes[i].intersects(boxes[j])) continue;
       const double depth = gauge.depth(parts[i].mesh, parts[i].X_WP, parts[j].mesh, parts[j].X_WP);
       if (!(depth > kDeepest)) continue;
       scenario_.warnings.push_back(
@@ -1736,12 +1739,6 @@ void Loader::resolve() {
       check_part(p, r.where, "region '" + r.region.name + "'");
   }
   // Parts attached from the start: to another part, not fixed themselves, without a cycle.
-  const auto spec = [&](const std::string& name) -> const PartSpec* {
-    for (const PartSpec& p : scenario_.parts) {
-      if (p.name == name) return &p;
-    }
-    return nullptr;
-  };
   for (const PartSpec& p : scenario_.parts) {
     if (p.attached_to.empty()) continue;
     const std::string what = "part '" + p.name + "': attached_to";
@@ -1757,7 +1754,7 @@ void Loader::resolve() {
     const PartSpec* q = &p;
     for (std::size_t k = 0; k < scenario_.parts.size() && q && !q->attached_to.empty(); ++k) {
       chain += " to '" + q->attached_to + "'";
-      q = spec(q->attached_to);
+      q = part_named(q->attached_to);
       if (q == &p) {
         note(p.where, what + " makes a cycle: " + chain);
         break;
@@ -1776,9 +1773,9 @@ void Loader::resolve() {
     } else {
       // Holding a part carries its sub-assembly: one attached to a fixed part
       // cannot move. (The chain has no cycle: those are refused above.)
-      const PartSpec* q = spec(scenario_.glove->holding);
+      const PartSpec* q = part_named(scenario_.glove->holding);
       for (std::size_t k = 0; q && !q->attached_to.empty() && k < scenario_.parts.size(); ++k) {
-        q = spec(q->attached_to);
+        q = part_named(q->attached_to);
       }
       if (q && q->fixed) {
         note(scenario_.glove->where, "glove: the hand cannot hold '" + scenario_.glove->holding +
