@@ -87,6 +87,20 @@ std::uint64_t frame_count(const Scenario& scenario, double end_time) {
   return static_cast<std::uint64_t>(std::ceil(end_time / scenario.time_step - 1e-9)) + 1;
 }
 
+/// When a run ends: at the scenario's duration; without one, at the glove's
+/// last sample, a second later for a plan (its hand comes to rest) and at
+/// once for a trace; 1 s without a glove.
+double run_end_time(const Scenario& scenario, const interaction::GloveSource* source, bool trace) {
+  if (scenario.duration) return *scenario.duration;
+  if (!source) return 1;
+  return source->end_time() + (trace ? 0 : 1);
+}
+
+/// The time of the run's last frame (frame_count).
+double last_frame_time(const Scenario& scenario, double end_time) {
+  return static_cast<double>(frame_count(scenario, end_time) - 1) * scenario.time_step;
+}
+
 /// Steps and rules waiting for after(t) with t past the run's last frame,
 /// which never comes: they can never happen.
 std::vector<std::string> never_after(const Scenario& scenario, double last_time) {
@@ -1363,14 +1377,11 @@ void Runner::run() {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return;
   }
-  double end_time = scenario_.duration.value_or(0);
-  if (!scenario_.duration) {
-    end_time = hand_ ? hand_->source().end_time() +
-                           (options_.trace || !scenario_.glove->trace.empty() ? 0 : 1)
-                     : 1;
-  }
+  const double end_time =
+      run_end_time(scenario_, hand_ ? &hand_->source() : nullptr,
+                   options_.trace || (scenario_.glove && !scenario_.glove->trace.empty()));
   const std::uint64_t frames = frame_count(scenario_, end_time);
-  const double last_time = static_cast<double>(frames - 1) * scenario_.time_step;
+  const double last_time = last_frame_time(scenario_, end_time);
   for (std::string& w : never_after(scenario_, last_time)) out_.warnings.push_back(std::move(w));
   if (options_.picture_at && *options_.picture_at > last_time + 1e-9) {
     out_.status = RunOutcome::Status::kError;
@@ -1663,12 +1674,11 @@ Scenario check_scenario(const std::filesystem::path& file, const SandboxLimits& 
     }
   }
   // The run's end, as the run finds it: rules that wait past it.
-  double end_time = scenario.duration.value_or(1);
-  if (!scenario.duration && read)
-    end_time = read->end_time() + (scenario.glove->trace.empty() ? 1 : 0);
-  const double last_time =
-      static_cast<double>(frame_count(scenario, end_time) - 1) * scenario.time_step;
-  for (std::string& w : never_after(scenario, last_time)) scenario.warnings.push_back(std::move(w));
+  const double end_time =
+      run_end_time(scenario, read.get(), scenario.glove && !scenario.glove->trace.empty());
+  for (std::string& w : never_after(scenario, last_frame_time(scenario, end_time))) {
+    scenario.warnings.push_back(std::move(w));
+  }
   return scenario;
 }
 
