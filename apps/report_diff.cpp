@@ -179,11 +179,11 @@ class Differ {
         if (const auto it = was.find(key); it != was.end()) {
           walk(*it, value, at);
         } else {
-          add(at, shown(value), "null");
+          add(at, value, "null");
         }
       }
       for (const auto& [key, value] : was.items()) {
-        if (!now.contains(key)) add(where.empty() ? key : where + "." + key, "null", shown(value));
+        if (!now.contains(key)) add(where.empty() ? key : where + "." + key, "null", value);
       }
       return;
     }
@@ -197,7 +197,7 @@ class Differ {
         const std::string label = label_of(now[i]);
         const std::string index = where + "[" + std::to_string(i) + "]";
         if (label != label_of(was[i])) {
-          add(index, shown(now[i]), shown(was[i]));  // another entry in its place
+          add(index, now[i], was[i]);  // another entry in its place
         } else {
           walk(was[i], now[i], label.empty() ? index : where + "[" + label + "]");
         }
@@ -206,10 +206,10 @@ class Differ {
         add(where + " entries", std::to_string(now.size()), std::to_string(was.size()));
       }
       for (std::size_t i = common; i < now.size(); ++i) {
-        add(where + "[" + std::to_string(i) + "]", shown(now[i]), "null");
+        add(where + "[" + std::to_string(i) + "]", now[i], "null");
       }
       for (std::size_t i = common; i < was.size(); ++i) {
-        add(where + "[" + std::to_string(i) + "]", "null", shown(was[i]));
+        add(where + "[" + std::to_string(i) + "]", "null", was[i]);
       }
       return;
     }
@@ -221,10 +221,7 @@ class Differ {
         alike_texts(was.get<std::string>(), now.get<std::string>())) {
       return;
     }
-    if (was != now) {
-      const std::size_t from = was.is_string() && now.is_string() ? shown_from(was, now) : 0;
-      add(where, shown(now, from), shown(was, from));
-    }
+    if (was != now) add(where, now, was);
   }
 
   std::vector<ReportChange> changes;
@@ -238,8 +235,10 @@ class Differ {
                        [](const json& entry) { return !label_of(entry).empty(); });
   }
 
-  /// Whether walk would find no difference between two values.
+  /// Whether walk would find no difference between two values: exactly
+  /// equal ones, without a tolerance.
   bool same(const json& was, const json& now) const {
+    if (tolerance_ == 0) return was == now;
     Differ probe(0, tolerance_);
     probe.walk(was, now, "");
     return probe.total == 0;
@@ -298,9 +297,9 @@ class Differ {
       for (; i < mi && j < mj; ++i, ++j) {
         walk(was[i], now[j], where + "[" + std::to_string(j) + "]");
       }
-      for (; j < mj; ++j) add(where + "[" + std::to_string(j) + "]", shown(now[j]), "null");
+      for (; j < mj; ++j) add(where + "[" + std::to_string(j) + "]", now[j], "null");
       for (; i < mi; ++i) {
-        add(where + "[" + std::to_string(i) + "] of the baseline", "gone", shown(was[i]));
+        add(where + "[" + std::to_string(i) + "] of the baseline", "gone", was[i]);
       }
       i = mi + 1;
       j = mj + 1;
@@ -324,10 +323,27 @@ class Differ {
     return true;
   }
 
-  void add(std::string where, std::string now, std::string was) {
+  /// One side of a difference: a value of a report, formatted only when the
+  /// difference is kept (a probe of `same` keeps none), or a word ("null",
+  /// "gone", a count). Made implicitly from either, as the call sites read.
+  struct Side {
+    Side(const json& v) : value(&v) {}
+    Side(std::string t) : text(std::move(t)) {}
+    Side(const char* t) : text(t) {}
+    const json* value = nullptr;
+    std::string text;
+  };
+
+  void add(std::string where, const Side& now, const Side& was) {
     ++total;
-    if (changes.size() < limit_)
-      changes.push_back({std::move(where), std::move(now), std::move(was)});
+    if (changes.size() >= limit_) return;
+    // Two texts are shown from a little before their first difference.
+    const std::size_t from =
+        now.value && was.value && now.value->is_string() && was.value->is_string()
+            ? shown_from(*was.value, *now.value)
+            : 0;
+    changes.push_back({std::move(where), now.value ? shown(*now.value, from) : now.text,
+                       was.value ? shown(*was.value, from) : was.text});
   }
 
   std::size_t limit_;
