@@ -118,7 +118,8 @@ void Hand::pose_parts(engine::Scene& scene) const {
   }
 }
 
-void Hand::filter(const engine::Scene& scene, std::vector<engine::Event>& events) const {
+void Hand::filter(const engine::Scene& scene, std::vector<engine::Event>& events) {
+  merge_region_events(events);
   auto is_any_hand = [&](const std::string& name) {
     const engine::PartId part = scene.find(name);
     return part.valid() && scene.has_tag(part, "hand");
@@ -134,6 +135,39 @@ void Hand::filter(const engine::Scene& scene, std::vector<engine::Event>& events
     e.kind = e.kind == engine::EventKind::kContactBegin ? engine::EventKind::kHandContactBegin
                                                         : engine::EventKind::kHandContactEnd;
     if (b_is_hand) std::swap(e.a, e.b);
+  }
+}
+
+void Hand::merge_region_events(std::vector<engine::Event>& events) {
+  auto is_segment_in_region = [&](const engine::Event& e) {
+    return (e.kind == engine::EventKind::kRegionEnter ||
+            e.kind == engine::EventKind::kRegionLeave) &&
+           segment_of(e.a).has_value();
+  };
+  // The frame's counts before and after, per region touched this frame.
+  std::map<std::string, std::pair<std::size_t, std::size_t>, std::less<>> changed;
+  std::uint64_t frame = 0;
+  double time = 0;
+  for (const engine::Event& e : events) {
+    if (!is_segment_in_region(e)) continue;
+    frame = e.frame;
+    time = e.time;
+    std::size_t& inside = segments_inside_[e.b];
+    const auto it = changed.try_emplace(e.b, inside, inside).first;
+    if (e.kind == engine::EventKind::kRegionEnter) {
+      ++inside;
+    } else {
+      --inside;
+    }
+    it->second.second = inside;
+  }
+  if (changed.empty()) return;
+  std::erase_if(events, is_segment_in_region);
+  for (const auto& [region, counts] : changed) {
+    const auto [before, after] = counts;
+    if ((before == 0) == (after == 0)) continue;
+    events.push_back({after > 0 ? engine::EventKind::kRegionEnter : engine::EventKind::kRegionLeave,
+                      frame, time, settings_.name, region});
   }
 }
 

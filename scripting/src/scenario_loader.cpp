@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <lua.hpp>
 #include <map>
 #include <numbers>
@@ -130,6 +131,35 @@ std::string brief(double x) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.3g", x);
   return buffer;
+}
+
+/// Of "mm", "cm" and "m", the unit in which numbers read in `units` as
+/// `metres` would give the size nearest `target` metres (by ratio).
+std::string likely_units(double metres, const std::string& units, double target) {
+  const double numbers = metres / engine::metres_per_unit(units).value_or(1);
+  std::string best = units;
+  double best_error = std::numeric_limits<double>::infinity();
+  for (const char* unit : {"mm", "cm", "m"}) {
+    const double error = std::abs(std::log(numbers * *engine::metres_per_unit(unit) / target));
+    if (error < best_error) {
+      best = unit;
+      best_error = error;
+    }
+  }
+  return best;
+}
+
+/// The end of a warning of a mesh file in other units: how its numbers are
+/// read, and the `units` that would read them as `likely` (its_or_their:
+/// "Its" for a part, "Their" for parts).
+std::string units_hint(const std::string& its_or_their, const std::string& units,
+                       const std::string& likely, const std::string& the_part_or_parts) {
+  std::string hint = its_or_their + " numbers are read in " + units;
+  if (likely != units) {
+    hint += "; if they are in " + likely + ", give " + the_part_or_parts + " units = \"" + likely +
+            "\"";
+  }
+  return hint;
 }
 
 std::string format_number(double x) {
@@ -824,9 +854,11 @@ class Loader {
     return arg;
   }
 
-  /// A part's mesh file read (whole, or the nodes selected), in metres.
+  /// A part's mesh file read (whole, or the nodes selected), scaled from its
+  /// units to metres.
   std::shared_ptr<const collision::Mesh> read_mesh_file(const std::filesystem::path& path,
                                                         const Arg& nodes, const Arg& without,
+                                                        double metres_per_unit,
                                                         const SourceLocation& where,
                                                         const std::string& what) {
     collision::Mesh loaded;
@@ -852,7 +884,7 @@ class Loader {
     } catch (const std::exception& e) {
       fail(where, what + ": " + e.what());
     }
-    for (Vec3& v : loaded.vertices) v *= scenario_.metres_per_unit;
+    for (Vec3& v : loaded.vertices) v *= metres_per_unit;
     return std::make_shared<const collision::Mesh>(std::move(loaded));
   }
 
@@ -1179,6 +1211,20 @@ void Loader::read_part(int map, PartSpec& part) {
       fail(part.where, what + ": nodes and without select from a mesh file");
     }
     if (nodes.given && without.given) fail(part.where, what + ": give either nodes or without");
+    double file_metres_per_unit = scenario_.metres_per_unit;
+    if (const Arg units = field(t, word, "units", part.where, what); units.given) {
+      if (!mesh.given) {
+        fail(field_line(part.where, "part", "units"),
+             what + ": units are a mesh file's; a shape's lengths are in the scenario's units");
+      }
+      if (const std::optional<double> metres = engine::metres_per_unit(units.text)) {
+        part.file_units = units.text;
+        file_metres_per_unit = *metres;
+      } else {
+        fail(field_line(part.where, "part", "units"),
+             what + ": units must be \"mm\", \"cm\" or \"m\", not \"" + units.text + "\"");
+      }
+    }
     if (mesh.given) {
       const std::filesystem::path path = folder_ / mesh.text;
       note_file(path);  // named by the scenario, read or not: never to be overwritten
@@ -1188,6 +1234,7 @@ void Loader::read_part(int map, PartSpec& part) {
       std::error_code ec;
       const std::filesystem::path where_on_disk = std::filesystem::weakly_canonical(path, ec);
       std::string key = (ec ? path.lexically_normal() : where_on_disk).string();
+      key += '\0' + std::to_string(file_metres_per_unit);
       for (const auto& [which, arg] :
            {std::pair{"nodes", &nodes}, std::pair{"without", &without}}) {
         if (!arg->given) continue;
@@ -1200,7 +1247,7 @@ void Loader::read_part(int map, PartSpec& part) {
       if (const auto known = meshes_.find(key); known != meshes_.end()) {
         part.mesh = known->second;  // its files were noted when it was read
       } else {
-        part.mesh = read_mesh_file(path, nodes, without, part.where, what);
+        part.mesh = read_mesh_file(path, nodes, without, file_metres_per_unit, part.where, what);
         meshes_.emplace(key, part.mesh);
       }
     }
@@ -1601,14 +1648,17 @@ void Loader::warn_about_mesh_sizes() {
     const bool never = metres < 5e-5 || metres > 200;
     if (!(far && rare) && !never) continue;
     const std::string& units = scenario_.units;
+    const std::string& file_units = p.file_units.empty() ? units : p.file_units;
     scenario_.warnings.push_back(
         p.where.str() + ": part '" + p.name + "' (" + p.file + ") is " + brief(size) + " " + units +
         " across, " +
         (ratio > 1 ? "1/" + brief(std::round(ratio)) + " of"
                    : brief(std::round(1 / ratio)) + " times") +
         " the other parts (a median of " + brief(median) + " " + units +
-        "): is the file in other units? A mesh file's numbers are read in the scenario's (" +
-        units + ")");
+        "): is the file in other units? " +
+        units_hint("Its", file_units,
+                   likely_units(metres, file_units, median * scenario_.metres_per_unit),
+                   "the part"));
   }
 }
 
@@ -1620,8 +1670,10 @@ void Loader::warn_about_mesh_sizes() {
 void Loader::warn_about_parts_beside_the_hand() {
   if (!scenario_.glove) return;
   std::vector<double> sizes;
+  std::set<std::string> file_units;
   for (const PartSpec& p : scenario_.parts) {
     if (p.file.empty() || !p.mesh) continue;
+    file_units.insert(p.file_units.empty() ? scenario_.units : p.file_units);
     Eigen::AlignedBox<double, 3> box;
     for (const Vec3& v : p.mesh->vertices) box.extend(v);
     sizes.push_back(box.diagonal().norm());  // metres (the vertices are scaled)
@@ -1647,9 +1699,11 @@ void Loader::warn_about_parts_beside_the_hand() {
       scenario_.glove->where.str() + ": the parts from mesh files are a median of " +
       brief(median / per_unit) + " " + units + " across, " +
       (ratio > 1 ? "1/" + whole(ratio) + " of" : whole(1 / ratio) + " times") + " the hand (" +
-      brief(hand / per_unit) + " " + units +
-      "): are the files in other units? A mesh file's numbers are read in the scenario's (" +
-      units + ")");
+      brief(hand / per_unit) + " " + units + "): are the files in other units?" +
+      (file_units.size() == 1
+           ? " " + units_hint("Their", *file_units.begin(),
+                              likely_units(median, *file_units.begin(), hand), "the parts")
+           : std::string()));
 }
 
 /// A part from a mesh file whose surface is open or inconsistently wound:
@@ -1735,8 +1789,13 @@ void Loader::resolve() {
       note(m.where, "mate '" + m.mate.name + "': its part '" + m.mate.part + "' is fixed");
   }
   for (const RegionSpec& r : scenario_.regions) {
-    for (const std::string& p : r.region.parts)
-      check_part(p, r.where, "region '" + r.region.name + "'");
+    for (const std::string& p : r.region.parts) {
+      if (p != "hand") {
+        check_part(p, r.where, "region '" + r.region.name + "'");
+      } else if (!scenario_.glove && !hand_given_) {
+        note(r.where, "region '" + r.region.name + "': the scenario has no hand");
+      }
+    }
   }
   // Parts attached from the start: to another part, not fixed themselves, without a cycle.
   for (const PartSpec& p : scenario_.parts) {
@@ -1803,6 +1862,20 @@ void Loader::resolve() {
                                    (fixed(c.args[0].text)
                                         ? "'" + c.args[0].text + "' is fixed"
                                         : std::string("the scenario has no hand")));
+    }
+    if (w == "enters" || w == "leaves" || w == "inside") {
+      for (const RegionSpec& r : scenario_.regions) {
+        const std::vector<std::string>& watched = r.region.parts;
+        if (r.region.name != c.args[1].text || watched.empty() ||
+            std::find(watched.begin(), watched.end(), c.args[0].text) != watched.end()) {
+          continue;
+        }
+        std::string list;
+        for (const std::string& p : watched) list += (list.empty() ? "'" : ", '") + p + "'";
+        scenario_.warnings.push_back(c.where.str() + ": " + context + c.text +
+                                     " can never happen: region '" + r.region.name +
+                                     "' watches only " + list);
+      }
     }
   };
   for (const StepSpec& s : scenario_.steps) {

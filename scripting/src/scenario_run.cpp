@@ -195,6 +195,19 @@ std::string format_length(double metres, const RunOutcome& o) {
 /// The same pose, to the bit.
 bool same(const Transform& x, const Transform& y) { return x.R == y.R && x.t == y.t; }
 
+/// The region as the engine watches it: "hand" among its parts stands for
+/// every segment of the hand (whose events the hand merges into its own).
+engine::Region with_hand_segments(engine::Region region) {
+  const auto hand = std::find(region.parts.begin(), region.parts.end(), "hand");
+  if (hand == region.parts.end()) return region;
+  region.parts.erase(hand);
+  for (std::size_t i = 0; i < interaction::kSegmentCount; ++i) {
+    region.parts.push_back(
+        "hand." + std::string(interaction::segment_name(static_cast<interaction::Segment>(i))));
+  }
+  return region;
+}
+
 std::pair<std::string, std::string> ordered(const std::string& a, const std::string& b) {
   return a < b ? std::pair(a, b) : std::pair(b, a);
 }
@@ -627,7 +640,6 @@ void Runner::build() {
     settings.cross_check = options_.cross_check;
   }
   sim_ = std::make_unique<engine::Simulation>(std::move(scene), settings);
-  for (const RegionSpec& r : scenario_.regions) sim_->add_region(r.region);
   // Actions of the last frame, then moves in progress: before the hand and grasping.
   sim_->set_frame_hook(
       [this](engine::Simulation&, std::uint64_t frame, double t) { start_frame(frame, t); });
@@ -657,6 +669,8 @@ void Runner::build() {
     throw ScenarioError(file_.string() +
                         ": --record: the scenario has no glove, so there are no samples to record");
   }
+  // After the hand: a region may watch its segments.
+  for (const RegionSpec& r : scenario_.regions) sim_->add_region(with_hand_segments(r.region));
   // Mates snapped by a rule appear among the frame's events.
   sim_->add_event_filter([this](engine::Simulation&, std::vector<Event>& events) {
     events.insert(events.end(), injected_.begin(), injected_.end());

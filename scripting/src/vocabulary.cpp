@@ -46,7 +46,11 @@ std::vector<Word> make_vocabulary() {
        WordKind::kDeclaration,
        {{"shape", kWord, kOptional, "a generated shape: `cylinder { ... }`, `box { ... }`, ..."},
         {"mesh", kFile, kOptional,
-         "or a mesh file (OBJ, STL, PLY, glTF, ... in the scenario's units)"},
+         "or a mesh file (OBJ, STL, PLY, glTF, ...; its numbers in the scenario's units "
+         "unless `units` says otherwise)"},
+        {"units", kText, kOptional,
+         "the unit of the mesh file's numbers, \"mm\", \"cm\" or \"m\" (default: the "
+         "scenario's); `at` and the mates' points stay in the scenario's"},
         {"nodes", kNames, kOptional,
          "only these nodes of the mesh file, as `dovetail inspect --parts` names them; "
          "the part's frame stays the file's"},
@@ -125,8 +129,11 @@ std::vector<Word> make_vocabulary() {
                WordKind::kDeclaration,
                {{"min", kVector, kRequired, "lowest corner"},
                 {"max", kVector, kRequired, "highest corner"},
-                {"parts", kNames, kOptional, "only these parts (default: all)"}},
-               "A box in the world; a part whose bounding box overlaps it is inside.",
+                {"parts", kNames, kOptional,
+                 "only these parts, and \"hand\" for the hand (default: every part and the "
+                 "hand)"}},
+               "A box in the world; a part whose bounding box overlaps it is inside, and the "
+               "hand is while one of its segments' boxes does.",
                "tray = region { min = { -50, 0, -50 }, max = { 50, 20, 50 } }"});
   // ---- shapes
   w.push_back({"box",
@@ -207,18 +214,18 @@ std::vector<Word> make_vocabulary() {
        "A carried part (the held part, or a part of its sub-assembly) comes into contact "
        "with another part and slides along it: once for each pair, named as it touches.",
        "slides(\"peg\", \"block\")"});
-  w.push_back(
-      {"enters",
-       WordKind::kEvent,
-       {{"part", kPart, kRequired, "the part"}, {"region", kRegion, kRequired, "the region"}},
-       "The part enters the region.",
-       "enters(\"peg\", \"tray\")"});
-  w.push_back(
-      {"leaves",
-       WordKind::kEvent,
-       {{"part", kPart, kRequired, "the part"}, {"region", kRegion, kRequired, "the region"}},
-       "The part leaves the region.",
-       "leaves(\"peg\", \"tray\")"});
+  w.push_back({"enters",
+               WordKind::kEvent,
+               {{"part", kPartOrHand, kRequired, "a part, or \"hand\""},
+                {"region", kRegion, kRequired, "the region"}},
+               "The part enters the region (\"hand\": as its first segment does).",
+               "enters(\"peg\", \"tray\")"});
+  w.push_back({"leaves",
+               WordKind::kEvent,
+               {{"part", kPartOrHand, kRequired, "a part, or \"hand\""},
+                {"region", kRegion, kRequired, "the region"}},
+               "The part leaves the region (\"hand\": as its last segment does).",
+               "leaves(\"peg\", \"tray\")"});
   w.push_back({"after",
                WordKind::kEvent,
                {{"seconds", kSeconds, kRequired, "simulated seconds from the start"}},
@@ -268,12 +275,12 @@ std::vector<Word> make_vocabulary() {
                {{"step", kStep, kRequired, "the step"}},
                "The step has been completed.",
                "done \"insert\""});
-  w.push_back(
-      {"inside",
-       WordKind::kState,
-       {{"part", kPart, kRequired, "the part"}, {"region", kRegion, kRequired, "the region"}},
-       "The part is inside the region.",
-       "inside(\"peg\", \"tray\")"});
+  w.push_back({"inside",
+               WordKind::kState,
+               {{"part", kPartOrHand, kRequired, "a part, or \"hand\""},
+                {"region", kRegion, kRequired, "the region"}},
+               "The part is inside the region.",
+               "inside(\"peg\", \"tray\")"});
   // ---- actions
   w.push_back({"highlight",
                WordKind::kAction,

@@ -946,7 +946,62 @@ TEST(ScenarioLoad, AMeshFileInOtherUnitsThanTheScenarioIsAWarning) {
                                "1/780 of the other parts (a median of 66.3 mm)"),
             std::string::npos)
       << s.warnings[0];
-  EXPECT_NE(s.warnings[0].find("is the file in other units?"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("is the file in other units? Its numbers are read in mm; if they "
+                               "are in m, give the part units = \"m\""),
+            std::string::npos)
+      << s.warnings[0];
+  // Said so, the plate is 60 mm across and nothing is out of place.
+  const Scenario in_metres = check_scenario(write(
+      dir, "plate_in_m.lua",
+      std::regex_replace(moved_peg("", ""), std::regex("    lid = part"),
+                         "    plate = part { mesh = \"plate_m.obj\", units = \"m\", at = { 0, "
+                         "200, 0 } },\n    lid = part")));
+  EXPECT_TRUE(in_metres.warnings.empty()) << in_metres.warnings[0];
+  const auto plate = std::find_if(in_metres.parts.begin(), in_metres.parts.end(),
+                                  [](const PartSpec& p) { return p.name == "plate"; });
+  ASSERT_NE(plate, in_metres.parts.end());
+  EXPECT_NEAR(plate->mesh->vertices[1].x(), 0.03, 1e-9);  // metres (the file is read in floats)
+  EXPECT_EQ(plate->file_units, "m");
+}
+
+TEST(ScenarioLoad, APartsUnitsAreAMeshFilesAndOneOfThree) {
+  const test::TempDir dir("dovetail_scenario");
+  const auto with_lid = [&](const char* name, const std::string& lid) {
+    return write(dir, name,
+                 std::regex_replace(moved_peg("", ""), std::regex("    lid = part \\{"),
+                                    "    lid = part { " + lid));
+  };
+  const std::string shape = load_error(with_lid("shape.lua", "units = \"m\","));
+  EXPECT_NE(shape.find("shape.lua:6: part 'lid': units are a mesh file's; a shape's lengths are "
+                       "in the scenario's units"),
+            std::string::npos)
+      << shape;
+  write(dir, "cube.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
+        "f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\nf 3 7 4\nf 4 7 8\n"
+        "f 1 5 3\nf 3 5 7\nf 2 4 6\nf 4 8 6\n");
+  const std::string inches =
+      load_error(write(dir, "inches.lua",
+                       "return scenario {\n  name = \"u\",\n  parts = {\n    c = part { mesh = "
+                       "\"cube.obj\",\n      units = \"in\" },\n  },\n}\n"));
+  EXPECT_NE(inches.find("inches.lua:5: part 'c': units must be \"mm\", \"cm\" or \"m\", not "
+                        "\"in\""),
+            std::string::npos)
+      << inches;
+  // One file in two units is two meshes, not one shared.
+  LuaHost host({}, 1);
+  const Scenario two = load_scenario(
+      host, write(dir, "two.lua",
+                  "return scenario {\n  name = \"u\", units = \"mm\",\n  parts = {\n"
+                  "    a = part { mesh = \"cube.obj\", units = \"cm\" },\n"
+                  "    b = part { mesh = \"cube.obj\", at = { 100, 0, 0 } },\n"
+                  "    c = part { mesh = \"cube.obj\", units = \"mm\", at = { 200, 0, 0 } },\n"
+                  "  },\n}\n"));
+  ASSERT_EQ(two.parts.size(), 3u);
+  EXPECT_EQ(two.parts[0].mesh->vertices[7], Vec3(0.01, 0.01, 0.01));
+  EXPECT_EQ(two.parts[1].mesh->vertices[7], Vec3(0.001, 0.001, 0.001));
+  EXPECT_NE(two.parts[0].mesh, two.parts[1].mesh);
+  EXPECT_EQ(two.parts[1].mesh, two.parts[2].mesh);  // the scenario's units, said or not
 }
 
 TEST(ScenarioLoad, PartsFromMeshFilesFarFromTheHandsSizeAreAWarning) {
@@ -978,7 +1033,8 @@ TEST(ScenarioLoad, PartsFromMeshFilesFarFromTheHandsSizeAreAWarning) {
   ASSERT_EQ(mm.warnings.size(), 1u);
   EXPECT_NE(mm.warnings[0].find("mm.lua:4: the parts from mesh files are a median of 0.139 mm "
                                 "across, 1/1371 of the hand (190 mm): are the files in other "
-                                "units?"),
+                                "units? Their numbers are read in mm; if they are in m, give "
+                                "the parts units = \"m\""),
             std::string::npos)
       << mm.warnings[0];
   EXPECT_TRUE(check_scenario(scenario("m")).warnings.empty());
@@ -2089,5 +2145,61 @@ TEST(ShippedScenarios, PegInHolePassesAndGivesTheSameReportAtAnyThreadCountAndOn
   EXPECT_EQ(run_scenario(kScenarios / "01_peg_in_hole.lua", replay).to_json(), first.to_json());
 }
 
+TEST(ScenarioRun, TheHandEntersAndLeavesARegionAsOne) {
+  // The open hand sweeps 200 mm along x through a region, so its 16
+  // segments enter one after another and leave one after another; the
+  // timeline and the rules see the hand come in once and go out once.
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "sweep.plan",
+        "start -0.200 0.100 0.000  0.7071067811865476 0 0 0.7071067811865476\n"
+        "reach 1.0  0.200 0.100 0.000  0.7071067811865476 0 0 0.7071067811865476\n");
+  const auto file = write(dir, "sweep.lua", R"(return scenario {
+  name = "sweep", units = "mm", duration = 1.2,
+  parts = {
+    base = part { shape = box { size = { 20, 20, 20 } }, at = { 0, -200, 0 }, fixed = true },
+  },
+  regions = {
+    gate = region { min = { -10, 0, -150 }, max = { 10, 200, 150 } },
+    hand_only = region { min = { -10, 0, -150 }, max = { 10, 200, 150 }, parts = { "hand" } },
+    base_only = region { min = { -10, 0, -150 }, max = { 10, 200, 150 }, parts = { "base" } },
+  },
+  hand = glove { plan = "sweep.plan" },
+  rules = {
+    rule { when = enters("hand", "gate"), only_if = inside("hand", "hand_only"),
+           act = { log "in" } },
+    rule { when = leaves("hand", "hand_only"), act = { log "out" } },
+    rule { when = enters("hand", "base_only"), act = { log "never" } },
+  },
+})");
+  LuaHost host({}, 1);
+  const Scenario s = load_scenario(host, file);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("sweep.lua:16: rule: enters(\"hand\", \"base_only\") can never "
+                               "happen: region 'base_only' watches only 'base'"),
+            std::string::npos)
+      << s.warnings[0];
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+  EXPECT_EQ(logged_texts(o), (std::vector<std::string>{"in", "out"})) << o.to_json();
+  std::vector<std::string> regions;
+  for (const engine::Event& e : o.report.events) {
+    if (e.kind == engine::EventKind::kRegionEnter || e.kind == engine::EventKind::kRegionLeave)
+      regions.push_back(std::string(engine::event_kind_name(e.kind)) + " " + e.a + " " + e.b);
+  }
+  EXPECT_EQ(regions,
+            (std::vector<std::string>{"region_enter hand gate", "region_enter hand hand_only",
+                                      "region_leave hand gate", "region_leave hand hand_only"}));
+}
+
+TEST(ScenarioLoad, ARegionWatchingTheHandNeedsOne) {
+  const test::TempDir dir("dovetail_scenario");
+  const std::string error =
+      load_error(write(dir, "nohand.lua",
+                       moved_peg("", "",
+                                 "  regions = { r = region { min = { 0, 0, 0 }, max = { 1, 1, 1 }, "
+                                 "parts = { \"hand\" } } },\n")));
+  EXPECT_NE(error.find("nohand.lua:22: region 'r': the scenario has no hand"), std::string::npos)
+      << error;
+}
 }  // namespace
 }  // namespace dovetail::scripting

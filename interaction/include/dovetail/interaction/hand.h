@@ -95,7 +95,10 @@ class Hand {
 
  private:
   void update(engine::Simulation& simulation, std::uint64_t frame, Real t);
-  void filter(const engine::Scene& scene, std::vector<engine::Event>& events) const;
+  void filter(const engine::Scene& scene, std::vector<engine::Event>& events);
+  /// Turns the segments' region events into the hand's: it enters a region
+  /// as its first segment does and leaves it as its last one does.
+  void merge_region_events(std::vector<engine::Event>& events);
   void pose_parts(engine::Scene& scene) const;
 
   HandModel model_;
@@ -111,6 +114,8 @@ class Hand {
   Transform X_WH_{};
   std::vector<GloveSample> recorded_;
   std::array<std::uint64_t, kJointCount> clamped_frames_{};
+  /// Per region: how many of its segments are inside.
+  std::map<std::string, std::size_t, std::less<>> segments_inside_;
 };
 
 }  // namespace dovetail::interaction

@@ -71,7 +71,8 @@ struct PartSpec {
   std::string name{};
   SourceLocation where{};
   std::shared_ptr<const collision::Mesh> mesh{};  ///< in metres
-  std::string file{};  ///< the mesh file as the scenario names it; empty for a shape
+  std::string file{};        ///< the mesh file as the scenario names it; empty for a shape
+  std::string file_units{};  ///< the unit of the file's numbers when the part gives it, or empty
   Transform X_WP{};
   bool fixed = false;
   std::string attached_to{};  ///< the part it moves with from the start, or empty
