@@ -1604,10 +1604,12 @@ std::string RunOutcome::to_json() const {
     out += (i ? ", " : "") + json_string(warnings[i]);
   out += "],\n";
   out += "  \"rules_fired\": " + std::to_string(rules_fired) + ",\n";
+  // No two parts ever overlapped: a depth of 0, and no time or parts.
+  const bool overlapped = !max_penetration_a.empty();
   out += "  \"max_penetration\": {\"depth\": " + json_number(max_penetration / metres_per_unit) +
-         ", \"time\": " + json_number(max_penetration_time) +
-         ", \"a\": " + json_string(max_penetration_a) +
-         ", \"b\": " + json_string(max_penetration_b) + "},\n";
+         ", \"time\": " + (overlapped ? json_number(max_penetration_time) : "null") +
+         ", \"a\": " + (overlapped ? json_string(max_penetration_a) : "null") +
+         ", \"b\": " + (overlapped ? json_string(max_penetration_b) : "null") + "},\n";
   out += "  \"final_poses\": [";
   for (std::size_t i = 0; i < final_poses.size(); ++i) {
     const PartPose& p = final_poses[i];

@@ -561,6 +561,11 @@ TEST(ScenarioRun, RulesStepsAndExpectationsOfAMovedPeg) {
   ASSERT_FALSE(o.messages.empty());
   EXPECT_EQ(o.messages[0].text, "seated");
   EXPECT_EQ(o.messages[0].where.line, 18);
+  // The peg snapped in without touching the hole's wall: nothing overlapped.
+  EXPECT_NE(o.to_json().find("\"max_penetration\": {\"depth\": 0, \"time\": null, \"a\": null, "
+                             "\"b\": null}"),
+            std::string::npos)
+      << o.to_json();
 }
 
 TEST(ScenarioRun, ASnapOfAPartInPlaceAlreadyFiresNoSecondMated) {
@@ -672,6 +677,8 @@ TEST(ScenarioRun, APartPushedThroughAnotherFailsMaxPenetrationNamingThePartsAndT
   EXPECT_NE(o.expectations[0].detail.find("'block' and 'peg' overlapped"), std::string::npos)
       << o.expectations[0].detail;
   EXPECT_GT(o.max_penetration, 0.001);
+  EXPECT_NE(o.to_json().find("\"a\": \"block\", \"b\": \"peg\"}"), std::string::npos)
+      << o.to_json();
 }
 
 TEST(ScenarioRun, AFailingCustomActionEndsWithAnErrorAndAReport) {
