@@ -182,7 +182,15 @@ int message_handler(lua_State* L) {
       lua_concat(L, 2);
     }
   }
-  luaL_traceback(L, L, lua_tostring(L, -1), 1);
+  // A C metamethod that raised the error (the scenario loader's unknown
+  // names) is no place in the script: the traceback starts at its caller.
+  int level = 1;
+  lua_Debug ar;
+  if (lua_getstack(L, 1, &ar) != 0 && lua_getinfo(L, "Sn", &ar) != 0 && ar.what[0] == 'C' &&
+      ar.namewhat != nullptr && std::strcmp(ar.namewhat, "metamethod") == 0) {
+    level = 2;
+  }
+  luaL_traceback(L, L, lua_tostring(L, -1), level);
   return 1;
 }
 

@@ -70,6 +70,30 @@ int where_function(lua_State* L) {
   return 1;
 }
 
+/// The sandbox globals' __index while a scenario file is read: a name that
+/// is no global is an error, not nil. A word written without its quotes
+/// (`steps_in_order { carry }`, `units = m`, `fixed = yes`) would otherwise
+/// leave its field unset without a word. Custom actions, run later, read
+/// unset globals as nil, as Lua does (`count = (count or 0) + 1`).
+int unknown_global(lua_State* L) {
+  if (lua_type(L, 2) != LUA_TSTRING) return 0;
+  char message[512];
+  {
+    const std::string name(lua_tostring(L, 2));
+    std::vector<std::string> words;
+    for (const Word& w : vocabulary()) words.emplace_back(w.name);
+    std::string hint = did_you_mean(name, words);
+    if (hint.empty()) {
+      hint = " (a name is given in quotes, \"" + name + "\"; true and false without)";
+    }
+    std::snprintf(message, sizeof message, "unknown name '%s'%s", name.c_str(), hint.c_str());
+  }  // no C++ object lives on past here: lua_error does not return
+  luaL_where(L, 1);
+  lua_pushstring(L, message);
+  lua_concat(L, 2);
+  return lua_error(L);
+}
+
 /// The line of the file's last `return scenario` outside a comment: where
 /// a scenario returned directly was declared. Lua keeps no line for it (the
 /// call in a `return` is a tail call, whose caller's frame is gone). 0 when
@@ -181,11 +205,10 @@ const std::map<std::string, std::array<float, 3>, std::less<>>& color_names() {
   return names;
 }
 
-/// A call of an unknown global that is nearly a word of the vocabulary
-/// (`touchs(...)`) gets the word suggested after Lua's own message, and a
-/// table whose fields lack a comma the question whether one is missing.
-ScriptError with_word_suggested(const ScriptError& e) {
-  constexpr std::string_view kCall = "attempt to call a nil value (global '";
+/// A table whose fields lack a comma gets the question whether one is
+/// missing after Lua's own message. (A misspelt word, `touchs(...)`, is
+/// named by unknown_global, with the word suggested.)
+ScriptError with_comma_hint(const ScriptError& e) {
   const std::string& first = e.message();
   const auto with_hint = [&](const std::string& hint) {
     const std::string what = e.what();
@@ -206,16 +229,7 @@ ScriptError with_word_suggested(const ScriptError& e) {
       return with_hint(" (is a comma missing at the end of the field before?)");
     }
   }
-  const std::size_t at = first.find(kCall);
-  if (at == std::string::npos) return e;
-  const std::size_t from = at + kCall.size();
-  const std::size_t to = first.find('\'', from);
-  if (to == std::string::npos) return e;
-  std::vector<std::string> words;
-  for (const Word& w : vocabulary()) words.emplace_back(w.name);
-  const std::string hint = did_you_mean(first.substr(from, to - from), words);
-  if (hint.empty()) return e;
-  return with_hint(hint);
+  return e;
 }
 
 class Loader {
@@ -1034,12 +1048,30 @@ Scenario Loader::load() {
   lua_pushcfunction(L_, where_function);
   host_.call(2, 0);
 
+  // Unknown names are errors while the file runs, and nil again after.
+  const auto set_unknown_global = [&](lua_CFunction handler) {
+    host_.push_env();
+    lua_getmetatable(L_, -1);
+    if (handler) {
+      lua_pushcfunction(L_, handler);
+    } else {
+      lua_pushnil(L_);
+    }
+    lua_setfield(L_, -2, "__index");
+    lua_pop(L_, 2);
+  };
   const int base = lua_gettop(L_);
+  set_unknown_global(unknown_global);
   try {
     host_.run_file(file_, 1);
   } catch (const ScriptError& e) {
-    throw with_word_suggested(e);
+    set_unknown_global(nullptr);
+    throw with_comma_hint(e);
+  } catch (...) {
+    set_unknown_global(nullptr);
+    throw;
   }
+  set_unknown_global(nullptr);
   const int top = base + 1;
   const SourceLocation file_only{file_, 0};
   if (word_of(top) != "scenario") {
@@ -1381,7 +1413,12 @@ void Loader::read_regions(int map, const SourceLocation& where) {
     spec.region.name = name;
     spec.region.box.min = field(t, word, "min", spec.where, what).vector;
     spec.region.box.max = field(t, word, "max", spec.where, what).vector;
-    spec.region.parts = field(t, word, "parts", spec.where, what).names;
+    const Arg parts = field(t, word, "parts", spec.where, what);
+    if (parts.given && parts.names.empty()) {
+      fail(field_line(spec.where, "region", "parts"),
+           what + ": parts is empty; leave it out to watch every part and the hand");
+    }
+    spec.region.parts = parts.names;
     if ((spec.region.box.max - spec.region.box.min).minCoeff() < 0) {
       fail(spec.where, what + ": max must not be below min on any axis");
     }
@@ -1608,6 +1645,7 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
         break;
       case ArgType::kNames:
         if (clause.word->name == "steps_in_order") {
+          if (arg.names.empty()) note(clause.where, "steps_in_order: name at least one step");
           for (const std::string& name : arg.names) check(name, steps, "step");
         }
         break;

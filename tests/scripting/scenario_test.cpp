@@ -398,7 +398,7 @@ TEST(ScenarioLoad, AMateAngleOutsideItsRangeIsNamed) {
 
 TEST(ScenarioLoad, AMisspeltWordAndAWordWithoutArgumentsAreNamed) {
   const test::TempDir dir("dovetail_scenario");
-  // A call of an unknown global that is nearly a word: Lua's message and the word.
+  // A call of an unknown name that is nearly a word: the word.
   const auto call_file =
       write(dir, "call.lua",
             moved_peg("    rule { when = touchs(\"peg\", \"block\"), act = { log \"x\" } },", ""));
@@ -410,8 +410,7 @@ TEST(ScenarioLoad, AMisspeltWordAndAWordWithoutArgumentsAreNamed) {
   } catch (const ScriptError& e) {  // a Lua error, not a scenario mistake
     call = e.what();
   }
-  EXPECT_NE(call.find("call.lua:17: attempt to call a nil value (global 'touchs') (did you mean "
-                      "'touches'?)"),
+  EXPECT_NE(call.find("call.lua:17: unknown name 'touchs' (did you mean 'touches'?)"),
             std::string::npos)
       << call;
   // A word written without its arguments, with "an" before a vowel.
@@ -422,6 +421,66 @@ TEST(ScenarioLoad, AMisspeltWordAndAWordWithoutArgumentsAreNamed) {
       << bare;
   const std::string kind = load_error(write(dir, "kind.lua", moved_peg("", "    after(1),")));
   EXPECT_NE(kind.find("must be an expectation; 'after' is an event"), std::string::npos) << kind;
+}
+
+TEST(ScenarioLoad, AWordWithoutItsQuotesIsAnUnknownNameNotAnUnsetField) {
+  // Lua reads an unknown name as nil, which would leave the field unset:
+  // steps_in_order { insert } would check no step, units = m the scenario's
+  // units, fixed = yes a movable part.
+  const test::TempDir dir("dovetail_scenario");
+  const auto error_of = [&](const char* name, const std::string& text) {
+    try {
+      LuaHost host({}, 1);
+      load_scenario(host, write(dir, name, text));
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("loaded");
+  };
+  const std::string steps = error_of("steps.lua", moved_peg("", "    steps_in_order { insert },"));
+  EXPECT_NE(steps.find("steps.lua:20: unknown name 'insert' (a name is given in quotes, "
+                       "\"insert\"; true and false without)"),
+            std::string::npos)
+      << steps;
+  const std::string fixed =
+      error_of("fixed.lua",
+               std::regex_replace(moved_peg("", ""), std::regex("fixed = true"), "fixed = yes"));
+  EXPECT_NE(fixed.find("fixed.lua:4: unknown name 'yes'"), std::string::npos) << fixed;
+  EXPECT_EQ(fixed.find("metamethod"), std::string::npos) << fixed;  // the script's lines only
+  // Nearly a word: the word.
+  const std::string word = error_of("word.lua", moved_peg("", "    mate_mad \"peg_in_hole\","));
+  EXPECT_NE(word.find("word.lua:20: unknown name 'mate_mad' (did you mean 'mate_made'?)"),
+            std::string::npos)
+      << word;
+  // An empty list names nothing: said, not taken as every step or part.
+  const std::string none =
+      load_error(write(dir, "none.lua", moved_peg("", "    steps_in_order {},")));
+  EXPECT_NE(none.find("none.lua:20: steps_in_order: name at least one step"), std::string::npos)
+      << none;
+  const std::string region = load_error(
+      write(dir, "region.lua",
+            moved_peg("", "",
+                      "  regions = { r = region { min = { 0, 0, 0 }, max = { 1, 1, 1 },\n"
+                      "    parts = {} } },\n")));
+  EXPECT_NE(region.find("region.lua:23: region 'r': parts is empty; leave it out to watch every "
+                        "part and the hand"),
+            std::string::npos)
+      << region;
+}
+
+TEST(ScenarioRun, ACustomActionReadsAGlobalNotYetSetAsNil) {
+  // Unknown names are errors while the file is read, not in custom actions
+  // run later, which may keep a count in a global as Lua allows.
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(dir, "count.lua",
+                          moved_peg("    rule { when = every(0.25), act = { custom(function(dt)\n"
+                                    "      count = (count or 0) + 1\n"
+                                    "      dt.log(tostring(count))\n"
+                                    "    end) }, cooldown = 0 },",
+                                    ""));
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+  EXPECT_EQ(logged_texts(o), (std::vector<std::string>{"1", "2", "3", "4"})) << o.to_json();
 }
 
 TEST(ScenarioLoad, AnUnknownFieldAndAWrongKindAreNamed) {
