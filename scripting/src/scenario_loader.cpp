@@ -1632,6 +1632,24 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
         check(arg.text, parts, "part");
         break;
       case ArgType::kPart:
+        if (arg.text == "hand" && !clause.word->params.empty() &&
+            clause.word->params[0].type == ArgType::kPartOrHand) {
+          // touches("peg", "hand"): the hand may be named, but first.
+          note(clause.where, std::string(clause.word->name) +
+                                 ": the hand is named first: " + std::string(clause.word->name) +
+                                 "(\"hand\", \"" + clause.args[0].text + "\")");
+          break;
+        }
+        if (arg.text == "hand") {
+          std::string words;
+          for (const Word& w : vocabulary()) {
+            if (!w.params.empty() && w.params[0].type == ArgType::kPartOrHand)
+              words += (words.empty() ? "" : ", ") + std::string(w.name);
+          }
+          note(clause.where, std::string(clause.word->name) +
+                                 ": 'hand' is no part (the hand is named first in " + words + ")");
+          break;
+        }
         check(arg.text, parts, "part");
         break;
       case ArgType::kMate:
@@ -1792,9 +1810,15 @@ void Loader::warn_about_overlapping_parts() {
       if (!boxes[i].intersects(boxes[j])) continue;
       const double depth = gauge.depth(parts[i].mesh, parts[i].X_WP, parts[j].mesh, parts[j].X_WP);
       if (!(depth > kDeepest)) continue;
+      // Named at the later declaration (the part more likely placed last),
+      // with the other's line.
+      const bool j_later = parts[i].where.line <= parts[j].where.line;
+      const PartSpec& later = j_later ? parts[j] : parts[i];
+      const PartSpec& earlier = j_later ? parts[i] : parts[j];
       scenario_.warnings.push_back(
-          parts[j].where.str() + ": parts '" + parts[i].name + "' and '" + parts[j].name +
-          "' overlap by " + brief(depth / scenario_.metres_per_unit) + " " + scenario_.units +
+          later.where.str() + ": parts '" + later.name + "' and '" + earlier.name + "' (line " +
+          std::to_string(earlier.where.line) + ") overlap by " +
+          brief(depth / scenario_.metres_per_unit) + " " + scenario_.units +
           " where the scenario places them: one starts inside the other (attach them with "
           "attached_to if they are pressed together)");
     }

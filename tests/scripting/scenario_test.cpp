@@ -533,6 +533,27 @@ TEST(ScenarioLoad, ARuleThatCanNeverFireIsAWarning) {
       << s.warnings[0];
 }
 
+TEST(ScenarioLoad, TheHandNamedWhereOnlyAPartGoesIsSaidSo) {
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "hand.plan", "start 0 0.2 0  1 0 0 0\nwait 0.1\n");
+  const std::string glove = "  hand = glove { plan = \"hand.plan\" },\n";
+  const std::string second = load_error(
+      write(dir, "second.lua",
+            moved_peg("    rule { when = touches(\"peg\", \"hand\"), act = { log \"x\" } },", "",
+                      glove)));
+  EXPECT_NE(second.find("second.lua:17: touches: the hand is named first: touches(\"hand\", "
+                        "\"peg\")"),
+            std::string::npos)
+      << second;
+  const std::string grasped = load_error(
+      write(dir, "grasped.lua",
+            moved_peg("    rule { when = grasped \"hand\", act = { log \"x\" } },", "", glove)));
+  EXPECT_NE(grasped.find("grasped.lua:17: grasped: 'hand' is no part (the hand is named first in "
+                         "touches, separates, enters, leaves, touching, inside, no_contact)"),
+            std::string::npos)
+      << grasped;
+}
+
 TEST(ScenarioLoad, AShapeTooLargeOrTooSmallIsNamedAtItsLine) {
   const test::TempDir dir("dovetail_scenario");
   const auto shape = [&](const std::string& name, const std::string& text) {
@@ -1877,8 +1898,8 @@ TEST(ScenarioLoad, PartsThatStartInsideEachOtherAreWarnedOf) {
   },
 })"));
   ASSERT_EQ(s.warnings.size(), 1u) << s.warnings[1];
-  EXPECT_NE(s.warnings[0].find("inside.lua:5: parts 'housing' and 'shaft' overlap by 10 mm where "
-                               "the scenario places them"),
+  EXPECT_NE(s.warnings[0].find("inside.lua:5: parts 'shaft' and 'housing' (line 4) overlap by 10 "
+                               "mm where the scenario places them"),
             std::string::npos)
       << s.warnings[0];
 }
