@@ -8,6 +8,7 @@
 // loader's errors without crossing Lua's C frames.
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include <lua.hpp>
 #include <map>
 #include <numbers>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -37,16 +39,19 @@ using collision::Real;
 
 constexpr const char* kPreludeName = "dovetail prelude";
 /// Defines one constructor per word: it packs its arguments and marks the
-/// table with the word's name and where it was called.
+/// table with the word's name and where it was called. Where each named
+/// declaration (a part, mate or region) was made is listed in `made`.
 constexpr const char* kPrelude = R"lua(
-local words, where = ...
+local words, where, made = ...
 local pack = table.pack
 for i = 1, #words do
   local name = words[i]
+  local list = made[name]
   rawset(_ENV, name, function(...)
     local t = pack(...)
     t.__word = name
     t.__where = where()
+    if list then list[#list + 1] = t.__where end
     return t
   end)
 end
@@ -93,6 +98,10 @@ int unknown_global(lua_State* L) {
   lua_concat(L, 2);
   return lua_error(L);
 }
+
+/// The declarations whose tables are keyed by name: the same name given
+/// twice in one table leaves only the later, without a word from Lua.
+constexpr std::array<const char*, 3> kNamedDeclarations = {"part", "mate", "region"};
 
 /// The line of the file's last `return scenario` outside a comment: where
 /// a scenario returned directly was declared. Lua keeps no line for it (the
@@ -243,11 +252,16 @@ class Loader {
         files_read_(files_read),
         hand_given_(hand_given) {}
 
+  ~Loader() { luaL_unref(L_, LUA_REGISTRYINDEX, made_); }
+  Loader(const Loader&) = delete;
+  Loader& operator=(const Loader&) = delete;
+
   Scenario load();
   void warn_about_mesh_sizes();
   void warn_about_parts_beside_the_hand();
   void warn_about_open_surfaces();
   void warn_about_overlapping_parts();
+  void warn_about_dropped_declarations();
   /// The part of that name, or null.
   const PartSpec* part_named(const std::string& name) const {
     for (const PartSpec& p : scenario_.parts) {
@@ -1004,6 +1018,9 @@ class Loader {
 
   LuaHost& host_;
   lua_State* L_;
+  /// The registry's reference to the lists of where each named declaration
+  /// was made (the prelude's `made`).
+  int made_ = LUA_NOREF;
   std::string file_;
   /// A file the scenario names, into *files_read_ (kept when loading fails).
   void note_file(const std::filesystem::path& path) {
@@ -1046,7 +1063,14 @@ Scenario Loader::load() {
     lua_rawseti(L_, -2, i++);
   }
   lua_pushcfunction(L_, where_function);
-  host_.call(2, 0);
+  lua_createtable(L_, 0, static_cast<int>(kNamedDeclarations.size()));
+  for (const char* word : kNamedDeclarations) {
+    lua_newtable(L_);
+    lua_setfield(L_, -2, word);
+  }
+  lua_pushvalue(L_, -1);
+  made_ = luaL_ref(L_, LUA_REGISTRYINDEX);
+  host_.call(3, 0);
 
   // Unknown names are errors while the file runs, and nil again after.
   const auto set_unknown_global = [&](lua_CFunction handler) {
@@ -1673,6 +1697,66 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
   }
 }
 
+/// A part, mate or region made but in no table of the scenario: most often
+/// one of two of the same name in one table (`peg = part { ... }` twice),
+/// of which Lua keeps the later without a word. A declaration made by a
+/// function for many (one line for all) is not told apart from its others.
+void Loader::warn_about_dropped_declarations() {
+  std::map<std::string, std::set<std::string>> read;  // word -> "file:line" of those read
+  for (const PartSpec& p : scenario_.parts) read["part"].insert(p.where.str());
+  for (const MateSpec& m : scenario_.mates) read["mate"].insert(m.where.str());
+  for (const RegionSpec& r : scenario_.regions) read["region"].insert(r.where.str());
+  std::vector<std::pair<std::string, SourceLocation>> dropped;  // (word, where)
+  lua_rawgeti(L_, LUA_REGISTRYINDEX, made_);
+  for (const char* word : kNamedDeclarations) {
+    lua_getfield(L_, -1, word);
+    const lua_Integer n = luaL_len(L_, -1);
+    for (lua_Integer i = 1; i <= n; ++i) {
+      lua_rawgeti(L_, -1, i);
+      const std::string text = string_at(-1);
+      lua_pop(L_, 1);
+      const SourceLocation where = parse_where(text, file_);
+      if (where.line > 0 && read[word].count(where.str()) == 0) dropped.emplace_back(word, where);
+    }
+    lua_pop(L_, 1);
+  }
+  lua_pop(L_, 1);
+  if (dropped.empty()) return;
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(file_, std::ios::binary);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+  }
+  for (const auto& [word, where] : dropped) {
+    // The name it was given, from its line: `name = part {` or `["name"] = part {`.
+    std::string name;
+    if (where.file == file_ && where.line <= static_cast<int>(lines.size())) {
+      std::smatch m;
+      const std::regex named("(?:([A-Za-z_][A-Za-z0-9_]*)|\\[\\s*\"([^\"]*)\"\\s*\\])\\s*=\\s*" +
+                             std::string(word) + "\\b");
+      if (std::regex_search(lines[where.line - 1], m, named)) name = m[1].matched ? m[1] : m[2];
+    }
+    const SourceLocation* kept = nullptr;
+    for (const PartSpec& p : scenario_.parts)
+      if (word == "part" && p.name == name) kept = &p.where;
+    for (const MateSpec& m : scenario_.mates)
+      if (word == "mate" && m.mate.name == name) kept = &m.where;
+    for (const RegionSpec& r : scenario_.regions)
+      if (word == "region" && r.region.name == name) kept = &r.where;
+    if (kept) {
+      scenario_.warnings.push_back(where.str() + ": " + word + " '" + name +
+                                   "' is declared again at line " + std::to_string(kept->line) +
+                                   ", which replaces this one: give each " + word +
+                                   " a name of its own");
+    } else {
+      scenario_.warnings.push_back(where.str() + ": this " + word +
+                                   " { ... } is in none of the "
+                                   "scenario's " +
+                                   word + "s (is its name given twice?)");
+    }
+  }
+}
+
 /// A part from a mesh file hundreds of times smaller or larger than the
 /// scenario's other parts, and under 2 mm or over 20 m across (or under
 /// 0.05 mm or over 200 m whatever the others): most likely a file in other
@@ -1886,6 +1970,7 @@ void Loader::resolve() {
   warn_about_parts_beside_the_hand();
   warn_about_open_surfaces();
   if (noted_.empty()) warn_about_overlapping_parts();
+  warn_about_dropped_declarations();
   if (scenario_.glove && !scenario_.glove->holding.empty()) {
     check_part(scenario_.glove->holding, scenario_.glove->where, "glove: holding");
     if (fixed(scenario_.glove->holding)) {

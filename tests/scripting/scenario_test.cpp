@@ -554,6 +554,44 @@ TEST(ScenarioLoad, TheHandNamedWhereOnlyAPartGoesIsSaidSo) {
       << grasped;
 }
 
+TEST(ScenarioLoad, ANameGivenTwiceInOneTableIsAWarning) {
+  // Lua keeps the later of two equal keys without a word: the earlier part
+  // or region would vanish. Parts made by a function for many are fine.
+  const test::TempDir dir("dovetail_scenario");
+  LuaHost host({}, 1);
+  const Scenario s = load_scenario(host, write(dir, "twice.lua", R"(local function brick(x)
+  return part { shape = box { size = { 10, 10, 10 } }, at = { x, 0, 0 } }
+end
+local spare = part { shape = box { size = { 1, 1, 1 } } }
+return scenario {
+  name = "twice", units = "mm",
+  parts = {
+    a = brick(0), b = brick(20),
+    lid = part { shape = box { size = { 5, 5, 5 } }, at = { 0, 50, 0 } },
+    ["lid"] = part { shape = box { size = { 6, 6, 6 } }, at = { 0, 80, 0 } },
+  },
+  regions = {
+    tray = region { min = { 0, 0, 0 }, max = { 1, 1, 1 } },
+    tray = region { min = { 0, 0, 0 }, max = { 2, 2, 2 } },
+  },
+})"));
+  ASSERT_EQ(s.parts.size(), 3u);
+  std::vector<std::string> warnings = s.warnings;
+  std::sort(warnings.begin(), warnings.end());
+  ASSERT_EQ(warnings.size(), 3u) << warnings[0];
+  EXPECT_NE(warnings[0].find("twice.lua:13: region 'tray' is declared again at line 14, which "
+                             "replaces this one: give each region a name of its own"),
+            std::string::npos)
+      << warnings[0];
+  EXPECT_NE(warnings[1].find("twice.lua:4: this part { ... } is in none of the scenario's parts "
+                             "(is its name given twice?)"),
+            std::string::npos)
+      << warnings[1];
+  EXPECT_NE(warnings[2].find("twice.lua:9: part 'lid' is declared again at line 10"),
+            std::string::npos)
+      << warnings[2];
+}
+
 TEST(ScenarioLoad, AShapeTooLargeOrTooSmallIsNamedAtItsLine) {
   const test::TempDir dir("dovetail_scenario");
   const auto shape = [&](const std::string& name, const std::string& text) {
