@@ -175,6 +175,13 @@ std::vector<std::string> glove_warnings(const Scenario& scenario, const GloveSpe
                   " s; until then the hand stays at its first sample (its times are seconds "
                   "from the start of the run: shift them to start at 0)");
   }
+  // A plan cut short by the scenario's duration: the hand stops where it is.
+  if (trace.empty() && !dynamic_cast<const interaction::TraceSource*>(&source) &&
+      scenario.duration && source.end_time() > *scenario.duration + 1e-9) {
+    out.push_back(who + ": the plan runs to t=" + format_time(source.end_time()) +
+                  " s, past the scenario's duration (" + format_time(*scenario.duration) +
+                  " s): the run ends before the hand has done it");
+  }
   if (!glove.holding.empty()) {
     for (const PartSpec& p : scenario.parts) {
       if (p.name != glove.holding) continue;
@@ -1235,7 +1242,10 @@ void Runner::evaluate_expectations() {
         if (!step_done_[i]) {
           e.passed = false;
           e.detail = "step '" + scenario_.steps[i].name + "' was never completed (run ended at t=" +
-                     format_time(sim_->report().frames * scenario_.time_step) + " s)";
+                     format_time(static_cast<double>(
+                                     std::max<std::uint64_t>(sim_->report().frames, 1) - 1) *
+                                 scenario_.time_step) +
+                     " s)";
         } else if (*step_done_[i] > args[0].number) {
           e.passed = false;
           e.detail = "step '" + scenario_.steps[i].name +

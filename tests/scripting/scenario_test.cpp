@@ -592,6 +592,26 @@ return scenario {
       << warnings[2];
 }
 
+TEST(ScenarioRun, APlanLongerThanTheDurationIsAWarningAndTheRunEndsAtItsLastFrame) {
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "long.plan", "start 0 0.3 0  1 0 0 0\nwait 2\n");
+  const auto file =
+      write(dir, "short.lua",
+            moved_peg("", "    finished_within(5),", "  hand = glove { plan = \"long.plan\" },\n"));
+  const std::string expected =
+      "short.lua:22: glove: the plan runs to t=2.000 s, past the scenario's duration (1.000 s): "
+      "the run ends before the hand has done it";
+  const Scenario checked = check_scenario(file);
+  ASSERT_EQ(checked.warnings.size(), 1u);
+  EXPECT_NE(checked.warnings[0].find(expected), std::string::npos) << checked.warnings[0];
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.warnings.size(), 1u);
+  EXPECT_NE(o.warnings[0].find(expected), std::string::npos) << o.warnings[0];
+  // 91 frames, the last at t = 1 s: the run ended there, not a frame later.
+  ASSERT_EQ(o.expectations.size(), 1u);
+  EXPECT_EQ(o.expectations[0].detail, "step 'insert' was never completed (run ended at t=1.000 s)");
+}
+
 TEST(ScenarioLoad, AShapeTooLargeOrTooSmallIsNamedAtItsLine) {
   const test::TempDir dir("dovetail_scenario");
   const auto shape = [&](const std::string& name, const std::string& text) {
