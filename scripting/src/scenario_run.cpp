@@ -994,10 +994,16 @@ std::string Runner::why_not_snapped(const MateSpec& m) const {
   // A part snaps when the hand lets it go (or by a rule's snap): one the hand
   // never held could not, however close it came.
   const bool held = carried_ever_.count(m.mate.part) != 0;
-  const std::string never_held =
+  std::string never_held =
       held ? ""
            : "; the hand never held it, and a part snaps when the hand lets it go (or by a "
              "rule's snap)";
+  // Carried to the end: never let go, so never snapped.
+  if (held && carried_now_.count(m.mate.part) != 0 &&
+      !(i < released_.size() && released_[i].seen)) {
+    never_held =
+        "; the hand still held it when the run ended, and a part snaps when the hand lets it go";
+  }
   // Rounded to a millionth of a degree: turns given in degrees leave ~1e-15.
   const auto degrees = [](const interaction::MateOffset& offset) {
     char text[64];

@@ -2130,6 +2130,24 @@ std::string peg_in_hole_text() {
   return std::string(std::istreambuf_iterator<char>(f), {});
 }
 
+TEST(ScenarioRun, AMateOfAPartStillHeldAtTheEndSaysSo) {
+  // The shipped peg in hole cut at 1 s, the peg still in the hand.
+  const test::TempDir dir("dovetail_scenario");
+  std::string text = std::regex_replace(peg_in_hole_text(), std::regex("units = \"mm\","),
+                                        "units = \"mm\", duration = 1,");
+  text = std::regex_replace(text, std::regex("\\.\\./assets"), (kScenarios / "../assets").string());
+  const RunOutcome o = run_scenario(write(dir, "cut.lua", text));
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed);
+  const auto made = std::find_if(o.expectations.begin(), o.expectations.end(), [](const auto& e) {
+    return e.text == "mate_made(\"peg_in_hole\")";
+  });
+  ASSERT_NE(made, o.expectations.end());
+  EXPECT_NE(made->detail.find("; the hand still held it when the run ended, and a part snaps when "
+                              "the hand lets it go"),
+            std::string::npos)
+      << made->detail;
+}
+
 TEST(ScenarioReplay, ATraceOnADeviceClockIsNamedAsSuch) {
   // A trace whose times count from 1970 (device time) rather than from the
   // start of the run: too long without a duration, said with where it starts;
