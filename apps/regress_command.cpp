@@ -894,8 +894,13 @@ void check_baseline(const std::filesystem::path& baseline, const std::filesystem
                     const std::vector<std::filesystem::path>& files,
                     const std::filesystem::path& folder) {
   std::error_code ec;
-  const std::string make_one = " (make a baseline with 'dovetail regress " + folder.string() +
-                               " --out " + baseline.string() + "')";
+  // The scenarios' own folder is no place for reports: a folder of its own.
+  const bool in_scenarios = engine::same_file(baseline, folder);
+  const std::string make_one =
+      " (make a baseline with 'dovetail regress " + folder.string() + " --out " +
+      (in_scenarios ? (folder.parent_path() / "baseline").lexically_normal().string()
+                    : baseline.string()) +
+      "'" + (in_scenarios ? ", a folder of its own, then give it as --baseline)" : ")");
   if (!std::filesystem::exists(baseline, ec)) {
     throw InputError(baseline.string() + ": no such folder" + make_one);
   }
@@ -956,7 +961,14 @@ int regress_command(std::span<const std::string> argv) {
   }
   args.expect_positional(1, "a folder of scenarios");
   const std::filesystem::path folder = args.positional()[0];
-  if (!std::filesystem::is_directory(folder)) throw InputError(folder.string() + ": not a folder");
+  if (!std::filesystem::is_directory(folder)) {
+    std::error_code ec;
+    throw InputError(folder.string() + ": not a folder" +
+                     (std::filesystem::is_regular_file(folder, ec)
+                          ? " (regress runs every scenario of a folder; 'dovetail run " +
+                                folder.string() + "' runs one)"
+                          : std::string()));
+  }
   const std::filesystem::path out = args.value("out").value_or("regress-out");
   const auto parallel = static_cast<std::size_t>(args.integer("j", 1, 256).value_or(1));
   const int threads = static_cast<int>(args.integer("threads", 0, 1024).value_or(1));

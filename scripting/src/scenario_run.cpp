@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <lua.hpp>
 #include <map>
 #include <optional>
@@ -222,6 +223,34 @@ std::pair<std::string, std::string> ordered(const std::string& a, const std::str
 /// The glove's samples: the trace to replay when given, else the glove's
 /// trace or plan, with its noise. Errors name the file (and line) and, for
 /// the scenario's own file, the glove that asked for it.
+/// When a glove file of the other kind was given (a plan where a trace
+/// belongs, or a trace where a plan does), what to do instead; else empty.
+/// Judged by its first line that is not blank or a comment.
+std::string other_kind_of_glove_file(const std::filesystem::path& file, bool trace_expected) {
+  std::ifstream in(file, std::ios::binary);
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    line.erase(0, first);
+    break;
+  }
+  const std::string word = line.substr(0, line.find_first_of(" \t,\r"));
+  const bool plan = word == "start" || word == "reach" || word == "path" || word == "close" ||
+                    word == "open" || word == "wait";
+  const bool trace = line.rfind("t,", 0) == 0;
+  if (trace_expected && plan) {
+    return " (" + file.filename().string() +
+           " is a glove plan, which a scenario names as glove { plan = \"...\" }; a trace, "
+           "as replay, --trace and glove { trace = \"...\" } take, is a recorded CSV file)";
+  }
+  if (!trace_expected && trace) {
+    return " (" + file.filename().string() +
+           " is a glove trace, CSV, which a scenario names as glove { trace = \"...\" })";
+  }
+  return "";
+}
+
 std::shared_ptr<const interaction::GloveSource> glove_source(
     const Scenario& scenario, const std::optional<std::filesystem::path>& replay) {
   const GloveSpec glove = scenario.glove.value_or(GloveSpec{});
@@ -235,9 +264,15 @@ std::shared_ptr<const interaction::GloveSource> glove_source(
       source = std::make_shared<interaction::SimulatedGlove>(interaction::read_plan(glove.plan));
     }
   } catch (const std::exception& e) {
-    // The file's own message names it (and its line); say which glove asked for it.
-    throw ScenarioError(replay ? std::string(e.what())
-                               : glove.where.str() + ": glove: " + e.what());
+    // The file's own message names it (and its line); say which glove asked
+    // for it, and what to give when it is a file of the other kind.
+    const bool trace = replay || !glove.trace.empty();
+    const std::string hint = other_kind_of_glove_file(replay  ? *replay
+                                                      : trace ? glove.trace
+                                                              : glove.plan,
+                                                      trace);
+    throw ScenarioError(
+        (replay ? std::string(e.what()) : glove.where.str() + ": glove: " + e.what()) + hint);
   }
   if (glove.noise && !replay)
     source = std::make_shared<interaction::NoisyGlove>(source, *glove.noise);

@@ -300,6 +300,14 @@ dovetail_cli_test(regress_empty_shard EXIT 0 ARGS regress ${scenarios} --shard 1
                   STDERR "no scenarios in .* for this shard")
 dovetail_cli_test(regress_bad_shard EXIT 2 ARGS regress ${scenarios} --shard 3/2 STDERR "--shard must be K/N")
 dovetail_cli_test(regress_not_a_folder EXIT 1 ARGS regress ${out}/no_such_folder STDERR "not a folder")
+dovetail_cli_test(regress_a_scenario EXIT 1 ARGS regress ${scenarios}/01_peg_in_hole.lua
+                  STDERR "01_peg_in_hole.lua: not a folder \\(regress runs every scenario of a folder; 'dovetail run [^']*01_peg_in_hole.lua' runs one\\)")
+dovetail_cli_test(regress_baseline_is_scenarios EXIT 1
+                  ARGS regress ${scenarios} --baseline ${scenarios}
+                  STDERR "holds no report of a scenario in [^\n]*--out [^\n]*baseline', a folder of its own, then give it as --baseline\\)")
+dovetail_cli_test(replay_a_plan EXIT 1
+                  ARGS replay ${scenarios}/01_peg_in_hole.lua ${PROJECT_SOURCE_DIR}/assets/glove/peg_in_hole.plan
+                  STDERR "peg_in_hole.plan is a glove plan, which a scenario names as glove \\{ plan = \"...\" \\}; a trace, as replay, --trace and glove \\{ trace = \"...\" \\} take, is a recorded CSV file")
 
 # The shipped scenarios: every one passes, the same reports at 1, 2 and 8 threads, twice.
 add_test(NAME cli.regress_shipped_deterministic
