@@ -1472,8 +1472,14 @@ void Loader::read_glove(int index, const SourceLocation& outer) {
                                         : interaction::GraspType::kPower;
   }
   if (const Arg a = field(t, word, "hand_length", glove.where, "glove"); a.given) {
-    if (a.number < 0.12 || a.number > 0.26)
-      fail(glove.where, "glove: hand_length must be 120 to 260 mm");
+    if (a.number < 0.12 || a.number > 0.26) {
+      // In the scenario's units, as the number was given.
+      const double per_unit = scenario_.metres_per_unit;
+      fail(field_line(glove.where, "glove", "hand_length"),
+           "glove: hand_length must be " + brief(0.12 / per_unit) + " to " +
+               brief(0.26 / per_unit) + " " + scenario_.units + " (120 to 260 mm), not " +
+               brief(a.number / per_unit) + " " + scenario_.units);
+    }
     glove.hand_length = a.number;
   }
   raw_getfield(t, "noise");
@@ -1653,7 +1659,13 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
             note(clause.where, std::string(clause.word->name) + ": the scenario has no hand");
           break;
         }
-        check(arg.text, parts, "part");
+        if (scenario_.glove || hand_given_) {
+          std::vector<std::string> parts_and_hand = parts;  // "hnad": did you mean 'hand'?
+          parts_and_hand.emplace_back("hand");
+          check(arg.text, parts_and_hand, "part");
+        } else {
+          check(arg.text, parts, "part");
+        }
         break;
       case ArgType::kPart:
         if (arg.text == "hand" && !clause.word->params.empty() &&
@@ -1937,7 +1949,12 @@ void Loader::resolve() {
   for (const RegionSpec& r : scenario_.regions) {
     for (const std::string& p : r.region.parts) {
       if (p != "hand") {
-        check_part(p, r.where, "region '" + r.region.name + "'");
+        std::vector<std::string> parts_and_hand = parts;  // "hnad": did you mean 'hand'?
+        if (scenario_.glove || hand_given_) parts_and_hand.emplace_back("hand");
+        if (std::find(parts.begin(), parts.end(), p) == parts.end()) {
+          note(r.where, "region '" + r.region.name + "': no part '" + p + "'" +
+                            did_you_mean(p, parts_and_hand));
+        }
       } else if (!scenario_.glove && !hand_given_) {
         note(r.where, "region '" + r.region.name + "': the scenario has no hand");
       }

@@ -612,6 +612,37 @@ TEST(ScenarioRun, APlanLongerThanTheDurationIsAWarningAndTheRunEndsAtItsLastFram
   EXPECT_EQ(o.expectations[0].detail, "step 'insert' was never completed (run ended at t=1.000 s)");
 }
 
+TEST(ScenarioLoad, AHandMisspeltOrTooLongIsNamedInTheScenariosTerms) {
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "hand.plan", "start 0 0.2 0  1 0 0 0\nwait 0.1\n");
+  const std::string glove = "  hand = glove { plan = \"hand.plan\" },\n";
+  const std::string rule = load_error(
+      write(dir, "rule.lua",
+            moved_peg("    rule { when = touches(\"hnad\", \"peg\"), act = { log \"x\" } },", "",
+                      glove)));
+  EXPECT_NE(rule.find("rule.lua:17: touches: no part 'hnad' (did you mean 'hand'?)"),
+            std::string::npos)
+      << rule;
+  const std::string region = load_error(
+      write(dir, "region.lua",
+            moved_peg("", "",
+                      glove + "  regions = { r = region { min = { 0, 0, 0 }, max = { 1, 1, 1 }, "
+                              "parts = { \"hnad\" } } },\n")));
+  EXPECT_NE(region.find("region 'r': no part 'hnad' (did you mean 'hand'?)"), std::string::npos)
+      << region;
+  // A hand of 190 cm in a scenario in cm: the range in cm, and what was read.
+  const std::string cm =
+      load_error(write(dir, "cm.lua",
+                       std::regex_replace(moved_peg("", "",
+                                                    "  hand = glove { plan = \"hand.plan\",\n"
+                                                    "    hand_length = 190 },\n"),
+                                          std::regex("units = \"mm\""), "units = \"cm\"")));
+  EXPECT_NE(
+      cm.find("cm.lua:23: glove: hand_length must be 12 to 26 cm (120 to 260 mm), not 190 cm"),
+      std::string::npos)
+      << cm;
+}
+
 TEST(ScenarioLoad, AShapeTooLargeOrTooSmallIsNamedAtItsLine) {
   const test::TempDir dir("dovetail_scenario");
   const auto shape = [&](const std::string& name, const std::string& text) {
