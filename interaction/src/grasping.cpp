@@ -479,6 +479,13 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
     return;
   }
 
+  // And the hand must have closed lately while the grasp built up: an open or
+  // still hand moved against a part (drawn back along a rod it just let go
+  // of, or slid along a bar with the glove's noise on every joint) grasps
+  // nothing. A closing hand sweeps tens of degrees of total flexion in a
+  // quarter second; the smoothed noise of a still one rises by more than
+  // kMinClosing about once in 10^4 frames at 1.5 degrees a joint.
+  constexpr Real kMinClosing = 10;  // degrees of total flexion, smoothed, within kClosingWindow_s
   // Grasp onset: the same part and type for onset_frames frames while the hand closes.
   std::optional<GraspType> found;
   std::string found_part;
@@ -496,8 +503,10 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
         segments.push_back(c.segment);
       }
     }
-    if (Attempt& best = attempts_[scene.name(part)]; segments.size() > best.touching.size()) {
-      best = {t, std::move(segments), type};
+    const bool closing_now = closed_lately >= kMinClosing;
+    if (Attempt& best = attempts_[scene.name(part)];
+        std::pair(closing_now, segments.size()) > std::pair(best.closing, best.touching.size())) {
+      best = {t, std::move(segments), type, closing_now};
     }
     if (type) {
       found = type;
@@ -543,13 +552,6 @@ void Grasping::update(engine::Simulation& simulation, std::uint64_t frame, Real 
   last_digit_flexion_ = digit_flexion;
   // The grasp holds for onset_frames; its type is taken once the hand stops closing
   // (or after four times as long), so that the last fingers to arrive count.
-  // And the hand must have closed lately while the grasp built up: an open or
-  // still hand moved against a part (drawn back along a rod it just let go
-  // of, or slid along a bar with the glove's noise on every joint) grasps
-  // nothing. A closing hand sweeps tens of degrees of total flexion in a
-  // quarter second; the smoothed noise of a still one rises by more than
-  // kMinClosing about once in 10^4 frames at 1.5 degrees a joint.
-  constexpr Real kMinClosing = 10;  // degrees of total flexion, smoothed, within kClosingWindow_s
   if (found && found_part == candidate_ && candidate_frames_ >= settings_.grasp.onset_frames &&
       candidate_closing_ >= kMinClosing &&
       (!still_closing || candidate_frames_ >= 4 * settings_.grasp.onset_frames)) {
@@ -799,6 +801,11 @@ std::string Grasping::why_not_grasped(const std::string& part) const {
     why = "they made a " + std::string(grasp_type_name(*a.type)) +
           " grasp, but the hand was not closing (a grasp needs the glove's flexion to rise by "
           "10 degrees within a quarter second while it builds up)";
+  } else if (!a.closing) {
+    why =
+        "the hand was not closing then, and it touched less of it while it closed (a grasp "
+        "needs the glove's flexion to rise by 10 degrees within a quarter second while it "
+        "builds up)";
   } else if (!palm && !thumb_tip) {
     why = "neither the palm (within " +
           std::to_string(static_cast<int>(std::round(settings_.grasp.palm_gap * 1000))) +

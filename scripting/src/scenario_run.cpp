@@ -357,6 +357,9 @@ class Runner {
   /// Why a mate never snapped, for its expectation: a refused snap, or how
   /// close its part came to its place against the tolerances.
   std::string why_not_snapped(const MateSpec& mate) const;
+  /// For a grasp never made: the other parts the hand touched at its closest
+  /// try at `part` (a table under a bar stops the fingers), or empty.
+  std::string also_touched_then(const std::string& part) const;
   void evaluate_expectations();
   /// Draws the scene to `path`: the frames of --every from one camera, fitted
   /// to the first; the final picture from one fitted to the final scene (so
@@ -1013,6 +1016,31 @@ std::string overlapper(const interaction::RefusedSnap& r) {
   return r.overlapping == r.part ? "it" : "'" + r.overlapping + "', moved with it,";
 }
 
+std::string Runner::also_touched_then(const std::string& part) const {
+  const std::optional<double> when = grasping_->closest_try_time(part);
+  if (!when) return "";
+  // The hand's contacts with other parts at that time, from the timeline.
+  std::map<std::string, std::set<std::string>> touching;  // part -> segments
+  for (const engine::Event& e : sim_->report().events) {
+    if (e.time > *when + 1e-9) break;
+    if (e.b == part) continue;
+    const std::string segment = e.a.substr(e.a.find('.') + 1);
+    if (e.kind == EventKind::kHandContactBegin) touching[e.b].insert(segment);
+    if (e.kind == EventKind::kHandContactEnd) {
+      touching[e.b].erase(segment);
+      if (touching[e.b].empty()) touching.erase(e.b);
+    }
+  }
+  if (touching.empty()) return "";
+  std::string text;
+  for (const auto& [other, segments] : touching) {
+    std::string list;
+    for (const std::string& s : segments) list += (list.empty() ? "" : ", ") + s;
+    text += (text.empty() ? "" : " and ") + ("'" + other + "' (" + list + ")");
+  }
+  return "; then the hand touched " + text + " too, and a finger stops at the first part it meets";
+}
+
 std::string Runner::why_not_snapped(const MateSpec& m) const {
   if (grasping_) {
     const auto& refused = grasping_->refused_snaps();
@@ -1379,8 +1407,9 @@ void Runner::evaluate_expectations() {
         e.detail =
             "'" + args[0].text + "' was never grasped as " + args[1].text +
             (other ? "; it was grasped as " + other->b + " at t=" + format_time(other->time) + " s"
-             : grasping_ ? "; " + grasping_->why_not_grasped(args[0].text)
-                         : std::string());
+             : grasping_
+                 ? "; " + grasping_->why_not_grasped(args[0].text) + also_touched_then(args[0].text)
+                 : std::string());
       }
     }
     out_.expectations.push_back(std::move(e));

@@ -407,8 +407,10 @@ std::vector<Word> make_vocabulary() {
        WordKind::kExpectation,
        {{"part", kPart, kRequired, "the part"}, {"type", kGraspType, kRequired, "the grasp type"}},
        "The hand grasps the part with this grasp type at some time. Failed, it says the "
-       "hand's closest try: the moment most of the hand touched the part, what touched it, and "
-       "what the grasp lacked (the palm within 2 mm, a finger opposing it, the hand closing).",
+       "hand's closest try: the moment most of the hand touched the part (while the hand "
+       "closed, if it touched it then), what touched it, what the grasp lacked (the palm "
+       "within 2 mm, a finger opposing it, the hand closing) and the other parts the hand "
+       "touched then, which stop the fingers they meet (a table under a bar).",
        "grasped_as(\"pin\", \"precision\")"});
   return w;
 }

@@ -1512,6 +1512,36 @@ TEST(ScenarioRun, AHandClosingOnABarGraspsItWhereverThePalmLiesOnIt) {
   EXPECT_EQ(grasped, tried);
 }
 
+TEST(ScenarioRun, AGraspNeverMadeNamesThePartsThatStoppedTheFingers) {
+  // A fist closed over a bar lying on a table: the ring and little fingers'
+  // tips stop on the table, and the hand, carried on, grasps nothing. The
+  // failure names the table beside what touched the bar.
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "fist.plan",
+        "start 0 0.090 0.065  1 0 0 0 open\n"
+        "reach 1.0  0 0.051 0.065  1 0 0 0\n"
+        "close 0.5 fist\n"
+        "reach 1.5  0.150 0.080 0.065  1 0 0 0\n");
+  const RunOutcome o = run_scenario(write(dir, "fist.lua", R"(return scenario {
+  name = "bar on a table", units = "mm",
+  parts = {
+    table = part { shape = box { size = { 1000, 1000, 1000 } }, at = { 0, -500, 0 }, fixed = true },
+    bar = part { shape = cylinder { diameter = 40, length = 80 }, at = { -40, 20.5, 0 },
+                 turn = { y = 90 } },
+  },
+  hand = glove { plan = "fist.plan" },
+  expect = { grasped_as("bar", "power") },
+})"));
+  ASSERT_EQ(o.status, RunOutcome::Status::kFailed) << o.failure_summary() << o.error;
+  ASSERT_EQ(o.expectations.size(), 1u);
+  const std::string& detail = o.expectations[0].detail;
+  EXPECT_NE(detail.find("the most of the hand that touched it was at t="), std::string::npos)
+      << detail;
+  EXPECT_NE(detail.find("; then the hand touched 'table' ("), std::string::npos) << detail;
+  EXPECT_NE(detail.find(") too, and a finger stops at the first part it meets"), std::string::npos)
+      << detail;
+}
+
 TEST(ScenarioRun, AGraspNeverMadeIsExplainedByTheHandsClosestTry) {
   // A hand 5 mm too high wraps its fingers round the bar without its palm
   // on it; one far above never touches it. The failure says which.

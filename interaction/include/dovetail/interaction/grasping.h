@@ -197,6 +197,11 @@ class Grasping {
   /// touched and what the grasp lacked ("at t=1.240 s the palm and index
   /// touched it, but ..."), or that it never touched it.
   std::string why_not_grasped(const std::string& part) const;
+  /// The time of why_not_grasped's try at the part, if the hand touched it.
+  std::optional<Real> closest_try_time(const std::string& part) const {
+    const auto it = attempts_.find(part);
+    return it == attempts_.end() ? std::nullopt : std::optional<Real>(it->second.time);
+  }
 
  private:
   struct Models;
@@ -311,11 +316,13 @@ class Grasping {
   InteractionStats stats_{};
   std::vector<RefusedSnap> refused_snaps_;
   /// Per part: the frame in which most hand segments touched it while the
-  /// hand held nothing, for why_not_grasped.
+  /// hand held nothing, for why_not_grasped; one while the hand was closing
+  /// comes before any while it was not (which could grasp nothing).
   struct Attempt {
     Real time = 0;
     std::vector<Segment> touching;
     std::optional<GraspType> type;  ///< the grasp the contacts made, if any
+    bool closing = false;           ///< the hand had closed enough lately to grasp
   };
   std::map<std::string, Attempt> attempts_;
 };
