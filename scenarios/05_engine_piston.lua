@@ -25,6 +25,7 @@ return scenario {
   parts = {
     engine = part {
       mesh = "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
+      units = "mm",  -- its numbers are millimetres, though glTF's are metres by its specification
       fixed = true, color = { 0.45, 0.6, 0.3 },  -- 743 x 273 x 268 mm, its base at y = -181
       open_surface = true,  -- its tessellation has cracks (13,308 open edges); nothing touches it
     },

@@ -262,6 +262,7 @@ class Loader {
   void warn_about_open_surfaces();
   void warn_about_overlapping_parts();
   void warn_about_dropped_declarations();
+  void warn_about_gltf_units();
   /// The part of that name, or null.
   const PartSpec* part_named(const std::string& name) const {
     for (const PartSpec& p : scenario_.parts) {
@@ -1603,8 +1604,14 @@ void Loader::read_rules(int list, const SourceLocation& where) {
     }
     if (rule.act.empty()) fail(rule.where, what + ": act lists no action");
     lua_pop(L_, 1);
-    if (const Arg a = field(t, word, "cooldown", rule.where, what); a.given)
+    // The cooldown keeps a flickering contact from firing a rule frame after
+    // frame; a timer's ticks are exact, and are kept from one another only
+    // by a cooldown given.
+    if (const Arg a = field(t, word, "cooldown", rule.where, what); a.given) {
       rule.cooldown = a.number;
+    } else if (rule.when.word->name == "every" || rule.when.word->name == "after") {
+      rule.cooldown = 0;
+    }
     rule.once = field(t, word, "once", rule.where, what).number != 0;
     lua_pop(L_, 2);
     scenario_.rules.push_back(std::move(rule));
@@ -1766,6 +1773,31 @@ void Loader::warn_about_dropped_declarations() {
                                    "scenario's " +
                                    word + "s (is its name given twice?)");
     }
+  }
+}
+
+/// A glTF file is in metres by its specification: read without `units` in
+/// a scenario in millimetres or centimetres, its numbers are taken as the
+/// scenario's, a thousandth or a hundredth of the size meant (a 1 m table
+/// becomes 1 mm), which the size warnings miss among parts of any size.
+/// Some exporters write millimetres; `units` says which.
+void Loader::warn_about_gltf_units() {
+  if (scenario_.metres_per_unit == 1) return;
+  for (const PartSpec& p : scenario_.parts) {
+    if (p.file.empty() || !p.file_units.empty() || !p.mesh) continue;
+    std::string extension = std::filesystem::path(p.file).extension().string();
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (extension != ".gltf" && extension != ".glb") continue;
+    Eigen::AlignedBox<double, 3> box;
+    for (const Vec3& v : p.mesh->vertices) box.extend(v);
+    const double across = box.diagonal().norm() / scenario_.metres_per_unit;  // its numbers
+    scenario_.warnings.push_back(
+        p.where.str() + ": part '" + p.name + "' (" + p.file +
+        "): a glTF file is in metres by its specification, but its numbers are read in " +
+        scenario_.units + ", as the scenario's: " + brief(across) + " " + scenario_.units +
+        " across, where in metres it is " + brief(across) +
+        " m; give the part units = \"m\", or units = \"" + scenario_.units +
+        "\" if the file is in " + scenario_.units);
   }
 }
 
@@ -1988,6 +2020,7 @@ void Loader::resolve() {
   warn_about_open_surfaces();
   if (noted_.empty()) warn_about_overlapping_parts();
   warn_about_dropped_declarations();
+  warn_about_gltf_units();
   if (scenario_.glove && !scenario_.glove->holding.empty()) {
     check_part(scenario_.glove->holding, scenario_.glove->where, "glove: holding");
     if (fixed(scenario_.glove->holding)) {
@@ -2051,6 +2084,11 @@ void Loader::resolve() {
   for (const RuleSpec& r : scenario_.rules) {
     resolve_clause(r.when, names);
     can_never(r.when, "rule: ");
+    if (r.when.word->name == "every" && r.when.args[0].number < r.cooldown - 1e-9) {
+      scenario_.warnings.push_back(r.when.where.str() + ": rule: " + r.when.text +
+                                   " fires at most once every " + format_number(r.cooldown) +
+                                   " s, the rule's cooldown: not at every tick");
+    }
     if (r.unless) resolve_clause(*r.unless, names);
     if (r.only_if) {
       resolve_clause(*r.only_if, names);

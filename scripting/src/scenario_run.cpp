@@ -949,11 +949,14 @@ bool Runner::timer_fires(const Clause& when, double now, double previous) const 
   if (past_end_) return false;  // the frame that finishes the last one's actions
   const std::string_view w = when.word->name;
   const double t = when.args[0].number;
-  if (w == "after") return now >= t && previous < t;
+  // A frame's time is its number times the step, rounded: 27 * (1/90) may
+  // fall a rounding short of 0.3. Within kRounding of a time is at it.
+  constexpr double kRounding = 1e-9;
+  if (w == "after") return now >= t - kRounding && previous < t - kRounding;
   if (w == "every") {
     if (!(t > 0)) return false;
-    const double k = std::floor(now / t);
-    return k >= 1 && k > std::floor(previous / t);
+    const double k = std::floor((now + kRounding) / t);
+    return k >= 1 && k > std::floor((previous + kRounding) / t);
   }
   return false;
 }
@@ -1220,7 +1223,7 @@ void Runner::end_frame(const engine::FrameResult& result, double previous_time) 
                                    [&](const Occurrence& o) { return matches(rule.when, o); });
     if (!fired) continue;
     if (rule.once && rule_last_[r]) continue;
-    if (rule_last_[r] && now - *rule_last_[r] < rule.cooldown) continue;
+    if (rule_last_[r] && now - *rule_last_[r] < rule.cooldown - 1e-9) continue;
     if (rule.unless && holds(*rule.unless)) continue;
     if (rule.only_if && !holds(*rule.only_if)) continue;
     rule_last_[r] = now;

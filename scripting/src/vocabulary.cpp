@@ -114,17 +114,18 @@ std::vector<Word> make_vocabulary() {
        "An assembly step. Steps are done in order; completing one before the step "
        "before it is recorded as out of order.",
        "step { \"insert\", \"Push the peg into the block\", done = mated \"peg_in_hole\" }"});
-  w.push_back(
-      {"rule",
-       WordKind::kDeclaration,
-       {{"when", kWord, kRequired, "the event"},
-        {"unless", kWord, kOptional, "a state that stops the rule"},
-        {"only_if", kWord, kOptional, "a state that must hold"},
-        {"act", kList, kRequired, "actions, done at the start of the next frame"},
-        {"cooldown", kSeconds, kOptional, "seconds before the rule can fire again (default 0.1)"},
-        {"once", kFlag, kOptional, "true: fire at most once"}},
-       "When the event happens (and the states allow), do the actions.",
-       "rule { when = touches(\"peg\", \"block\"), act = { highlight \"block\" } }"});
+  w.push_back({"rule",
+               WordKind::kDeclaration,
+               {{"when", kWord, kRequired, "the event"},
+                {"unless", kWord, kOptional, "a state that stops the rule"},
+                {"only_if", kWord, kOptional, "a state that must hold"},
+                {"act", kList, kRequired, "actions, done at the start of the next frame"},
+                {"cooldown", kSeconds, kOptional,
+                 "seconds before the rule can fire again (default 0.1, or 0 for a rule on after or "
+                 "every)"},
+                {"once", kFlag, kOptional, "true: fire at most once"}},
+               "When the event happens (and the states allow), do the actions.",
+               "rule { when = touches(\"peg\", \"block\"), act = { highlight \"block\" } }"});
   w.push_back({"region",
                WordKind::kDeclaration,
                {{"min", kVector, kRequired, "lowest corner"},
@@ -236,9 +237,8 @@ std::vector<Word> make_vocabulary() {
        WordKind::kEvent,
        {{"seconds", kSeconds, kRequired, "the period, > 0"}},
        "In the first frame at or after each multiple of the period, t = p, 2p, ... (not at 0): "
-       "once a frame for a period shorter than the time step. "
-       "A rule fires at most once per its cooldown (default 0.1 s): for a shorter period give "
-       "the rule cooldown = 0.",
+       "once a frame for a period shorter than the time step. A rule on it fires at every "
+       "tick, unless it is given a cooldown longer than the period.",
        "every(1)"});
   w.push_back({"arrives",
                WordKind::kEvent,

@@ -643,6 +643,42 @@ TEST(ScenarioLoad, AHandMisspeltOrTooLongIsNamedInTheScenariosTerms) {
       << cm;
 }
 
+TEST(ScenarioRun, EveryTicksAtEachMultipleOfItsPeriod) {
+  // Frame 27's time, 27 * (1/90), falls a rounding short of 0.3: the tick of
+  // every(0.1) there came a frame late, and the default cooldown of 0.1 s then
+  // kept the next tick from firing.
+  const test::TempDir dir("dovetail_scenario");
+  const auto file = write(dir, "ticks.lua", R"(return scenario {
+  name = "ticks", units = "mm", duration = 3,
+  parts = { a = part { shape = box { size = { 10, 10, 10 } } } },
+  rules = {
+    rule { when = every(0.1), act = { log "tick" } },
+    rule { when = after(0.3), act = { log "after" } },
+    rule { when = every(0.05), cooldown = 0.1, act = { log "slow" } },
+  },
+})");
+  const Scenario checked = check_scenario(file);
+  ASSERT_EQ(checked.warnings.size(), 1u);
+  EXPECT_NE(checked.warnings[0].find("ticks.lua:7: rule: every(0.05) fires at most once every "
+                                     "0.1 s, the rule's cooldown: not at every tick"),
+            std::string::npos)
+      << checked.warnings[0];
+  const RunOutcome o = run_scenario(file);
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.error;
+  std::vector<double> ticks;
+  std::optional<double> after;
+  for (const Message& m : o.messages) {
+    if (m.text == "tick") ticks.push_back(m.time);
+    if (m.text == "after") after = m.time;
+  }
+  ASSERT_EQ(ticks.size(), 30u);
+  for (std::size_t k = 0; k < ticks.size(); ++k) {
+    EXPECT_NEAR(ticks[k], 0.1 * static_cast<double>(k + 1), 1e-9) << k;
+  }
+  ASSERT_TRUE(after);
+  EXPECT_EQ(*after, ticks[2]);
+}
+
 TEST(ScenarioLoad, AShapeTooLargeOrTooSmallIsNamedAtItsLine) {
   const test::TempDir dir("dovetail_scenario");
   const auto shape = [&](const std::string& name, const std::string& text) {
@@ -1905,6 +1941,32 @@ TEST(ScenarioRun, RegionsTimersAttachAndCompletedEventsAsDescribed) {
   ASSERT_TRUE(o.steps[0].done_at);
   EXPECT_GT(*o.steps[0].done_at, 0.2);
   EXPECT_LT(*o.steps[0].done_at, 0.3);
+}
+
+TEST(ScenarioLoad, AGltfFileReadInMillimetresWithoutItsUnitsIsAWarning) {
+  // glTF is in metres by its specification; this one's numbers are
+  // millimetres, which a part says with units = "mm".
+  const std::string engine =
+      "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+  if (!std::filesystem::exists(engine))
+    GTEST_SKIP() << engine << " (assimp-testmodels) is not installed";
+  const test::TempDir dir("dovetail_scenario");
+  const auto scenario = [&](const char* name, const std::string& units) {
+    return check_scenario(write(dir, name,
+                                "return scenario {\n  name = \"g\", units = \"mm\",\n  parts = "
+                                "{\n    engine = part { mesh = \"" +
+                                    engine + "\", open_surface = true" + units + " },\n  },\n}\n"));
+  };
+  const Scenario unsaid = scenario("unsaid.lua", "");
+  ASSERT_EQ(unsaid.warnings.size(), 1u);
+  EXPECT_NE(unsaid.warnings[0].find(
+                "unsaid.lua:4: part 'engine' (" + engine +
+                "): a glTF file is in metres by its specification, but its numbers are read in "
+                "mm, as the scenario's: 836 mm across, where in metres it is 836 m; give the part "
+                "units = \"m\", or units = \"mm\" if the file is in mm"),
+            std::string::npos)
+      << unsaid.warnings[0];
+  EXPECT_TRUE(scenario("said.lua", ", units = \"mm\"").warnings.empty());
 }
 
 TEST(ScenarioLoad, NodesOfAMeshFileBecomeTheirOwnParts) {
