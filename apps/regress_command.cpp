@@ -898,7 +898,7 @@ void check_baseline(const std::filesystem::path& baseline, const std::filesystem
   const bool in_scenarios = engine::same_file(baseline, folder);
   const std::string make_one =
       " (make a baseline with 'dovetail regress " + folder.string() + " --out " +
-      (in_scenarios ? (folder.parent_path() / "baseline").lexically_normal().string()
+      (in_scenarios ? (folder / ".." / "baseline").lexically_normal().string()
                     : baseline.string()) +
       "'" + (in_scenarios ? ", a folder of its own, then give it as --baseline)" : ")");
   if (!std::filesystem::exists(baseline, ec)) {

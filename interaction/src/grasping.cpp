@@ -797,15 +797,19 @@ std::string Grasping::why_not_grasped(const std::string& part) const {
   char when[48];
   std::snprintf(when, sizeof when, "at t=%.3f s", a.time);
   std::string why;
-  if (a.type) {
+  constexpr const char* kClosingNeeded =
+      "a grasp needs the glove's flexion to rise by 10 degrees within a quarter second while it "
+      "builds up";
+  if (a.type && !a.closing) {
     why = "they made a " + std::string(grasp_type_name(*a.type)) +
-          " grasp, but the hand was not closing (a grasp needs the glove's flexion to rise by "
-          "10 degrees within a quarter second while it builds up)";
+          " grasp, but the hand was not closing (" + kClosingNeeded + ")";
+  } else if (a.type) {
+    why = "they made a " + std::string(grasp_type_name(*a.type)) +
+          " grasp as the hand closed, but not for the " +
+          std::to_string(settings_.grasp.onset_frames) +
+          " frames in a row a grasp needs while it builds up";
   } else if (!a.closing) {
-    why =
-        "the hand was not closing then, and it touched less of it while it closed (a grasp "
-        "needs the glove's flexion to rise by 10 degrees within a quarter second while it "
-        "builds up)";
+    why = "the hand never touched it while closing (" + std::string(kClosingNeeded) + ")";
   } else if (!palm && !thumb_tip) {
     why = "neither the palm (within " +
           std::to_string(static_cast<int>(std::round(settings_.grasp.palm_gap * 1000))) +
@@ -822,7 +826,7 @@ std::string Grasping::why_not_grasped(const std::string& part) const {
         "the thumb's tip did not oppose the index's or middle's (their contacts within the "
         "friction cones)";
   }
-  return "the most of the hand that touched it was " + std::string(when) + ": " + names + "; " +
+  return "the hand's closest try was " + std::string(when) + ", touching it with " + names + "; " +
          why;
 }
 

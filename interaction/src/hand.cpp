@@ -156,7 +156,7 @@ void Hand::merge_region_events(std::vector<engine::Event>& events) {
     const auto it = changed.try_emplace(e.b, inside, inside).first;
     if (e.kind == engine::EventKind::kRegionEnter) {
       ++inside;
-    } else {
+    } else if (inside > 0) {  // a leave without its enter (a region added later) counts none
       --inside;
     }
     it->second.second = inside;

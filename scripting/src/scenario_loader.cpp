@@ -18,7 +18,6 @@
 #include <lua.hpp>
 #include <map>
 #include <numbers>
-#include <regex>
 #include <set>
 #include <sstream>
 
@@ -83,8 +82,9 @@ int where_function(lua_State* L) {
 int unknown_global(lua_State* L) {
   if (lua_type(L, 2) != LUA_TSTRING) return 0;
   char message[512];
-  {
-    const std::string name(lua_tostring(L, 2));
+  const char* key = lua_tostring(L, 2);
+  try {
+    const std::string name(key);
     std::vector<std::string> words;
     for (const Word& w : vocabulary()) words.emplace_back(w.name);
     std::string hint = did_you_mean(name, words);
@@ -92,6 +92,8 @@ int unknown_global(lua_State* L) {
       hint = " (a name is given in quotes, \"" + name + "\"; true and false without)";
     }
     std::snprintf(message, sizeof message, "unknown name '%s'%s", name.c_str(), hint.c_str());
+  } catch (...) {  // no exception may cross Lua's C frames
+    std::snprintf(message, sizeof message, "unknown name '%s'", key);
   }  // no C++ object lives on past here: lua_error does not return
   luaL_where(L, 1);
   lua_pushstring(L, message);
@@ -102,6 +104,40 @@ int unknown_global(lua_State* L) {
 /// The declarations whose tables are keyed by name: the same name given
 /// twice in one table leaves only the later, without a word from Lua.
 constexpr std::array<const char*, 3> kNamedDeclarations = {"part", "mate", "region"};
+
+/// The name a line gives the first declaration of `word` on it, `peg` in
+/// `peg = part {` or `["peg"] = part {`; empty when it gives none.
+std::string declared_name(const std::string& line, std::string_view word) {
+  const auto name_char = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_';
+  };
+  for (std::size_t at = line.find(word); at != std::string::npos; at = line.find(word, at + 1)) {
+    const std::size_t end = at + word.size();
+    if ((at > 0 && name_char(line[at - 1])) || (end < line.size() && name_char(line[end]))) {
+      continue;  // part of a longer name
+    }
+    std::size_t i = at;
+    while (i > 0 && line[i - 1] == ' ') --i;
+    if (i == 0 || line[i - 1] != '=') continue;
+    --i;
+    while (i > 0 && line[i - 1] == ' ') --i;
+    if (i > 0 && line[i - 1] == ']') {  // ["name"]
+      --i;
+      while (i > 0 && line[i - 1] == ' ') --i;
+      if (i == 0 || line[i - 1] != '"') continue;
+      const std::size_t close = --i;
+      const std::size_t open = line.rfind('"', close == 0 ? 0 : close - 1);
+      if (open == std::string::npos || open == close) continue;
+      return line.substr(open + 1, close - open - 1);
+    }
+    std::size_t from = i;
+    while (from > 0 && name_char(line[from - 1])) --from;
+    if (from < i && std::isdigit(static_cast<unsigned char>(line[from])) == 0) {
+      return line.substr(from, i - from);
+    }
+  }
+  return "";
+}
 
 /// The line of the file's last `return scenario` outside a comment: where
 /// a scenario returned directly was declared. Lua keeps no line for it (the
@@ -167,13 +203,19 @@ std::string brief(double x) {
 }
 
 /// Of "mm", "cm" and "m", the unit in which numbers read in `units` as
-/// `metres` would give the size nearest `target` metres (by ratio).
+/// `metres` would give the size nearest `target` metres (by ratio), among
+/// those a hundred times or more from `units` (the size warnings fire at
+/// hundreds of times: a factor of 10, mm for cm, cannot be the cause); or
+/// `units` when none comes nearer.
 std::string likely_units(double metres, const std::string& units, double target) {
-  const double numbers = metres / engine::metres_per_unit(units).value_or(1);
+  const double per_unit = engine::metres_per_unit(units).value_or(1);
+  const double numbers = metres / per_unit;
   std::string best = units;
-  double best_error = std::numeric_limits<double>::infinity();
+  double best_error = std::abs(std::log(metres / target));
   for (const char* unit : {"mm", "cm", "m"}) {
-    const double error = std::abs(std::log(numbers * *engine::metres_per_unit(unit) / target));
+    const double other = *engine::metres_per_unit(unit);
+    if (std::max(other, per_unit) / std::min(other, per_unit) < 100) continue;
+    const double error = std::abs(std::log(numbers * other / target));
     if (error < best_error) {
       best = unit;
       best_error = error;
@@ -1478,7 +1520,8 @@ void Loader::read_glove(int index, const SourceLocation& outer) {
       const double per_unit = scenario_.metres_per_unit;
       fail(field_line(glove.where, "glove", "hand_length"),
            "glove: hand_length must be " + brief(0.12 / per_unit) + " to " +
-               brief(0.26 / per_unit) + " " + scenario_.units + " (120 to 260 mm), not " +
+               brief(0.26 / per_unit) + " " + scenario_.units +
+               (scenario_.units == "mm" ? "" : " (120 to 260 mm)") + ", not " +
                brief(a.number / per_unit) + " " + scenario_.units);
     }
     glove.hand_length = a.number;
@@ -1750,10 +1793,7 @@ void Loader::warn_about_dropped_declarations() {
     // The name it was given, from its line: `name = part {` or `["name"] = part {`.
     std::string name;
     if (where.file == file_ && where.line <= static_cast<int>(lines.size())) {
-      std::smatch m;
-      const std::regex named("(?:([A-Za-z_][A-Za-z0-9_]*)|\\[\\s*\"([^\"]*)\"\\s*\\])\\s*=\\s*" +
-                             std::string(word) + "\\b");
-      if (std::regex_search(lines[where.line - 1], m, named)) name = m[1].matched ? m[1] : m[2];
+      name = declared_name(lines[where.line - 1], word);
     }
     const SourceLocation* kept = nullptr;
     for (const PartSpec& p : scenario_.parts)
@@ -1853,6 +1893,9 @@ void Loader::warn_about_mesh_sizes() {
 /// set; warn_about_mesh_sizes, which compares parts with each other, misses it.
 void Loader::warn_about_parts_beside_the_hand() {
   if (!scenario_.glove) return;
+  // What a hand assembles is mostly of a few centimetres: the units to offer
+  // are those that bring the parts nearest that, not the hand's length.
+  constexpr double kTypicalPart_m = 0.05;
   std::vector<double> sizes;
   std::set<std::string> file_units;
   for (const PartSpec& p : scenario_.parts) {
@@ -1886,7 +1929,8 @@ void Loader::warn_about_parts_beside_the_hand() {
       brief(hand / per_unit) + " " + units + "): are the files in other units?" +
       (file_units.size() == 1
            ? " " + units_hint("Their", *file_units.begin(),
-                              likely_units(median, *file_units.begin(), hand), "the parts")
+                              likely_units(median, *file_units.begin(), kTypicalPart_m),
+                              "the parts")
            : std::string()));
 }
 
@@ -1966,11 +2010,13 @@ void Loader::resolve() {
     }
     return false;
   };
+  // With or_hand, "hand" is among the names suggested ("hnad": did you mean 'hand'?).
   auto check_part = [&](const std::string& name, const SourceLocation& where,
-                        const std::string& what) {
-    if (std::find(parts.begin(), parts.end(), name) == parts.end()) {
-      note(where, what + ": no part '" + name + "'" + did_you_mean(name, parts));
-    }
+                        const std::string& what, bool or_hand = false) {
+    if (std::find(parts.begin(), parts.end(), name) != parts.end()) return;
+    std::vector<std::string> known = parts;
+    if (or_hand && (scenario_.glove || hand_given_)) known.emplace_back("hand");
+    note(where, what + ": no part '" + name + "'" + did_you_mean(name, known));
   };
   for (const MateSpec& m : scenario_.mates) {
     check_part(m.mate.part, field_line(m.where, "mate", "part"), "mate '" + m.mate.name + "'");
@@ -1981,12 +2027,7 @@ void Loader::resolve() {
   for (const RegionSpec& r : scenario_.regions) {
     for (const std::string& p : r.region.parts) {
       if (p != "hand") {
-        std::vector<std::string> parts_and_hand = parts;  // "hnad": did you mean 'hand'?
-        if (scenario_.glove || hand_given_) parts_and_hand.emplace_back("hand");
-        if (std::find(parts.begin(), parts.end(), p) == parts.end()) {
-          note(r.where, "region '" + r.region.name + "': no part '" + p + "'" +
-                            did_you_mean(p, parts_and_hand));
-        }
+        check_part(p, r.where, "region '" + r.region.name + "'", true);
       } else if (!scenario_.glove && !hand_given_) {
         note(r.where, "region '" + r.region.name + "': the scenario has no hand");
       }
@@ -2041,21 +2082,23 @@ void Loader::resolve() {
   }
   auto can_never = [&](const Clause& c, const std::string& context) {
     const std::string_view w = c.word->name;
+    // An event never happens; a state never holds.
+    const std::string never =
+        c.text + (c.word->kind == WordKind::kState ? " can never hold: " : " can never happen: ");
     if ((w == "touches" || w == "separates" || w == "touching" || w == "no_contact") &&
         c.args[0].text != "hand" && fixed(c.args[0].text) && fixed(c.args[1].text)) {
-      scenario_.warnings.push_back(c.where.str() + ": " + context + c.text +
-                                   " can never happen: '" + c.args[0].text + "' and '" +
-                                   c.args[1].text + "' are both fixed");
+      scenario_.warnings.push_back(c.where.str() + ": " + context + never + "'" + c.args[0].text +
+                                   "' and '" + c.args[1].text + "' are both fixed");
     }
     if ((w == "touches" || w == "separates" || w == "touching") &&
         c.args[0].text == c.args[1].text) {
-      scenario_.warnings.push_back(c.where.str() + ": " + context + c.text +
-                                   " can never happen: a part does not touch itself");
+      scenario_.warnings.push_back(c.where.str() + ": " + context + never +
+                                   "a part does not touch itself");
     }
     if ((w == "grasped" || w == "released" || w == "holding" || w == "slides" ||
          w == "grasped_as") &&
         (fixed(c.args[0].text) || !(scenario_.glove || hand_given_))) {
-      scenario_.warnings.push_back(c.where.str() + ": " + context + c.text + " can never happen: " +
+      scenario_.warnings.push_back(c.where.str() + ": " + context + never +
                                    (fixed(c.args[0].text)
                                         ? "'" + c.args[0].text + "' is fixed"
                                         : std::string("the scenario has no hand")));
@@ -2069,9 +2112,8 @@ void Loader::resolve() {
         }
         std::string list;
         for (const std::string& p : watched) list += (list.empty() ? "'" : ", '") + p + "'";
-        scenario_.warnings.push_back(c.where.str() + ": " + context + c.text +
-                                     " can never happen: region '" + r.region.name +
-                                     "' watches only " + list);
+        scenario_.warnings.push_back(c.where.str() + ": " + context + never + "region '" +
+                                     r.region.name + "' watches only " + list);
       }
     }
   };

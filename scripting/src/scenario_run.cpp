@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <lua.hpp>
 #include <map>
 #include <optional>
@@ -177,8 +176,8 @@ std::vector<std::string> glove_warnings(const Scenario& scenario, const GloveSpe
                   "from the start of the run: shift them to start at 0)");
   }
   // A plan cut short by the scenario's duration: the hand stops where it is.
-  if (trace.empty() && !dynamic_cast<const interaction::TraceSource*>(&source) &&
-      scenario.duration && source.end_time() > *scenario.duration + 1e-9) {
+  if (trace.empty() && scenario.duration &&
+      source.end_time() > last_frame_time(scenario, *scenario.duration) + 1e-9) {
     out.push_back(who + ": the plan runs to t=" + format_time(source.end_time()) +
                   " s, past the scenario's duration (" + format_time(*scenario.duration) +
                   " s): the run ends before the hand has done it");
@@ -204,14 +203,13 @@ std::string format_length(double metres, const RunOutcome& o) {
 bool same(const Transform& x, const Transform& y) { return x.R == y.R && x.t == y.t; }
 
 /// The region as the engine watches it: "hand" among its parts stands for
-/// every segment of the hand (whose events the hand merges into its own).
-engine::Region with_hand_segments(engine::Region region) {
-  const auto hand = std::find(region.parts.begin(), region.parts.end(), "hand");
-  if (hand == region.parts.end()) return region;
-  region.parts.erase(hand);
+/// every segment of the hand named `hand` (whose events the hand merges
+/// into its own).
+engine::Region with_hand_segments(engine::Region region, const std::string& hand) {
+  if (std::erase(region.parts, "hand") == 0) return region;
   for (std::size_t i = 0; i < interaction::kSegmentCount; ++i) {
     region.parts.push_back(
-        "hand." + std::string(interaction::segment_name(static_cast<interaction::Segment>(i))));
+        hand + "." + std::string(interaction::segment_name(static_cast<interaction::Segment>(i))));
   }
   return region;
 }
@@ -220,37 +218,28 @@ std::pair<std::string, std::string> ordered(const std::string& a, const std::str
   return a < b ? std::pair(a, b) : std::pair(b, a);
 }
 
+/// When a glove file of the other kind was given (a plan where a trace
+/// belongs, or a trace where a plan does), what to do instead; else empty.
+/// Judged by the other kind's reader taking it.
+std::string other_kind_of_glove_file(const std::filesystem::path& file, bool trace_expected) {
+  try {
+    if (trace_expected) {
+      interaction::read_plan(file);
+      return " (" + file.filename().string() +
+             " is a glove plan, which a scenario names as glove { plan = \"...\" }; a trace, "
+             "as replay, --trace and glove { trace = \"...\" } take, is a recorded CSV file)";
+    }
+    interaction::read_trace(file);
+    return " (" + file.filename().string() +
+           " is a glove trace, CSV, which a scenario names as glove { trace = \"...\" })";
+  } catch (const std::exception&) {
+    return "";  // of neither kind: the reader's own message says what is wrong
+  }
+}
+
 /// The glove's samples: the trace to replay when given, else the glove's
 /// trace or plan, with its noise. Errors name the file (and line) and, for
 /// the scenario's own file, the glove that asked for it.
-/// When a glove file of the other kind was given (a plan where a trace
-/// belongs, or a trace where a plan does), what to do instead; else empty.
-/// Judged by its first line that is not blank or a comment.
-std::string other_kind_of_glove_file(const std::filesystem::path& file, bool trace_expected) {
-  std::ifstream in(file, std::ios::binary);
-  std::string line;
-  while (std::getline(in, line)) {
-    const std::size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    line.erase(0, first);
-    break;
-  }
-  const std::string word = line.substr(0, line.find_first_of(" \t,\r"));
-  const bool plan = word == "start" || word == "reach" || word == "path" || word == "close" ||
-                    word == "open" || word == "wait";
-  const bool trace = line.rfind("t,", 0) == 0;
-  if (trace_expected && plan) {
-    return " (" + file.filename().string() +
-           " is a glove plan, which a scenario names as glove { plan = \"...\" }; a trace, "
-           "as replay, --trace and glove { trace = \"...\" } take, is a recorded CSV file)";
-  }
-  if (!trace_expected && trace) {
-    return " (" + file.filename().string() +
-           " is a glove trace, CSV, which a scenario names as glove { trace = \"...\" })";
-  }
-  return "";
-}
-
 std::shared_ptr<const interaction::GloveSource> glove_source(
     const Scenario& scenario, const std::optional<std::filesystem::path>& replay) {
   const GloveSpec glove = scenario.glove.value_or(GloveSpec{});
@@ -715,7 +704,9 @@ void Runner::build() {
                         ": --record: the scenario has no glove, so there are no samples to record");
   }
   // After the hand: a region may watch its segments.
-  for (const RegionSpec& r : scenario_.regions) sim_->add_region(with_hand_segments(r.region));
+  for (const RegionSpec& r : scenario_.regions) {
+    sim_->add_region(with_hand_segments(r.region, interaction::kDefaultHandName));
+  }
   // Mates snapped by a rule appear among the frame's events.
   sim_->add_event_filter([this](engine::Simulation&, std::vector<Event>& events) {
     events.insert(events.end(), injected_.begin(), injected_.end());

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <lua.hpp>
 #include <map>
 #include <regex>
 
@@ -468,6 +469,18 @@ TEST(ScenarioLoad, AWordWithoutItsQuotesIsAnUnknownNameNotAnUnsetField) {
       << region;
 }
 
+TEST(ScenarioLoad, AFileThatFailsLeavesUnknownNamesNilOnItsHost) {
+  // The error for an unknown name holds while a file is read, also one that
+  // fails: the host's globals read as Lua's after.
+  const test::TempDir dir("dovetail_scenario");
+  LuaHost host({}, 1);
+  EXPECT_THROW(load_scenario(host, write(dir, "bad.lua", "return scenario { name = nameless }\n")),
+               ScriptError);
+  host.run_string("return nameless", "after", 1);
+  EXPECT_TRUE(lua_isnil(host.state(), -1));
+  lua_pop(host.state(), 1);
+}
+
 TEST(ScenarioRun, ACustomActionReadsAGlobalNotYetSetAsNil) {
   // Unknown names are errors while the file is read, not in custom actions
   // run later, which may keep a count in a global as Lua allows.
@@ -578,7 +591,17 @@ return scenario {
   ASSERT_EQ(s.parts.size(), 3u);
   std::vector<std::string> warnings = s.warnings;
   std::sort(warnings.begin(), warnings.end());
-  ASSERT_EQ(warnings.size(), 3u) << warnings[0];
+  // A line far longer than a pattern match could take: read by hand.
+  const Scenario long_line = load_scenario(
+      host, write(dir, "long.lua",
+                  "local t = { [\"" + std::string(200000, 'a') +
+                      "\"] = 1 }; local spare = part { shape = box { size = { 1, 1, 1 } } }\n"
+                      "return scenario { name = \"l\", parts = { a = part { shape = box { size "
+                      "= { 1, 1, 1 } } } } }\n"));
+  ASSERT_EQ(long_line.warnings.size(), 1u) << testing::PrintToString(long_line.warnings);
+  EXPECT_NE(long_line.warnings[0].find("long.lua:1: this part { ... } is in none"),
+            std::string::npos);
+  ASSERT_EQ(warnings.size(), 3u) << testing::PrintToString(warnings);
   EXPECT_NE(warnings[0].find("twice.lua:13: region 'tray' is declared again at line 14, which "
                              "replaces this one: give each region a name of its own"),
             std::string::npos)
@@ -1250,6 +1273,17 @@ TEST(ScenarioLoad, PartsFromMeshFilesFarFromTheHandsSizeAreAWarning) {
             std::string::npos)
       << mm.warnings[0];
   EXPECT_TRUE(check_scenario(scenario("m")).warnings.empty());
+  // Parts in millimetres read in metres, 25 and 30 m beside the hand: mm,
+  // not the cm that would bring them nearest the hand's length.
+  write(dir, "small.obj", box(25));
+  write(dir, "large.obj", box(30));
+  // (They overlap too, 1 m apart: a warning of its own.)
+  const std::string m = testing::PrintToString(check_scenario(scenario("m")).warnings);
+  EXPECT_NE(m.find("m.lua:4: the parts from mesh files are a median of 52 m across, 273 times "
+                   "the hand (0.19 m): are the files in other units? Their numbers are read in m; "
+                   "if they are in mm, give the parts units = \\\"mm\\\""),
+            std::string::npos)
+      << m;
 }
 
 TEST(ScenarioLoad, AnOpenOrWronglyWoundMeshIsAWarningThatCounts) {
@@ -1571,8 +1605,7 @@ TEST(ScenarioRun, AGraspNeverMadeNamesThePartsThatStoppedTheFingers) {
   ASSERT_EQ(o.status, RunOutcome::Status::kFailed) << o.failure_summary() << o.error;
   ASSERT_EQ(o.expectations.size(), 1u);
   const std::string& detail = o.expectations[0].detail;
-  EXPECT_NE(detail.find("the most of the hand that touched it was at t="), std::string::npos)
-      << detail;
+  EXPECT_NE(detail.find("the hand's closest try was at t="), std::string::npos) << detail;
   EXPECT_NE(detail.find("; then the hand touched 'table' ("), std::string::npos) << detail;
   EXPECT_NE(detail.find(") too, and a finger stops at the first part it meets"), std::string::npos)
       << detail;
@@ -1582,10 +1615,10 @@ TEST(ScenarioRun, AGraspNeverMadeIsExplainedByTheHandsClosestTry) {
   // A hand 5 mm too high wraps its fingers round the bar without its palm
   // on it; one far above never touches it. The failure says which.
   const test::TempDir dir("dovetail_scenario");
-  const auto detail = [&](double wrist_mm) {
+  const auto detail = [&](double wrist_mm, const char* hand = "close 0.5 fist") {
     char plan[128];
-    std::snprintf(plan, sizeof plan, "start 0 %.6f 0.060  1 0 0 0 open\nclose 0.5 fist\nwait 0.2\n",
-                  wrist_mm / 1000);
+    std::snprintf(plan, sizeof plan, "start 0 %.6f 0.060  1 0 0 0 open\n%s\nwait 0.2\n",
+                  wrist_mm / 1000, hand);
     write(dir, "bar.plan", plan);
     const RunOutcome o = run_scenario(write(dir, "bar.lua", R"(return scenario {
   name = "bar", units = "mm",
@@ -1598,8 +1631,7 @@ TEST(ScenarioRun, AGraspNeverMadeIsExplainedByTheHandsClosestTry) {
     return o.expectations.empty() ? std::string() : o.expectations[0].detail;
   };
   const std::string high = detail(15 + 10.45 + 5);
-  EXPECT_NE(high.find("'bar' was never grasped as power; the most of the hand that touched it "
-                      "was at t="),
+  EXPECT_NE(high.find("'bar' was never grasped as power; the hand's closest try was at t="),
             std::string::npos)
       << high;
   EXPECT_NE(high.find("index_distal"), std::string::npos) << high;
@@ -1607,6 +1639,12 @@ TEST(ScenarioRun, AGraspNeverMadeIsExplainedByTheHandsClosestTry) {
             std::string::npos)
       << high;
   EXPECT_NE(detail(200).find("the hand never touched it while it held nothing"), std::string::npos);
+  // An open hand laid on the bar, which never closes.
+  const std::string open = detail(15 + 10.45, "wait 0.5");
+  EXPECT_NE(open.find("; the hand never touched it while closing (a grasp needs the glove's "
+                      "flexion to rise by 10 degrees"),
+            std::string::npos)
+      << open;
 }
 
 TEST(ScenarioRun, AGraspBuildsUpThroughGloveNoise) {
@@ -2078,7 +2116,7 @@ TEST(ScenarioLoad, PartsThatStartInsideEachOtherAreWarnedOf) {
     lid = part { shape = box { size = { 40, 40, 4 } }, at = { 0, 0, 22 } },
   },
 })"));
-  ASSERT_EQ(s.warnings.size(), 1u) << s.warnings[1];
+  ASSERT_EQ(s.warnings.size(), 1u) << testing::PrintToString(s.warnings);
   EXPECT_NE(s.warnings[0].find("inside.lua:5: parts 'shaft' and 'housing' (line 4) overlap by 10 "
                                "mm where the scenario places them"),
             std::string::npos)
@@ -2475,6 +2513,22 @@ TEST(ScenarioRun, TheHandEntersAndLeavesARegionAsOne) {
   EXPECT_EQ(regions,
             (std::vector<std::string>{"region_enter hand gate", "region_enter hand hand_only",
                                       "region_leave hand gate", "region_leave hand hand_only"}));
+}
+
+TEST(ScenarioRun, ARegionNamingTheHandTwiceWatchesItOnce) {
+  const test::TempDir dir("dovetail_scenario");
+  write(dir, "hand.plan", "start 0 0.2 0  1 0 0 0\nwait 0.1\n");
+  const RunOutcome o = run_scenario(write(
+      dir, "twice.lua",
+      moved_peg("", "",
+                "  hand = glove { plan = \"hand.plan\" },\n"
+                "  regions = { r = region { min = { -500, -500, -500 }, max = { 500, 500, 500 }, "
+                "parts = { \"hand\", \"hand\" } } },\n")));
+  ASSERT_EQ(o.status, RunOutcome::Status::kPassed) << o.failure_summary() << o.error;
+  std::size_t entered = 0;
+  for (const engine::Event& e : o.report.events)
+    entered += e.kind == engine::EventKind::kRegionEnter;
+  EXPECT_EQ(entered, 1u);
 }
 
 TEST(ScenarioLoad, ARegionWatchingTheHandNeedsOne) {

@@ -192,10 +192,11 @@ class Grasping {
   const InteractionStats& stats() const { return stats_; }
   /// Every snap refused so far, in order.
   const std::vector<RefusedSnap>& refused_snaps() const { return refused_snaps_; }
-  /// Why the hand never grasped `part`, for a report: the frame in which
-  /// most of its segments touched the part while it held nothing, what
-  /// touched and what the grasp lacked ("at t=1.240 s the palm and index
-  /// touched it, but ..."), or that it never touched it.
+  /// Why the hand never grasped `part`, for a report: its closest try (the
+  /// frame in which most of its segments touched the part while it held
+  /// nothing and closed, or, when it never touched it closing, while it held
+  /// nothing), what touched and what the grasp lacked, or that it never
+  /// touched it.
   std::string why_not_grasped(const std::string& part) const;
   /// The time of why_not_grasped's try at the part, if the hand touched it.
   std::optional<Real> closest_try_time(const std::string& part) const {

@@ -38,11 +38,14 @@ inline constexpr std::array<float, 3> kHandColor = {0.96F, 0.76F, 0.62F};
 std::vector<engine::RenderItem> hand_render_items(const HandModel& model, const GloveSample& sample,
                                                   const std::string& name = "hand");
 
+/// The name of a hand unless it is given another.
+inline constexpr const char* kDefaultHandName = "hand";
+
 /// How to put a hand into a simulation.
 struct HandSettings {
   HandDef model{};
   /// Prefix of the segment parts' names, their collision group.
-  std::string name = "hand";
+  std::string name = kDefaultHandName;
   /// Keep every sample used, for recorded() and write_trace.
   bool record = true;
 };
