@@ -223,6 +223,11 @@ int check(std::span<const std::string> argv) {
                  "warning: %s: it starts at t=%.6g s; a run replays from t = 0 and the hand "
                  "stays at its first sample until then (shift its times to start at 0)\n",
                  path.c_str(), start);
+  } else if (start < 0) {
+    std::fprintf(stderr,
+                 "warning: %s: it starts at t=%.6g s; a run starts at t = 0, so what it holds "
+                 "before then is not used\n",
+                 path.c_str(), start);
   }
   constexpr double kFar = 20;  // metres: no workspace a tracker covers
   for (const interaction::GloveSample& g : samples) {

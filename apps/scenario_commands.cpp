@@ -3,6 +3,7 @@
 /// the command line (regress_command.cpp runs whole folders of them).
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -92,9 +93,16 @@ scripting::RunOptions run_options(const Args& args, std::optional<std::filesyste
   options.trace = std::move(trace);
   if (auto v = args.value("record")) options.record = *v;
   if (auto v = args.value("render")) options.render_dir = *v;
-  options.render_every = args.unsigned_integer("every").value_or(0);
-  if (args.value("every") && options.render_every == 0) {
-    throw UsageError(args.command() + ": --every must be at least 1 (every N-th frame)");
+  if (const std::optional<std::string> every = args.value("every")) {
+    std::uint64_t n = 0;
+    const auto [end, error] = std::from_chars(every->data(), every->data() + every->size(), n);
+    if (error != std::errc() || end != every->data() + every->size() || n == 0) {
+      throw UsageError(args.command() +
+                       ": --every must be a positive integer (every N-th frame), "
+                       "not '" +
+                       *every + "'");
+    }
+    options.render_every = n;
   }
   if (args.value("every") && !options.render_dir)
     throw UsageError(args.command() + ": --every needs --render DIR");

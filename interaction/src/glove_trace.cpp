@@ -164,11 +164,16 @@ TraceGaps trace_gaps(std::span<const GloveSample> samples) {
 }
 
 std::optional<std::string> sparse_samples(std::span<const GloveSample> samples) {
-  // Gloves sample 30 to 200 times a second; under 10 is another time unit.
+  // Gloves sample 30 to 200 times a second; under 10 is another time unit,
+  // unless the take would then last under a second: a trace keyed by hand
+  // (a pose every second or so, the hand moving straight between them).
   if (samples.size() < 3) return std::nullopt;
   const Real median = trace_gaps(samples).median;
   constexpr Real kSparse = 0.1;  // seconds
-  if (!(median > kSparse)) return std::nullopt;
+  constexpr Real kShortestTake = 1000;  // "seconds": a second in milliseconds
+  if (!(median > kSparse) || !(samples.back().t - samples.front().t >= kShortestTake)) {
+    return std::nullopt;
+  }
   char text[200];
   std::snprintf(text, sizeof text,
                 "its samples are %.4g s apart (the median), %.3g samples a second, where gloves "

@@ -1750,7 +1750,15 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
       case ArgType::kNames:
         if (clause.word->name == "steps_in_order") {
           if (arg.names.empty()) note(clause.where, "steps_in_order: name at least one step");
-          for (const std::string& name : arg.names) check(name, steps, "step");
+          for (std::size_t k = 0; k < arg.names.size(); ++k) {
+            check(arg.names[k], steps, "step");
+            // A step is done once: named twice, the order can never hold.
+            if (std::find(arg.names.begin(), arg.names.begin() + static_cast<std::ptrdiff_t>(k),
+                          arg.names[k]) != arg.names.begin() + static_cast<std::ptrdiff_t>(k)) {
+              note(clause.where, "steps_in_order: step '" + arg.names[k] +
+                                     "' is named twice; a step is completed once");
+            }
+          }
         }
         break;
       default:

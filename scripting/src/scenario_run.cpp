@@ -1476,8 +1476,10 @@ void Runner::run() {
     out_.error = file_.string() + ": no frame at t=" + format_time(*options_.picture_at) +
                  " s: the run's last frame is at t=" + format_time(last_time) + " s (" +
                  (scenario_.duration ? "its duration"
-                  : hand_            ? "the end of its glove"
-                                     : "1 s") +
+                  : options_.trace || (scenario_.glove && !scenario_.glove->trace.empty())
+                      ? "the end of its glove's trace"
+                  : hand_ ? "the end of its glove's plan, and a second for the hand to come to rest"
+                          : "1 s, as a scenario without a glove or duration runs") +
                  ")";
     out_.wall_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -18,16 +18,21 @@ dovetail_cli_test(glove_check_joint_out_of_range EXIT 0
                   ARGS glove check ${glove}/trace_joint_out_of_range.csv
                   STDOUT "\"samples\":3"
                   STDERR "trace_joint_out_of_range.csv: index_mcp reaches 500 deg at t=0.0111111 s, outside its range \\[-30, 90\\] by 410 deg")
-# Times in milliseconds read as seconds, and a file cut short: read, with a warning each.
+# Times in milliseconds read as seconds (a take of a second, 92 samples): read, with a warning.
 dovetail_cli_test(glove_check_times_in_milliseconds EXIT 0
                   ARGS glove check ${glove}/trace_times_in_milliseconds.csv
-                  STDOUT "\"samples\":3"
+                  STDOUT "\"samples\":92"
                   STDERR "trace_times_in_milliseconds.csv: its samples are 11.11 s apart \\(the median\\), 0.09 samples a second[^\n]*are its times in milliseconds\\?")
 # A start on a device clock and positions in millimetres, said as a run would.
 dovetail_cli_test(glove_check_device_clock_millimetres EXIT 0
                   ARGS glove check ${glove}/trace_device_clock_millimetres.csv
                   STDOUT "\"samples\":3"
                   STDERR "it starts at t=8123.25 s; a run replays from t = 0[^\n]*shift its times to start at 0\\)\n.*the tracker is 198.494 m from the origin at t=8123.25 s[^\n]*are its positions in millimetres\\?")
+# A start before t = 0: what it holds before then is not used, as a run says.
+dovetail_cli_test(glove_check_starts_before_zero EXIT 0
+                  ARGS glove check ${glove}/trace_starts_before_zero.csv
+                  STDOUT "\"samples\":3"
+                  STDERR "trace_starts_before_zero.csv: it starts at t=-1 s; a run starts at t = 0, so what it holds before then is not used")
 # Joint angles in radians read as degrees: a hand that hardly moves.
 dovetail_cli_test(glove_check_joint_angles_in_radians EXIT 0
                   ARGS glove check ${glove}/trace_joint_angles_in_radians.csv

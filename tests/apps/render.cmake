@@ -117,7 +117,7 @@ dovetail_cli_test(render_scenario_trace EXIT 0
                   REMOVE ${out}/render_peg_trace.png)
 dovetail_cli_test(render_scenario_past_its_end EXIT 1
                   ARGS render ${render_peg} --out ${out}/render_peg_late.png --time 200
-                  STDERR "01_peg_in_hole.lua: no frame at t=200.000 s: the run's last frame is at t=3.600 s")
+                  STDERR "01_peg_in_hole.lua: no frame at t=200.000 s: the run's last frame is at t=3.600 s \\(the end of its glove's plan, and a second for the hand to come to rest\\)")
 dovetail_cli_test(render_scenario_script_error EXIT 1
                   ARGS render ${data}/scenarios/hostile/endless_custom_action.lua
                        --out ${out}/render_endless.png --time 0.8
@@ -139,7 +139,10 @@ dovetail_cli_test(render_scenario_failed_before EXIT 1
                   STDERR "rule_fails.lua: no frame at t=1.000 s: [^\n]*rule_fails.lua:4: a rule failed the run at t=0.500 s: stop here")
 dovetail_cli_test(run_render_every_zero EXIT 2
                   ARGS run ${PROJECT_SOURCE_DIR}/scenarios/04_stacked_bricks.lua --render ${out}/every_zero --every 0
-                  STDERR "run: --every must be at least 1")
+                  STDERR "run: --every must be a positive integer \\(every N-th frame\\), not '0'")
+dovetail_cli_test(run_render_every_negative EXIT 2
+                  ARGS run ${PROJECT_SOURCE_DIR}/scenarios/04_stacked_bricks.lua --render ${out}/every_negative --every -5
+                  STDERR "run: --every must be a positive integer \\(every N-th frame\\), not '-5'")
 # ... but not when the run is refused: the old frames stay.
 add_test(NAME cli.run_render_keeps_old_frames_when_refused
          COMMAND sh -c "rm -rf \"$1\" && mkdir -p \"$1/report_is_a_folder\" && touch \"$1/frame_009999.png\" && \"$0\" run \"$2\" --render \"$1\" --every 1000 --report \"$1/report_is_a_folder\" --quiet 2> /dev/null; [ $? -eq 1 ] && [ -e \"$1/frame_009999.png\" ]"

@@ -489,5 +489,16 @@ TEST(GloveTraceDoubts, AGapOfManySamplesIsNamedAndAnEvenTraceIsNot) {
       << *doubt;
 }
 
+TEST(GloveTraceDoubts, SparseSamplesAreMillisecondsOnlyOverATakeOfASecondInThem) {
+  // A trace keyed by hand, a pose every second or so over 4.3 s: seconds.
+  EXPECT_FALSE(sparse_samples(samples_at({0, 1.8, 2.6, 3.4, 3.6, 3.9, 4.3})).has_value());
+  // A 2 s take at 90 Hz written in milliseconds: 11.1 "s" apart over 2000.
+  std::vector<GloveSample> ms;
+  for (int i = 0; i <= 180; ++i) ms.push_back(simple_sample(i * 1000 / 90.0));
+  const std::optional<std::string> doubt = sparse_samples(ms);
+  ASSERT_TRUE(doubt.has_value());
+  EXPECT_NE(doubt->find("are its times in milliseconds?"), std::string::npos) << *doubt;
+}
+
 }  // namespace
 }  // namespace dovetail::interaction

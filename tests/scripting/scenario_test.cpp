@@ -458,6 +458,13 @@ TEST(ScenarioLoad, AWordWithoutItsQuotesIsAnUnknownNameNotAnUnsetField) {
       load_error(write(dir, "none.lua", moved_peg("", "    steps_in_order {},")));
   EXPECT_NE(none.find("none.lua:20: steps_in_order: name at least one step"), std::string::npos)
       << none;
+  const std::string twice =
+      load_error(write(dir, "twice.lua",
+                       moved_peg("", "    steps_in_order { \"insert\", \"check\", \"insert\" },")));
+  EXPECT_NE(twice.find("twice.lua:20: steps_in_order: step 'insert' is named twice; a step is "
+                       "completed once"),
+            std::string::npos)
+      << twice;
   const std::string region = load_error(
       write(dir, "region.lua",
             moved_peg("", "",

@@ -75,7 +75,9 @@ struct TraceGaps {
 };
 TraceGaps trace_gaps(std::span<const GloveSample> samples);
 
-/// trace_doubts' first: samples more than 0.1 s apart at the median.
+/// trace_doubts' first: samples more than 0.1 s apart at the median over a
+/// take of 1000 s or more (in milliseconds, a second or more); a shorter one
+/// is a trace keyed by hand.
 std::optional<std::string> sparse_samples(std::span<const GloveSample> samples);
 /// trace_doubts' second: the widest gap between samples over 5 times the
 /// median gap (samples dropped; the hand moves in a straight line across it).
