@@ -3,8 +3,11 @@
 /// `run --capture DIR` (collision/capture.h) and says whether each suspect
 /// outcome happens again.
 
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include "cli.h"
 #include "commands.h"
@@ -15,9 +18,10 @@ namespace dovetail::cli {
 namespace {
 
 constexpr const char* kCaptureHelp =
-    R"(usage: dovetail capture FILE...
+    R"(usage: dovetail capture FILE|DIR...
 
-Replays failure-capture files written by 'dovetail run --capture DIR': reads
+Replays failure-capture files written by 'dovetail run --capture DIR' (a
+folder: its .capture files, in name order): reads
 each query's inputs (two meshes and their relative pose, hexadecimal floats)
 and runs it again: every polygon-level method and the convex level against
 brute force for a disagreement, GJK and the separating-plane search for an
@@ -36,9 +40,29 @@ int capture_command(std::span<const std::string> argv) {
     return kExitOk;
   }
   if (args.positional().empty()) throw UsageError("capture: give one or more capture files");
+  // A folder stands for its capture files, in name order.
+  std::vector<std::string> files;
+  bool empty_folder = false;
+  for (const std::string& given : args.positional()) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(given, ec)) {
+      files.push_back(given);
+      continue;
+    }
+    std::vector<std::string> inside;
+    for (const auto& entry : std::filesystem::directory_iterator(given, ec)) {
+      if (entry.path().extension() == ".capture") inside.push_back(entry.path().string());
+    }
+    std::sort(inside.begin(), inside.end());
+    if (inside.empty()) {
+      std::fprintf(stderr, "dovetail: %s: no .capture files in this folder\n", given.c_str());
+      empty_folder = true;
+    }
+    files.insert(files.end(), inside.begin(), inside.end());
+  }
   int exit_code = kExitOk;
-  bool unreadable = false;
-  for (const std::string& file : args.positional()) {
+  bool unreadable = empty_folder;
+  for (const std::string& file : files) {
     collision::Capture capture;
     try {
       capture = collision::read_capture(file);

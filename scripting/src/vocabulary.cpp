@@ -554,12 +554,22 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 std::optional<std::string> nearest_name(std::string_view name,
                                         std::span<const std::string> candidates) {
   const std::size_t limit = std::max<std::size_t>(2, name.size() / 3);
+  // Of equally near names, the one that shares the longest start: for
+  // "nodes[5]_3", "nodes[5]_2" rather than "nodes[25]_3".
+  const auto common_start = [&](const std::string& candidate) {
+    std::size_t n = 0;
+    while (n < name.size() && n < candidate.size() && name[n] == candidate[n]) ++n;
+    return n;
+  };
   const std::string* best = nullptr;
-  std::size_t best_distance = limit + 1;
+  std::size_t best_distance = limit + 1, best_start = 0;
   for (const std::string& candidate : candidates) {
     const std::size_t d = edit_distance(name, candidate);
-    if (d < best_distance) {
+    if (d > limit || d > best_distance) continue;
+    const std::size_t start = common_start(candidate);
+    if (d < best_distance || start > best_start) {
       best_distance = d;
+      best_start = start;
       best = &candidate;
     }
   }

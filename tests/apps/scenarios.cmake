@@ -363,8 +363,11 @@ dovetail_cli_test(capture_bad_file EXIT 1 ARGS capture ${data}/cube.obj
 # An unreadable file is said, and the files after it are replayed all the same.
 dovetail_cli_test(capture_bad_files_and_a_good_one EXIT 1
                   ARGS capture ${out}/no_such.capture ${data} ${data}/captures/touching-hulls.capture
-                  STDERR "no_such.capture: cannot be opened&&/data: is a folder"
+                  STDERR "no_such.capture: cannot be opened&&/data: no .capture files in this folder"
                   STDOUT "touching-hulls.capture: iteration-cap not reproduced")
+# A folder: its capture files in name order.
+dovetail_cli_test(capture_replay_folder EXIT 0 ARGS capture ${data}/captures
+                  STDOUT "^[^\n]*resting-boxes-turned.capture: methods-disagree not reproduced[^\n]*\n[^\n]*touching-hulls.capture: iteration-cap not reproduced")
 # A one-letter option's value may be joined on, as make's -j2.
 dovetail_cli_test(regress_short_option_joined EXIT 2 ARGS regress ${scenarios} -j0
                   STDERR "regress: -j must be an integer from 1 to 256")

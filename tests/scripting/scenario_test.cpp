@@ -90,6 +90,16 @@ std::string moved_peg(const std::string& rules, const std::string& expect,
          "}\n";
 }
 
+TEST(Vocabulary, OfEquallyNearNamesTheOneSharingTheLongestStartIsSuggested) {
+  const std::vector<std::string> nodes = {"nodes[25]_3", "nodes[5]_2"};
+  EXPECT_EQ(nearest_name("nodes[5]_3", nodes), "nodes[5]_2");
+  const std::vector<std::string> reversed = {"nodes[5]_2", "nodes[25]_3"};
+  EXPECT_EQ(nearest_name("nodes[5]_3", reversed), "nodes[5]_2");
+  // Too far from every name: none.
+  const std::vector<std::string> far = {"bracket", "nut"};
+  EXPECT_EQ(nearest_name("piston", far), std::nullopt);
+}
+
 TEST(ScenarioLoad, AMisspeltPartIsAnErrorWithFileLineAndASuggestion) {
   const test::TempDir dir("dovetail_scenario");
   const auto file =
