@@ -305,6 +305,17 @@ class Loader {
   void warn_about_overlapping_parts();
   void warn_about_dropped_declarations();
   void warn_about_gltf_units();
+  void warn_about_parts_named_in_custom(const Clause& custom,
+                                        const std::vector<std::string>& parts);
+  /// The scenario file's lines, read once.
+  const std::vector<std::string>& source_lines() {
+    if (!source_lines_) {
+      source_lines_.emplace();
+      std::ifstream in(file_, std::ios::binary);
+      for (std::string line; std::getline(in, line);) source_lines_->push_back(line);
+    }
+    return *source_lines_;
+  }
   /// The part of that name, or null.
   const PartSpec* part_named(const std::string& name) const {
     for (const PartSpec& p : scenario_.parts) {
@@ -1064,6 +1075,7 @@ class Loader {
   /// The registry's reference to the lists of where each named declaration
   /// was made (the prelude's `made`).
   int made_ = LUA_NOREF;
+  std::optional<std::vector<std::string>> source_lines_;
   std::string file_;
   /// A file the scenario names, into *files_read_ (kept when loading fails).
   void note_file(const std::filesystem::path& path) {
@@ -1792,11 +1804,7 @@ void Loader::warn_about_dropped_declarations() {
   }
   lua_pop(L_, 1);
   if (dropped.empty()) return;
-  std::vector<std::string> lines;
-  {
-    std::ifstream in(file_, std::ios::binary);
-    for (std::string line; std::getline(in, line);) lines.push_back(line);
-  }
+  const std::vector<std::string>& lines = source_lines();
   for (const auto& [word, where] : dropped) {
     // The name it was given, from its line: `name = part {` or `["name"] = part {`.
     std::string name;
@@ -1820,6 +1828,51 @@ void Loader::warn_about_dropped_declarations() {
                                    " { ... } is in none of the "
                                    "scenario's " +
                                    word + "s (is its name given twice?)");
+    }
+  }
+}
+
+/// A custom function's part names, where its text spells them out
+/// (`dt.part("peg")`), checked as the vocabulary's are: a misspelt one would
+/// stop the run when the function runs, perhaps minutes in. A name the
+/// function computes is not seen.
+void Loader::warn_about_parts_named_in_custom(const Clause& custom,
+                                              const std::vector<std::string>& parts) {
+  const Arg& function = custom.args[0];
+  if (!function.given || function.function_ref == LUA_NOREF) return;
+  lua_rawgeti(L_, LUA_REGISTRYINDEX, function.function_ref);
+  lua_Debug ar;
+  const bool known = lua_getinfo(L_, ">S", &ar) != 0 && ar.source != nullptr &&
+                     ar.source[0] == '@' && std::string(ar.source + 1) == file_;
+  if (!known || ar.linedefined <= 0) return;
+  const std::vector<std::string>& lines = source_lines();
+  const auto last =
+      std::min<std::size_t>(static_cast<std::size_t>(ar.lastlinedefined), lines.size());
+  for (std::size_t row = static_cast<std::size_t>(ar.linedefined); row <= last; ++row) {
+    const std::string& line = lines[row - 1];
+    for (std::size_t at = line.find("part"); at != std::string::npos;
+         at = line.find("part", at + 4)) {
+      if (at == 0 || (line[at - 1] != '.' && line[at - 1] != ':')) continue;
+      std::size_t i = at + 4;
+      while (i < line.size() && line[i] == ' ') ++i;
+      const bool paren = i < line.size() && line[i] == '(';
+      if (paren) ++i;
+      while (i < line.size() && line[i] == ' ') ++i;
+      if (i >= line.size() || (line[i] != '"' && line[i] != '\'')) continue;
+      const std::size_t close = line.find(line[i], i + 1);
+      if (close == std::string::npos) continue;
+      // The whole argument, not the start of a concatenation ("l" .. "id").
+      std::size_t after = close + 1;
+      while (after < line.size() && line[after] == ' ') ++after;
+      if (paren ? after >= line.size() || line[after] != ')'
+                : after < line.size() && line[after] == '.') {
+        continue;
+      }
+      const std::string name = line.substr(i + 1, close - i - 1);
+      if (std::find(parts.begin(), parts.end(), name) != parts.end()) continue;
+      scenario_.warnings.push_back(file_ + ":" + std::to_string(row) + ": custom: no part '" +
+                                   name + "'" + did_you_mean(name, parts) +
+                                   ": the run stops with an error if the function asks for it");
     }
   }
 }
@@ -2146,6 +2199,7 @@ void Loader::resolve() {
     }
     for (const Clause& c : r.act) {
       resolve_clause(c, names);
+      if (c.word->name == "custom") warn_about_parts_named_in_custom(c, names.parts);
       if (c.word->name != "attach") continue;
       const std::string &part = c.args[0].text, &to = c.args[1].text;
       if (part == to) {

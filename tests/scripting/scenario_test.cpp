@@ -498,6 +498,25 @@ TEST(ScenarioLoad, AFileThatFailsLeavesUnknownNamesNilOnItsHost) {
   lua_pop(host.state(), 1);
 }
 
+TEST(ScenarioLoad, APartACustomFunctionSpellsOutIsChecked) {
+  // The run would stop with an error when the function runs; a check says so
+  // before. Names the function computes are not seen.
+  const test::TempDir dir("dovetail_scenario");
+  const Scenario s =
+      check_scenario(write(dir, "custom.lua",
+                           moved_peg("    rule { when = after(0.1), act = { custom(function(dt)\n"
+                                     "      local x, y, z = dt.part(\"pge\"):translation()\n"
+                                     "      dt.part 'peg':set_translation(x, y, z)\n"
+                                     "      dt.part(\"l\" .. \"id\"):translation()\n"
+                                     "    end) } },",
+                                     "")));
+  ASSERT_EQ(s.warnings.size(), 1u) << testing::PrintToString(s.warnings);
+  EXPECT_NE(s.warnings[0].find("custom.lua:18: custom: no part 'pge' (did you mean 'peg'?): the "
+                               "run stops with an error if the function asks for it"),
+            std::string::npos)
+      << s.warnings[0];
+}
+
 TEST(ScenarioRun, ACustomActionReadsAGlobalNotYetSetAsNil) {
   // Unknown names are errors while the file is read, not in custom actions
   // run later, which may keep a count in a global as Lua allows.
