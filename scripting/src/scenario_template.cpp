@@ -24,6 +24,9 @@ return scenario {
       shape = cylinder { diameter = 20, length = 60 },
       at = { 0, 100, 0 }, turn = { x = 90 },
     },
+    -- A part may come from a mesh file instead, read in the file's own units
+    -- when they are not the scenario's (glTF is in metres):
+    -- bracket = part { mesh = "bracket.glb", units = "m", at = { 150, 0, 0 } },
   },
 
   mates = {
