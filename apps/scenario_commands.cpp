@@ -159,8 +159,9 @@ void print_problems(const scripting::RunOptions& options, const scripting::RunOu
   if (!failures.empty()) std::fputs(failures.c_str(), stderr);
 }
 
-/// The summary on standard output: outcome, steps, state hash, final frame.
-void print_summary(const scripting::RunOutcome& outcome) {
+/// The summary on standard output: outcome, steps, state hash, final frame,
+/// and for a failure capture that found nothing, that it looked.
+void print_summary(const scripting::RunOptions& options, const scripting::RunOutcome& outcome) {
   std::size_t passed = 0;
   for (const auto& e : outcome.expectations) passed += e.passed ? 1 : 0;
   // A run that stopped on an error before the end judged no expectation.
@@ -190,6 +191,10 @@ void print_summary(const scripting::RunOutcome& outcome) {
   }
   if (outcome.final_frame)
     std::printf("  final frame: %s\n", outcome.final_frame->string().c_str());
+  if (options.capture_dir && outcome.suspect_queries == 0 && outcome.report.frames > 0) {
+    std::printf("  capture: no suspect collision query%s\n",
+                options.cross_check ? ", every exact pair cross-checked" : "");
+  }
 }
 
 int exit_code(scripting::RunOutcome::Status status) {
@@ -265,7 +270,7 @@ int run_scenario_command(const Args& args, const std::filesystem::path& scenario
     write_report(*path, outcome);
   }
   print_problems(options, outcome);
-  if (!args.flag("quiet")) print_summary(outcome);
+  if (!args.flag("quiet")) print_summary(options, outcome);
   return exit_code(outcome.status);
 }
 

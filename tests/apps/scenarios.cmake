@@ -346,6 +346,11 @@ dovetail_cli_test(run_capture_cross_check EXIT 0
                   ARGS run ${scenarios}/01_peg_in_hole.lua --quiet --capture ${out}/captures
                        --cross-check dop18
                   STDERR "^$")
+# Without --quiet, the summary says the capture looked and found nothing.
+dovetail_cli_test(run_capture_clean_said EXIT 0
+                  ARGS run ${scenarios}/01_peg_in_hole.lua --capture ${out}/captures_said
+                       --cross-check dop18
+                  STDOUT "  capture: no suspect collision query, every exact pair cross-checked\n")
 dovetail_cli_test(run_cross_check_needs_capture EXIT 2
                   ARGS run ${scenarios}/01_peg_in_hole.lua --cross-check dop18
                   STDERR "--cross-check needs --capture DIR")
