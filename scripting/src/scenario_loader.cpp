@@ -305,6 +305,7 @@ class Loader {
   void warn_about_overlapping_parts();
   void warn_about_dropped_declarations();
   void warn_about_gltf_units();
+  void warn_about_nodes_taken_twice();
   void warn_about_parts_named_in_custom(const Clause& custom,
                                         const std::vector<std::string>& parts);
   /// The scenario file's lines, read once.
@@ -1018,9 +1019,11 @@ class Loader {
     }
     std::vector<Vec3> vertices;
     std::vector<collision::TriangleIndices> triangles;
+    last_taken_.assign(report.parts.size(), 0);
     for (std::size_t i = 0; i < report.parts.size(); ++i) {
       const engine::ImportedPart& p = report.parts[i];
       if ((listed[i] != 0) != keep) continue;
+      last_taken_[i] = 1;
       const auto base = static_cast<std::uint32_t>(vertices.size());
       vertices.insert(vertices.end(), p.mesh.vertices.begin(), p.mesh.vertices.end());
       for (collision::TriangleIndices tri : p.mesh.triangles) {
@@ -1097,6 +1100,16 @@ class Loader {
   std::map<std::string, std::string> source_text_;
   std::map<std::string, int> field_lines_;
   std::map<std::string, engine::ImportReport> imports_;  ///< mesh files read by node
+  /// The imported parts (of imports_) the last select_nodes took, and those
+  /// each node selection took, by the key of meshes_.
+  std::vector<char> last_taken_;
+  std::map<std::string, std::vector<char>> taken_by_key_;
+  /// A part made of nodes of a file: which it took, and where it stands.
+  struct NodesTaken {
+    std::string part, file;  ///< file: the key of imports_
+    std::vector<char> taken;
+  };
+  std::vector<NodesTaken> nodes_taken_;
   /// Parts declared `open_surface = true`: no warning about their surface.
   std::set<std::string> open_surfaces_;
   /// Mesh files read whole, once however many parts name them (each read is
@@ -1360,6 +1373,10 @@ void Loader::read_part(int map, PartSpec& part) {
       } else {
         part.mesh = read_mesh_file(path, nodes, without, file_metres_per_unit, part.where, what);
         meshes_.emplace(key, part.mesh);
+        if (nodes.given || without.given) taken_by_key_[key] = last_taken_;
+      }
+      if (nodes.given || without.given) {
+        nodes_taken_.push_back({name, path.string(), taken_by_key_[key]});
       }
     }
     if (const Arg at = field(t, word, "at", part.where, what); at.given) part.X_WP.t = at.vector;
@@ -1877,6 +1894,37 @@ void Loader::warn_about_parts_named_in_custom(const Clause& custom,
   }
 }
 
+/// Two parts of one file's nodes that share a node, standing where each
+/// other stands: its triangles are in both, one over the other. The overlap
+/// warning misses it between parts attached to each other (a pin taken
+/// with its piston's group, and again as a part attached to the piston).
+/// Parts placed apart are copies, as a file's brick is used for three.
+void Loader::warn_about_nodes_taken_twice() {
+  for (std::size_t a = 0; a < nodes_taken_.size(); ++a) {
+    for (std::size_t b = a + 1; b < nodes_taken_.size(); ++b) {
+      const NodesTaken &x = nodes_taken_[a], &y = nodes_taken_[b];
+      const PartSpec *px = part_named(x.part), *py = part_named(y.part);
+      if (x.file != y.file || !px || !py || !(px->X_WP.R == py->X_WP.R) ||
+          !(px->X_WP.t == py->X_WP.t)) {
+        continue;
+      }
+      const auto import = imports_.find(x.file);
+      if (import == imports_.end()) continue;
+      for (std::size_t i = 0; i < x.taken.size() && i < y.taken.size(); ++i) {
+        if (!x.taken[i] || !y.taken[i]) continue;
+        const SourceLocation& later = px->where.line <= py->where.line ? py->where : px->where;
+        scenario_.warnings.push_back(
+            later.str() + ": parts '" + x.part + "' and '" + y.part + "' both take node '" +
+            import->second.parts[i].name + "' of " +
+            std::filesystem::path(x.file).filename().string() +
+            ", where each stands: its triangles are in both, one over the other (a group's "
+            "name takes every node below it)");
+        break;
+      }
+    }
+  }
+}
+
 /// A glTF file is in metres by its specification: read without `units` in
 /// a scenario in millimetres or centimetres, its numbers are taken as the
 /// scenario's, a thousandth or a hundredth of the size meant (a 1 m table
@@ -2123,6 +2171,7 @@ void Loader::resolve() {
   if (noted_.empty()) warn_about_overlapping_parts();
   warn_about_dropped_declarations();
   warn_about_gltf_units();
+  warn_about_nodes_taken_twice();
   if (scenario_.glove && !scenario_.glove->holding.empty()) {
     check_part(scenario_.glove->holding, scenario_.glove->where, "glove: holding");
     if (fixed(scenario_.glove->holding)) {
