@@ -144,8 +144,8 @@ void Hand::merge_region_events(std::vector<engine::Event>& events) {
             e.kind == engine::EventKind::kRegionLeave) &&
            segment_of(e.a).has_value();
   };
-  // The frame's counts before and after, per region touched this frame.
-  std::map<std::string, std::pair<std::size_t, std::size_t>, std::less<>> changed;
+  // Per region touched this frame, its count before the frame's events.
+  std::map<std::string, std::size_t, std::less<>> before;
   std::uint64_t frame = 0;
   double time = 0;
   for (const engine::Event& e : events) {
@@ -153,19 +153,18 @@ void Hand::merge_region_events(std::vector<engine::Event>& events) {
     frame = e.frame;
     time = e.time;
     std::size_t& inside = segments_inside_[e.b];
-    const auto it = changed.try_emplace(e.b, inside, inside).first;
+    before.try_emplace(e.b, inside);
     if (e.kind == engine::EventKind::kRegionEnter) {
       ++inside;
     } else if (inside > 0) {  // a leave without its enter (a region added later) counts none
       --inside;
     }
-    it->second.second = inside;
   }
-  if (changed.empty()) return;
+  if (before.empty()) return;
   std::erase_if(events, is_segment_in_region);
-  for (const auto& [region, counts] : changed) {
-    const auto [before, after] = counts;
-    if ((before == 0) == (after == 0)) continue;
+  for (const auto& [region, was] : before) {
+    const std::size_t after = segments_inside_[region];
+    if ((was == 0) == (after == 0)) continue;
     events.push_back({after > 0 ? engine::EventKind::kRegionEnter : engine::EventKind::kRegionLeave,
                       frame, time, settings_.name, region});
   }
