@@ -202,6 +202,12 @@ std::string brief(double x) {
   return buffer;
 }
 
+/// A mesh's size: the diagonal of its box, in its own units.
+double across(const collision::Mesh& mesh) {
+  const collision::Bounds b = collision::mesh_bounds(mesh);
+  return (b.max - b.min).norm();
+}
+
 /// Of "mm", "cm" and "m", the unit in which numbers read in `units` as
 /// `metres` would give the size nearest `target` metres (by ratio), among
 /// those a hundred times or more from `units` (the size warnings fire at
@@ -938,17 +944,19 @@ class Loader {
   }
 
   /// A part's mesh file read (whole, or the nodes selected), scaled from its
-  /// units to metres.
+  /// units to metres; for a selection, `taken` gets which of the file's
+  /// imported parts it took.
   std::shared_ptr<const collision::Mesh> read_mesh_file(const std::filesystem::path& path,
                                                         const Arg& nodes, const Arg& without,
                                                         double metres_per_unit,
                                                         const SourceLocation& where,
-                                                        const std::string& what) {
+                                                        const std::string& what,
+                                                        std::vector<char>& taken) {
     collision::Mesh loaded;
     try {
       if (nodes.given || without.given) {
-        loaded =
-            select_nodes(path, nodes.given ? nodes.names : without.names, nodes.given, where, what);
+        loaded = select_nodes(path, nodes.given ? nodes.names : without.names, nodes.given, where,
+                              what, taken);
       } else {
         auto [it, fresh] = whole_imports_.try_emplace(path.string());
         if (fresh) {
@@ -971,10 +979,12 @@ class Loader {
     return std::make_shared<const collision::Mesh>(std::move(loaded));
   }
 
-  /// The named nodes of a mesh file (or all but them) as one mesh in the file's frame.
+  /// The named nodes of a mesh file (or all but them) as one mesh in the
+  /// file's frame; `taken` gets which of the file's imported parts it took.
   collision::Mesh select_nodes(const std::filesystem::path& path,
                                const std::vector<std::string>& names, bool keep,
-                               const SourceLocation& where, const std::string& what) {
+                               const SourceLocation& where, const std::string& what,
+                               std::vector<char>& taken) {
     auto [it, fresh] = imports_.try_emplace(path.string());
     if (fresh) {
       engine::ImportOptions options;
@@ -1019,11 +1029,11 @@ class Loader {
     }
     std::vector<Vec3> vertices;
     std::vector<collision::TriangleIndices> triangles;
-    last_taken_.assign(report.parts.size(), 0);
+    taken.assign(report.parts.size(), 0);
     for (std::size_t i = 0; i < report.parts.size(); ++i) {
       const engine::ImportedPart& p = report.parts[i];
       if ((listed[i] != 0) != keep) continue;
-      last_taken_[i] = 1;
+      taken[i] = 1;
       const auto base = static_cast<std::uint32_t>(vertices.size());
       vertices.insert(vertices.end(), p.mesh.vertices.begin(), p.mesh.vertices.end());
       for (collision::TriangleIndices tri : p.mesh.triangles) {
@@ -1069,6 +1079,9 @@ class Loader {
   /// Every name a clause may refer to, by kind.
   struct Names {
     std::vector<std::string> parts, mates, steps, regions;
+    /// The parts, and "hand" when the scenario has one: what a misspelt
+    /// name where the hand may stand is nearest ("hnad": 'hand').
+    std::vector<std::string> parts_or_hand;
   };
   void resolve();
   void resolve_clause(const Clause& clause, const Names& names);
@@ -1100,10 +1113,6 @@ class Loader {
   std::map<std::string, std::string> source_text_;
   std::map<std::string, int> field_lines_;
   std::map<std::string, engine::ImportReport> imports_;  ///< mesh files read by node
-  /// The imported parts (of imports_) the last select_nodes took, and those
-  /// each node selection took, by the key of meshes_.
-  std::vector<char> last_taken_;
-  std::map<std::string, std::vector<char>> taken_by_key_;
   /// A part made of nodes of a file: which it took, and where it stands.
   struct NodesTaken {
     std::string part, file;  ///< file: the key of imports_
@@ -1115,8 +1124,13 @@ class Loader {
   /// Mesh files read whole, once however many parts name them (each read is
   /// a process of its own).
   std::map<std::string, engine::ImportReport> whole_imports_;
-  /// The mesh of every file and node selection read so far.
-  std::map<std::string, std::shared_ptr<const collision::Mesh>> meshes_;
+  /// The mesh of every file and node selection read so far, and for a
+  /// selection which of the file's imported parts it took.
+  struct ReadMesh {
+    std::shared_ptr<const collision::Mesh> mesh;
+    std::vector<char> taken;
+  };
+  std::map<std::string, ReadMesh> meshes_;
 };
 
 Scenario Loader::load() {
@@ -1368,15 +1382,16 @@ void Loader::read_part(int map, PartSpec& part) {
         key += which;
         for (const std::string& node : names) (key += '\0') += node;
       }
-      if (const auto known = meshes_.find(key); known != meshes_.end()) {
-        part.mesh = known->second;  // its files were noted when it was read
-      } else {
-        part.mesh = read_mesh_file(path, nodes, without, file_metres_per_unit, part.where, what);
-        meshes_.emplace(key, part.mesh);
-        if (nodes.given || without.given) taken_by_key_[key] = last_taken_;
+      auto known = meshes_.find(key);
+      if (known == meshes_.end()) {
+        ReadMesh read;
+        read.mesh = read_mesh_file(path, nodes, without, file_metres_per_unit, part.where, what,
+                                   read.taken);
+        known = meshes_.emplace(key, std::move(read)).first;
       }
+      part.mesh = known->second.mesh;  // a known one's files were noted when it was read
       if (nodes.given || without.given) {
-        nodes_taken_.push_back({name, path.string(), taken_by_key_[key]});
+        nodes_taken_.push_back({name, path.string(), known->second.taken});
       }
     }
     if (const Arg at = field(t, word, "at", part.where, what); at.given) part.X_WP.t = at.vector;
@@ -1704,7 +1719,7 @@ void Loader::read_expectations(int list, const SourceLocation& where) {
 }
 
 void Loader::resolve_clause(const Clause& clause, const Names& names) {
-  const auto& [parts, mates, steps, regions] = names;
+  const auto& [parts, mates, steps, regions, parts_or_hand] = names;
   auto check = [&](const std::string& name, const std::vector<std::string>& known,
                    const char* kind) {
     if (std::find(known.begin(), known.end(), name) == known.end()) {
@@ -1738,13 +1753,7 @@ void Loader::resolve_clause(const Clause& clause, const Names& names) {
             note(clause.where, std::string(clause.word->name) + ": the scenario has no hand");
           break;
         }
-        if (scenario_.glove || hand_given_) {
-          std::vector<std::string> parts_and_hand = parts;  // "hnad": did you mean 'hand'?
-          parts_and_hand.emplace_back("hand");
-          check(arg.text, parts_and_hand, "part");
-        } else {
-          check(arg.text, parts, "part");
-        }
+        check(arg.text, parts_or_hand, "part");
         break;
       case ArgType::kPart:
         if (arg.text == "hand" && !clause.word->params.empty() &&
@@ -1937,14 +1946,12 @@ void Loader::warn_about_gltf_units() {
     std::string extension = std::filesystem::path(p.file).extension().string();
     for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (extension != ".gltf" && extension != ".glb") continue;
-    Eigen::AlignedBox<double, 3> box;
-    for (const Vec3& v : p.mesh->vertices) box.extend(v);
-    const double across = box.diagonal().norm() / scenario_.metres_per_unit;  // its numbers
+    const double numbers = across(*p.mesh) / scenario_.metres_per_unit;  // as the file has them
     scenario_.warnings.push_back(
         p.where.str() + ": part '" + p.name + "' (" + p.file +
         "): a glTF file is in metres by its specification, but its numbers are read in " +
-        scenario_.units + ", as the scenario's: " + brief(across) + " " + scenario_.units +
-        " across, where in metres it is " + brief(across) +
+        scenario_.units + ", as the scenario's: " + brief(numbers) + " " + scenario_.units +
+        " across, where in metres it is " + brief(numbers) +
         " m; give the part units = \"m\", or units = \"" + scenario_.units +
         "\" if the file is in " + scenario_.units);
   }
@@ -1957,21 +1964,23 @@ void Loader::warn_about_gltf_units() {
 /// across, and any part passes through it in a frame). A 4 mm screw in a
 /// 3 m frame is no such part.
 void Loader::warn_about_mesh_sizes() {
-  const auto across = [&](const PartSpec& p) {
-    Eigen::AlignedBox<double, 3> box;
-    for (const Vec3& v : p.mesh->vertices) box.extend(v);
-    return box.diagonal().norm() / scenario_.metres_per_unit;
-  };
+  // Each part's size in the scenario's units, once.
+  const std::vector<PartSpec>& parts = scenario_.parts;
+  std::vector<double> sizes(parts.size(), 0);
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (parts[i].mesh) sizes[i] = across(*parts[i].mesh) / scenario_.metres_per_unit;
+  }
   constexpr double kRatio = 500;  // units differ by 1000 (m and mm)
-  for (const PartSpec& p : scenario_.parts) {
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const PartSpec& p = parts[i];
     if (p.file.empty() || !p.mesh) continue;
     std::vector<double> others;
-    for (const PartSpec& q : scenario_.parts) {
-      if (&q != &p && q.mesh) others.push_back(across(q));
+    for (std::size_t j = 0; j < parts.size(); ++j) {
+      if (j != i && parts[j].mesh) others.push_back(sizes[j]);
     }
     if (others.empty()) continue;
     std::nth_element(others.begin(), others.begin() + others.size() / 2, others.end());
-    const double median = others[others.size() / 2], size = across(p);
+    const double median = others[others.size() / 2], size = sizes[i];
     if (!(size > 0) || !(median > 0)) continue;
     const double ratio = median / size;
     // Far from the others and of a size few parts have; or of a size no part has.
@@ -2010,9 +2019,7 @@ void Loader::warn_about_parts_beside_the_hand() {
   for (const PartSpec& p : scenario_.parts) {
     if (p.file.empty() || !p.mesh) continue;
     file_units.insert(p.file_units.empty() ? scenario_.units : p.file_units);
-    Eigen::AlignedBox<double, 3> box;
-    for (const Vec3& v : p.mesh->vertices) box.extend(v);
-    sizes.push_back(box.diagonal().norm());  // metres (the vertices are scaled)
+    sizes.push_back(across(*p.mesh));  // metres (the vertices are scaled)
   }
   if (sizes.empty()) return;
   std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
@@ -2112,6 +2119,8 @@ void Loader::resolve() {
   for (const MateSpec& m : scenario_.mates) names.mates.push_back(m.mate.name);
   for (const StepSpec& s : scenario_.steps) names.steps.push_back(s.name);
   for (const RegionSpec& r : scenario_.regions) names.regions.push_back(r.region.name);
+  names.parts_or_hand = names.parts;
+  if (scenario_.glove || hand_given_) names.parts_or_hand.emplace_back("hand");
   const std::vector<std::string>& parts = names.parts;
   auto fixed = [&](const std::string& name) {
     for (const PartSpec& p : scenario_.parts) {
@@ -2123,9 +2132,8 @@ void Loader::resolve() {
   auto check_part = [&](const std::string& name, const SourceLocation& where,
                         const std::string& what, bool or_hand = false) {
     if (std::find(parts.begin(), parts.end(), name) != parts.end()) return;
-    std::vector<std::string> known = parts;
-    if (or_hand && (scenario_.glove || hand_given_)) known.emplace_back("hand");
-    note(where, what + ": no part '" + name + "'" + did_you_mean(name, known));
+    note(where, what + ": no part '" + name + "'" +
+                    did_you_mean(name, or_hand ? names.parts_or_hand : parts));
   };
   for (const MateSpec& m : scenario_.mates) {
     check_part(m.mate.part, field_line(m.where, "mate", "part"), "mate '" + m.mate.name + "'");
