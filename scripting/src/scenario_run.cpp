@@ -1465,9 +1465,8 @@ void Runner::run() {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return;
   }
-  const double end_time =
-      run_end_time(scenario_, hand_ ? &hand_->source() : nullptr,
-                   options_.trace || (scenario_.glove && !scenario_.glove->trace.empty()));
+  const bool from_trace = options_.trace || (scenario_.glove && !scenario_.glove->trace.empty());
+  const double end_time = run_end_time(scenario_, hand_ ? &hand_->source() : nullptr, from_trace);
   const std::uint64_t frames = frame_count(scenario_, end_time);
   const double last_time = last_frame_time(scenario_, end_time);
   for (std::string& w : never_after(scenario_, last_time)) out_.warnings.push_back(std::move(w));
@@ -1476,8 +1475,7 @@ void Runner::run() {
     out_.error = file_.string() + ": no frame at t=" + format_time(*options_.picture_at) +
                  " s: the run's last frame is at t=" + format_time(last_time) + " s (" +
                  (scenario_.duration ? "its duration"
-                  : options_.trace || (scenario_.glove && !scenario_.glove->trace.empty())
-                      ? "the end of its glove's trace"
+                  : from_trace       ? "the end of its glove's trace"
                   : hand_ ? "the end of its glove's plan, and a second for the hand to come to rest"
                           : "1 s, as a scenario without a glove or duration runs") +
                  ")";
